@@ -1,0 +1,123 @@
+"""Embree ray queries over structure-of-arrays rays, chunked across a thread pool.
+
+``embreex``'s ``EmbreeScene.run`` is a single-threaded loop over rtcIntersect1/rtcOccluded1
+that releases the GIL, so chunks of rays run concurrently on a shared thread pool.
+``tnear`` is fixed at 0 by embreex: callers must offset origins (see :func:`offset_origin`).
+"""
+from __future__ import annotations
+
+import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+CHUNK_RAYS = 32768  # rays per Embree call: large enough to amortize the call, small for load balance
+
+_POOL: ThreadPoolExecutor | None = None
+
+
+def thread_count() -> int:
+    return max(1, os.cpu_count() or 1)
+
+
+def in_worker() -> bool:
+    """True inside a pool thread: nested work then runs inline instead of waiting on the pool."""
+    return threading.current_thread().name.startswith("restir")
+
+
+def run_chunks(fn, spans) -> None:
+    """Run ``fn(span)`` for every span, on the pool unless already inside a worker."""
+    if in_worker() or len(spans) == 1:
+        for span in spans:
+            fn(span)
+    else:
+        list(pool().map(fn, spans))
+
+
+def pool() -> ThreadPoolExecutor:
+    """The process-wide worker pool (one thread per core)."""
+    global _POOL
+    if _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=thread_count(), thread_name_prefix="restir")
+    return _POOL
+
+
+def offset_origin(p: np.ndarray, ng: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Move points off their surface along the geometric normal, to the side ``direction`` leaves by.
+
+    The offset scales with the coordinate magnitude (float32 spacing) so it works at any scene scale.
+    """
+    side = np.where(np.einsum("ij,ij->i", ng, direction) >= 0.0, 1.0, -1.0).astype(np.float32)
+    mag = np.maximum(np.abs(p).max(axis=1), 1.0).astype(np.float32)
+    return (p + ng * (side * mag * 1e-4)[:, None]).astype(np.float32)
+
+
+class Hits:
+    """Closest-hit results, SoA: prim (int32, -1 = miss), t (float32 distance), u, v (barycentrics)."""
+
+    __slots__ = ("prim", "t", "u", "v")
+
+    def __init__(self, n: int):
+        self.prim = np.full(n, -1, dtype=np.int32)
+        self.t = np.full(n, np.inf, dtype=np.float32)
+        self.u = np.zeros(n, dtype=np.float32)
+        self.v = np.zeros(n, dtype=np.float32)
+
+
+class Accel:
+    """A static triangle scene. ``triangles`` is (n, 3, 3) float32 world-space vertices."""
+
+    def __init__(self, triangles: np.ndarray):
+        self.n_triangles = int(len(triangles))
+        self._scene = None
+        if self.n_triangles:
+            from embreex import rtcore_scene
+            from embreex.mesh_construction import TriangleMesh
+            self._scene = rtcore_scene.EmbreeScene()
+            self._mesh = TriangleMesh(self._scene, np.ascontiguousarray(triangles, dtype=np.float32))
+
+    # -- chunked execution -------------------------------------------------------------
+    def _chunks(self, n: int):
+        return [(s, min(n, s + CHUNK_RAYS)) for s in range(0, n, CHUNK_RAYS)]
+
+    def intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
+        """Closest hit of each ray (origins/directions (n, 3) float32; directions need not be unit,
+        ``t`` is then in units of the direction length)."""
+        n = len(origins)
+        hits = Hits(n)
+        if self._scene is None or n == 0:
+            return hits
+        o = np.ascontiguousarray(origins, dtype=np.float32)
+        d = np.ascontiguousarray(directions, dtype=np.float32)
+        far = None if tmax is None else np.ascontiguousarray(tmax, dtype=np.float32)
+
+        def work(span):
+            s, e = span
+            r = self._scene.run(o[s:e], d[s:e], dists=None if far is None else far[s:e].copy(), output=1)
+            prim = r["primID"]
+            hits.prim[s:e] = prim
+            hit = prim >= 0
+            hits.t[s:e] = np.where(hit, r["tfar"], np.inf)
+            hits.u[s:e] = r["u"]
+            hits.v[s:e] = r["v"]
+
+        run_chunks(work, self._chunks(n))
+        return hits
+
+    def occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+        """True where something lies on the segment origin + t*direction, 0 < t < tmax."""
+        n = len(origins)
+        out = np.zeros(n, dtype=bool)
+        if self._scene is None or n == 0:
+            return out
+        o = np.ascontiguousarray(origins, dtype=np.float32)
+        d = np.ascontiguousarray(directions, dtype=np.float32)
+        far = np.ascontiguousarray(tmax, dtype=np.float32)
+
+        def work(span):
+            s, e = span
+            out[s:e] = self._scene.run(o[s:e], d[s:e], dists=far[s:e].copy(), query="OCCLUDED") >= 0
+
+        run_chunks(work, self._chunks(n))
+        return out

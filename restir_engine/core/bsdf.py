@@ -1,0 +1,116 @@
+"""Lambert diffuse + GGX specular BSDF, vectorized.
+
+All directions are in the local shading frame (z = shading normal), unit length,
+``wo`` towards the viewer, ``wi`` towards the light. ``eval`` returns f (n, 3) without the
+cosine, pdfs are in solid-angle measure.
+
+Model (an approximation of Principled BSDF, see docs/MATERIALS.md):
+  diffuse  = base·(1-metallic)/π · (1 - F_d(cos_o))      F_d: Schlick with the dielectric f0
+  specular = D·G·F / (4 cos_i cos_o)   GGX D, height-correlated Smith G, Schlick F with
+             f0 = mix(f0_dielectric, base, metallic), alpha = roughness²
+The (1 - F_d) factor keeps reflectance ≤ 1 (energy-sensible). Lobes are sampled by one-sample
+MIS: cosine hemisphere for the diffuse lobe, the GGX normal distribution for the specular one.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .sampling import cosine_hemisphere
+
+ALPHA_MIN = 1e-3
+INV_PI = np.float32(1.0 / np.pi)
+
+
+def luminance(rgb: np.ndarray) -> np.ndarray:
+    return rgb @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
+
+
+@dataclass
+class SurfaceParams:
+    """Per-hit BSDF parameters: diffuse (n, 3), f0 (n, 3), f0_dielectric (n,), alpha (n,), p_spec (n,)."""
+
+    diffuse: np.ndarray
+    f0: np.ndarray
+    f0_dielectric: np.ndarray
+    alpha: np.ndarray
+    p_spec: np.ndarray
+
+    @staticmethod
+    def from_material(base: np.ndarray, metallic: np.ndarray, roughness: np.ndarray, f0_d: np.ndarray):
+        m = np.clip(metallic, 0, 1)[:, None]
+        f0 = (f0_d[:, None] * (1 - m) + base * m).astype(np.float32)
+        diffuse = (base * (1 - m)).astype(np.float32)
+        alpha = np.maximum(np.clip(roughness, 0, 1) ** 2, ALPHA_MIN).astype(np.float32)
+        ws = luminance(f0)
+        wd = luminance(diffuse) * (1 - f0_d)
+        tot = ws + wd
+        p = np.where(tot > 0, ws / np.maximum(tot, 1e-12), 0.0)
+        both = (ws > 0) & (wd > 0)
+        p = np.where(both, np.clip(p, 0.1, 0.9), p).astype(np.float32)
+        return SurfaceParams(diffuse, f0, f0_d.astype(np.float32), alpha, p)
+
+
+def _schlick(f0, cos):
+    c = np.clip(1.0 - cos, 0.0, 1.0)
+    c5 = (c * c) * (c * c) * c
+    return f0 + (1.0 - f0) * c5
+
+
+def _ggx_d(alpha, cos_h):
+    a2 = alpha * alpha
+    c2 = cos_h * cos_h
+    den = c2 * (a2 - 1.0) + 1.0
+    return a2 / (np.pi * den * den)
+
+
+def _smith_lambda(alpha, cos):
+    c2 = np.clip(cos * cos, 1e-12, 1.0)
+    tan2 = (1.0 - c2) / c2
+    return 0.5 * (np.sqrt(1.0 + alpha * alpha * tan2) - 1.0)
+
+
+def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
+    """f (n, 3) and pdf (n,) of sampling wi given wo."""
+    co = wo[:, 2]
+    ci = wi[:, 2]
+    valid = (co > 0) & (ci > 0)
+    fd = 1.0 - _schlick(p.f0_dielectric, co)
+    f = p.diffuse * (fd * INV_PI)[:, None]
+    pdf_d = np.maximum(ci, 0) * INV_PI
+    h = wo + wi
+    hn = np.linalg.norm(h, axis=1)
+    h = h / np.maximum(hn, 1e-12)[:, None]
+    cos_h = np.clip(h[:, 2], 0, 1)
+    odh = np.clip(np.einsum("ij,ij->i", wo, h), 1e-6, 1.0)
+    d = _ggx_d(p.alpha, cos_h)
+    g = 1.0 / (1.0 + _smith_lambda(p.alpha, co) + _smith_lambda(p.alpha, ci))
+    fr = _schlick(p.f0, odh[:, None])
+    spec = (d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr
+    f = f + spec
+    pdf_s = d * cos_h / (4.0 * odh)
+    pdf = (1 - p.p_spec) * pdf_d + p.p_spec * pdf_s
+    f = np.where(valid[:, None], f, 0.0).astype(np.float32)
+    pdf = np.where(valid, pdf, 0.0).astype(np.float32)
+    return f, pdf
+
+
+def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.ndarray, u2: np.ndarray):
+    """Sample wi; returns wi (n, 3), f (n, 3), pdf (n,) (the mixture pdf, so MIS-ready)."""
+    n = len(wo)
+    spec = u_lobe < p.p_spec
+    wi = cosine_hemisphere(u1, u2)
+    if spec.any():
+        a = p.alpha[spec]
+        uu1, uu2 = u1[spec], u2[spec]
+        tan2 = a * a * uu1 / np.maximum(1.0 - uu1, 1e-7)
+        cos_t = 1.0 / np.sqrt(1.0 + tan2)
+        sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+        phi = 2 * np.pi * uu2
+        h = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=-1)
+        o = wo[spec]
+        wi[spec] = (2.0 * np.einsum("ij,ij->i", o, h)[:, None] * h - o).astype(np.float32)
+    f, pdf = eval_bsdf(p, wo, wi)
+    ok = (pdf > 0) & (wi[:, 2] > 0)
+    return wi, np.where(ok[:, None], f, 0.0).astype(np.float32), np.where(ok, pdf, 0.0).astype(np.float32)

@@ -1,0 +1,42 @@
+"""Primary rays from Blender's camera model.
+
+Raster coordinates are in pixels of the full render resolution, x to the right and y *up*
+(row 0 at the bottom, as Blender stores images). Pixel (i, j) covers [i, i+1) x [j, j+1).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .scene import Camera
+
+
+def _xform(m: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    h = pts @ m[:3, :3].T + m[:3, 3]
+    w = pts @ m[3, :3] + m[3, 3]
+    return h / w[:, None]
+
+
+def forward(cam: Camera) -> np.ndarray:
+    f = -cam.cam_to_world[:3, 2]
+    return (f / np.linalg.norm(f)).astype(np.float32)
+
+
+def position(cam: Camera) -> np.ndarray:
+    return cam.cam_to_world[:3, 3].astype(np.float32)
+
+
+def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray):
+    """Rays through raster points (x, y): origins on the near clip plane (n, 3), unit directions
+    (n, 3) and the distance to the far clip plane (n,)."""
+    nx = (2.0 * x / cam.width - 1.0).astype(np.float64)
+    ny = (2.0 * y / cam.height - 1.0).astype(np.float64)
+    ones = np.ones_like(nx)
+    near = _xform(cam.ndc_to_cam, np.stack([nx, ny, -ones], axis=-1))
+    far = _xform(cam.ndc_to_cam, np.stack([nx, ny, ones], axis=-1))
+    c2w = cam.cam_to_world.astype(np.float64)
+    near_w = near @ c2w[:3, :3].T + c2w[:3, 3]
+    far_w = far @ c2w[:3, :3].T + c2w[:3, 3]
+    d = far_w - near_w
+    length = np.linalg.norm(d, axis=1)
+    d = d / np.maximum(length, 1e-30)[:, None]
+    return near_w.astype(np.float32), d.astype(np.float32), length.astype(np.float32)

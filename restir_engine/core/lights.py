@@ -1,0 +1,185 @@
+"""One light table over every emitter, with power-proportional selection.
+
+Entries, in order: emissive scene triangles (kind GEOM), Blender lamp triangles (kind LAMP,
+non-occluding) and suns (kind SUN, distant lights). Triangle lights are sampled uniformly in
+area; the returned pdf is converted to solid angle: p_ω = p_select · (1/A) · d² / |cos θ_light|.
+Suns are sampled uniformly in their cone and are handled by light sampling only (a BSDF ray
+that escapes never collects a sun), which keeps the MIS estimator unbiased.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .bsdf import luminance
+from .sampling import AliasTable, orthonormal_basis, uniform_triangle
+from .scene import Lamps, MaterialTable, Scene, TriangleSet
+from .textures import apply_texture, mean_color
+
+GEOM, LAMP, SUN = 0, 1, 2
+
+
+def triangle_geometry(verts: np.ndarray):
+    """Unit geometric normals (winding order) and areas of (n, 3, 3) triangles."""
+    c = np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0])
+    ln = np.linalg.norm(c, axis=1)
+    ng = c / np.maximum(ln, 1e-30)[:, None]
+    return ng.astype(np.float32), (0.5 * ln).astype(np.float32)
+
+
+def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarray,
+                     b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
+    """Emitted radiance (n, 3), W·sr⁻¹·m⁻², at barycentrics (b1, b2) of triangles ``tri``."""
+    mat = tris.material[tri]
+    le = materials.emission[mat]
+    if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
+        uv3 = tris.uvs[tri]
+        uv = uv3[:, 0] * (1 - b1 - b2)[:, None] + uv3[:, 1] * b1[:, None] + uv3[:, 2] * b2[:, None]
+        le = apply_texture(le, materials.emit_tex[mat], uv, materials.textures)
+    return le
+
+
+def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Spot cone attenuation (n,) of lamp triangles seen from points p (Cycles' smoothstep blend)."""
+    cos_cut = lamps.spot_cos[lamp_tri]
+    out = np.ones(len(lamp_tri), np.float32)
+    spot = cos_cut > -1.5
+    if spot.any():
+        d = p[spot] - lamps.spot_center[lamp_tri[spot]]
+        d /= np.maximum(np.linalg.norm(d, axis=1), 1e-30)[:, None]
+        t = np.einsum("ij,ij->i", d, lamps.spot_axis[lamp_tri[spot]])
+        sm = lamps.spot_smooth[lamp_tri[spot]]
+        x = np.where(sm > 0, (t - cos_cut[spot]) / np.maximum(sm, 1e-12), np.where(t > cos_cut[spot], 1.0, 0.0))
+        x = np.clip(x, 0.0, 1.0)
+        out[spot] = x * x * (3 - 2 * x)
+    return out
+
+
+@dataclass
+class LightSample:
+    """Per shading point: unit direction wi (n, 3), distance (n,) (inf for suns), radiance Le (n, 3)
+    arriving along -wi, pdf (n,) in solid angle (selection included; 0 = no light), delta (n,) bool."""
+
+    wi: np.ndarray
+    dist: np.ndarray
+    le: np.ndarray
+    pdf: np.ndarray
+    delta: np.ndarray
+
+
+class LightTable:
+    def __init__(self, scene: Scene, scene_radius: float):
+        geom, lamps, mats = scene.geometry, scene.lamps, scene.materials
+        # emissive scene triangles: non-zero emission (texture mean included)
+        emit_lum = luminance(mats.emission)
+        tex_mean = np.array([luminance(mean_color(t)[None])[0] for t in mats.textures], np.float32)
+        emit_scale = np.where(mats.emit_tex >= 0, tex_mean[np.maximum(mats.emit_tex, 0)] if len(tex_mean) else 0.0, 1.0)
+        mat_power_density = emit_lum * emit_scale * np.where(mats.two_sided_emission, 2.0, 1.0) * np.pi
+        g_idx = np.flatnonzero(mat_power_density[geom.material] > 0) if len(geom) else np.zeros(0, np.int64)
+        l_idx = np.flatnonzero(mat_power_density[lamps.tris.material] > 0) if len(lamps.tris) else np.zeros(0, np.int64)
+        self.geom_ids = g_idx
+        self.lamp_ids = l_idx
+        self.tri_verts = np.concatenate([geom.verts[g_idx], lamps.tris.verts[l_idx]]).astype(np.float32)
+        self.tri_normal, self.tri_area = triangle_geometry(self.tri_verts) if len(self.tri_verts) else (
+            np.zeros((0, 3), np.float32), np.zeros(0, np.float32))
+        tri_mat = np.concatenate([geom.material[g_idx], lamps.tris.material[l_idx]]).astype(np.int64)
+        self.tri_two_sided = mats.two_sided_emission[tri_mat] if len(tri_mat) else np.zeros(0, bool)
+        # power (W, luminance-weighted) decides selection; zero-area triangles get zero power
+        tri_power = mat_power_density[tri_mat] * self.tri_area if len(tri_mat) else np.zeros(0, np.float32)
+        sun_power = luminance(lamps.sun_irradiance) * np.pi * scene_radius ** 2 if len(lamps.sun_dir) else np.zeros(0)
+        self.n_tri = len(self.tri_verts)
+        self.n_geom = len(g_idx)
+        self.n_sun = len(lamps.sun_dir)
+        power = np.concatenate([tri_power, sun_power]).astype(np.float64)
+        self.power = power
+        self.geom_to_light = np.full(len(geom), -1, np.int64)
+        self.geom_to_light[g_idx] = np.arange(len(g_idx))
+        self.lamp_to_light = np.full(len(lamps.tris), -1, np.int64)
+        self.lamp_to_light[l_idx] = len(g_idx) + np.arange(len(l_idx))
+        self.alias = AliasTable(power) if (power > 0).any() else None
+        self.scene = scene
+
+    @property
+    def empty(self) -> bool:
+        return self.alias is None
+
+    def tri_pdf_solid_angle(self, light: np.ndarray, dist: np.ndarray, cos_light: np.ndarray) -> np.ndarray:
+        """Solid-angle pdf with which :meth:`sample` would pick this point of triangle light ``light``."""
+        if self.alias is None:
+            return np.zeros(len(light), np.float32)
+        p_sel = self.alias.pdf[light]
+        area = np.maximum(self.tri_area[light], 1e-30)
+        return (p_sel / area * dist * dist / np.maximum(np.abs(cos_light), 1e-8)).astype(np.float32)
+
+    def radiance_of(self, light: np.ndarray, b1, b2, p_receiver: np.ndarray) -> np.ndarray:
+        """Radiance (n, 3) leaving triangle light ``light`` at (b1, b2) towards p_receiver,
+        before the sidedness test (spot cones included)."""
+        scene = self.scene
+        out = np.zeros((len(light), 3), np.float32)
+        is_geom = light < self.n_geom
+        if is_geom.any():
+            g = self.geom_ids[light[is_geom]]
+            out[is_geom] = emitted_radiance(scene.geometry, scene.materials, g, b1[is_geom], b2[is_geom])
+        lm = ~is_geom
+        if lm.any():
+            t = self.lamp_ids[light[lm] - self.n_geom]
+            le = emitted_radiance(scene.lamps.tris, scene.materials, t, b1[lm], b2[lm])
+            out[lm] = le * spot_factor(scene.lamps, t, p_receiver[lm])[:, None]
+        return out
+
+    def sample(self, p: np.ndarray, u: np.ndarray) -> LightSample:
+        """Pick one light per point p (n, 3) with power-proportional probability and a point on it.
+        ``u`` is (n, 4) uniforms."""
+        n = len(p)
+        wi = np.zeros((n, 3), np.float32)
+        dist = np.zeros(n, np.float32)
+        le = np.zeros((n, 3), np.float32)
+        pdf = np.zeros(n, np.float32)
+        delta = np.zeros(n, bool)
+        if self.alias is None or n == 0:
+            return LightSample(wi, dist, le, pdf, delta)
+        light = self.alias.sample(u[:, 0], u[:, 1])
+        tri = light < self.n_tri
+        if tri.any():
+            li = light[tri]
+            b1, b2 = uniform_triangle(u[tri, 2], u[tri, 3])
+            v = self.tri_verts[li]
+            q = v[:, 0] * (1 - b1 - b2)[:, None] + v[:, 1] * b1[:, None] + v[:, 2] * b2[:, None]
+            d = q - p[tri]
+            dl = np.linalg.norm(d, axis=1)
+            w = d / np.maximum(dl, 1e-30)[:, None]
+            cos_l = -np.einsum("ij,ij->i", w, self.tri_normal[li])
+            facing = (cos_l > 0) | self.tri_two_sided[li]
+            rad = self.radiance_of(li, b1, b2, p[tri])
+            pd = self.tri_pdf_solid_angle(li, dl, cos_l)
+            ok = facing & (dl > 0) & (np.abs(cos_l) > 1e-8) & np.isfinite(pd)
+            wi[tri] = w
+            dist[tri] = dl
+            le[tri] = np.where(ok[:, None], rad, 0.0)
+            pdf[tri] = np.where(ok, pd, 0.0)
+        sun = ~tri
+        if sun.any():
+            s = light[sun] - self.n_tri
+            lamps = self.scene.lamps
+            axis = lamps.sun_dir[s]
+            cmax = lamps.sun_cos[s]
+            is_delta = cmax >= 1.0 - 1e-9
+            # uniform direction in the cone around the sun axis
+            cos_t = 1.0 - u[sun, 2] * (1.0 - cmax)
+            sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+            phi = 2 * np.pi * u[sun, 3]
+            t, b = orthonormal_basis(axis)
+            dvec = (t * (sin_t * np.cos(phi))[:, None] + b * (sin_t * np.sin(phi))[:, None] + axis * cos_t[:, None])
+            solid = 2 * np.pi * (1.0 - cmax)
+            p_sel = self.alias.pdf[light[sun]]
+            # radiance of a disc of half-angle a whose cosine-weighted integral is the irradiance E
+            sin2 = np.maximum(1.0 - cmax * cmax, 1e-30)
+            rad = lamps.sun_irradiance[s] / (np.pi * sin2)[:, None]
+            wi[sun] = np.where(is_delta[:, None], axis, dvec)
+            dist[sun] = np.inf
+            # for a delta sun store Le·(1/p_sel) with pdf = p_sel and flag delta: the estimator divides by pdf
+            le[sun] = np.where(is_delta[:, None], lamps.sun_irradiance[s], rad)
+            pdf[sun] = np.where(is_delta, p_sel, p_sel / np.maximum(solid, 1e-30))
+            delta[sun] = True  # suns are never hit by BSDF rays: no MIS
+        return LightSample(wi, dist, le, pdf, delta)

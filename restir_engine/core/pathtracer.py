@@ -1,0 +1,237 @@
+"""Reference path tracer: the unbiased baseline every other method is compared with.
+
+Estimator per pixel sample (wavefront form, vectorized over the rays of a tile):
+  L = Le(x0) + Σ_k T_k [ f·|cos|·Le / p_light · w_light  (next-event estimation at x_k)
+                          + f·|cos|/p_bsdf · Le(x_{k+1}) · w_bsdf ]   (BSDF sampling)
+with power-heuristic MIS weights w = p²/(p_light² + p_bsdf²), both pdfs in solid angle.
+``max_bounces`` = 0 is direct light only (as in Cycles); Russian roulette from bounce ``rr_start``.
+Lamps (Blender Light objects) emit but do not occlude; a ray collects the nearest lamp in front
+of its geometry hit and continues. The world colour is collected by escaping rays (weight 1:
+it is not light-sampled). Suns are light-sampled only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import camera as camera_mod
+from .accel import Accel, offset_origin
+from .bsdf import SurfaceParams, eval_bsdf, sample_bsdf
+from .lights import LightTable, spot_factor, triangle_geometry, emitted_radiance
+from .sampling import orthonormal_basis, to_local, to_world
+from .scene import Scene
+from .textures import apply_texture
+
+
+@dataclass
+class TraceContext:
+    """Everything a tile needs, built once per frame."""
+
+    scene: Scene
+    geom_accel: Accel
+    lamp_accel: Accel
+    lights: LightTable
+    geom_ng: np.ndarray  # (n, 3) unit geometric normals
+    lamp_ng: np.ndarray
+    max_bounces: int
+    rr_start: int = 3
+    film_transparent: bool = False
+
+
+def _power_heuristic(a, b):
+    a2 = a * a
+    return np.where(a2 > 0, a2 / np.maximum(a2 + b * b, 1e-30), 0.0).astype(np.float32)
+
+
+def _sanitize(x: np.ndarray) -> np.ndarray:
+    return np.where(np.isfinite(x), x, 0.0).astype(np.float32)
+
+
+class Surface:
+    """Shading data at hits: p, ng, ns (both facing the incoming ray), uv, BSDF params, frame."""
+
+    def __init__(self, ctx: TraceContext, prim, u, v, o, d, t):
+        scene = ctx.scene
+        geom = scene.geometry
+        mats = scene.materials
+        self.prim = prim
+        self.b1, self.b2 = u, v
+        w0 = (1 - u - v)[:, None]
+        self.p = (o + d * t[:, None]).astype(np.float32)
+        ng = ctx.geom_ng[prim]
+        cn = geom.normals[prim]
+        ns = cn[:, 0] * w0 + cn[:, 1] * u[:, None] + cn[:, 2] * v[:, None]
+        ns /= np.maximum(np.linalg.norm(ns, axis=1), 1e-12)[:, None]
+        bad = ~np.isfinite(ns).all(axis=1) | (np.linalg.norm(ns, axis=1) < 0.5)
+        ns[bad] = ng[bad]
+        ns = np.where((np.einsum("ij,ij->i", ns, ng) < 0)[:, None], -ns, ns)
+        flip = np.einsum("ij,ij->i", ng, d) > 0
+        s = np.where(flip, -1.0, 1.0).astype(np.float32)[:, None]
+        self.ng = (ng * s).astype(np.float32)
+        self.ns = (ns * s).astype(np.float32)
+        self.wo = (-d).astype(np.float32)
+        mat = geom.material[prim]
+        self.mat = mat
+        base = mats.base_color[mat]
+        self.uv = None
+        if geom.uvs is not None:
+            uv3 = geom.uvs[prim]
+            self.uv = uv3[:, 0] * w0 + uv3[:, 1] * u[:, None] + uv3[:, 2] * v[:, None]
+            base = apply_texture(base, mats.base_tex[mat], self.uv, mats.textures)
+        self.params = SurfaceParams.from_material(base, mats.metallic[mat], mats.roughness[mat], mats.f0[mat])
+        self.t, self.bt = orthonormal_basis(self.ns)
+        self.wo_l = to_local(self.wo, self.ns, self.t, self.bt)
+        # view vectors below the shading hemisphere (shading-normal artefact): bend to the horizon
+        self.wo_l[:, 2] = np.maximum(self.wo_l[:, 2], 1e-4)
+        self.wo_l /= np.linalg.norm(self.wo_l, axis=1)[:, None]
+
+    def emission(self, ctx: TraceContext):
+        """Emitted radiance (n, 3) towards the incoming ray (mesh emission is two-sided by default)."""
+        return emitted_radiance(ctx.scene.geometry, ctx.scene.materials, self.prim, self.b1, self.b2)
+
+
+def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
+    """Radiance collected from the nearest lamp hit by rays ``sel`` (front faces only), and the
+    solid-angle light pdf of that point for MIS."""
+    prim = lh.prim[sel]
+    t = lh.t[sel]
+    ng = ctx.lamp_ng[prim]
+    cos_l = -np.einsum("ij,ij->i", d[sel], ng)
+    lamps = ctx.scene.lamps
+    p = o[sel] + d[sel] * t[:, None]
+    le = emitted_radiance(lamps.tris, ctx.scene.materials, prim, lh.u[sel], lh.v[sel])
+    le *= spot_factor(lamps, prim, o[sel])[:, None]
+    le = np.where((cos_l > 0)[:, None], le, 0.0)
+    light = ctx.lights.lamp_to_light[prim]
+    pdf = np.where(light >= 0, ctx.lights.tri_pdf_solid_angle(np.maximum(light, 0), t, cos_l), 0.0)
+    del p
+    return le.astype(np.float32), pdf.astype(np.float32)
+
+
+def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Generator):
+    """Trace one path per raster sample point (x, y).
+
+    Returns radiance (n, 3) split into direct (n, 3) and indirect (n, 3) parts, planar depth (n,),
+    world normal (n, 3) and alpha (n,) of the first hit.
+    """
+    cam = ctx.scene.camera
+    n = len(x)
+    o, d, tmax = camera_mod.generate_rays(cam, x, y)
+    direct = np.zeros((n, 3), np.float32)
+    indirect = np.zeros((n, 3), np.float32)
+    emitted = np.zeros((n, 3), np.float32)
+    depth = np.full(n, 1e10, np.float32)
+    normal = np.zeros((n, 3), np.float32)
+    alpha = np.ones(n, np.float32)
+    hits = ctx.geom_accel.intersect(o, d, tmax)
+    alive = hits.prim >= 0
+    # lamps seen by the camera (those marked visible to camera rays)
+    if len(ctx.scene.lamps.tris):
+        lh = ctx.lamp_accel.intersect(o, d, np.minimum(hits.t, tmax))
+        sel = np.flatnonzero((lh.prim >= 0) & (lh.t < hits.t))
+        sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
+        if sel.size:
+            le, _ = _lamp_emission(ctx, lh, o, d, sel)
+            emitted[sel] += le
+    miss = ~alive
+    if ctx.film_transparent:
+        alpha[miss] = 0.0
+    else:
+        emitted[miss] += ctx.scene.world_radiance
+    idx = np.flatnonzero(alive)
+    if idx.size == 0:
+        return _sanitize(emitted), direct, indirect, depth, normal, alpha
+    fwd = camera_mod.forward(cam)
+    cam_pos = camera_mod.position(cam)
+    o, d = o[idx], d[idx]
+    prim, hu, hv, ht = hits.prim[idx], hits.u[idx], hits.v[idx], hits.t[idx]
+    throughput = np.ones((idx.size, 3), np.float32)
+    prev_pdf = np.zeros(idx.size, np.float32)
+
+    for bounce in range(ctx.max_bounces + 1):
+        s = Surface(ctx, prim, hu, hv, o, d, ht)
+        target = direct if bounce == 0 else indirect
+        if bounce == 0:
+            depth[idx] = np.einsum("ij,j->i", s.p - cam_pos, fwd)
+            normal[idx] = s.ns
+            emitted[idx] += s.emission(ctx)
+        # --- next-event estimation -------------------------------------------------------
+        if not ctx.lights.empty:
+            ls = ctx.lights.sample(s.p, rng.random((idx.size, 4), dtype=np.float32))
+            wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
+            f, pdf_b = eval_bsdf(s.params, s.wo_l, wi_l)
+            geo_ok = np.einsum("ij,ij->i", ls.wi, s.ng) > 0
+            w = np.where(ls.delta, 1.0, _power_heuristic(ls.pdf, pdf_b))
+            contrib = throughput * f * (np.abs(wi_l[:, 2]) * w / np.maximum(ls.pdf, 1e-30))[:, None] * ls.le
+            live = np.flatnonzero(geo_ok & (ls.pdf > 0) & (contrib.max(axis=1) > 0))
+            if live.size:
+                so = offset_origin(s.p[live], s.ng[live], ls.wi[live])
+                dist = ls.dist[live]
+                far = np.where(np.isfinite(dist), dist * (1 - 2e-4), 1e30)
+                vis = ~ctx.geom_accel.occluded(so, ls.wi[live], far)
+                np.add.at(target, idx[live[vis]], _sanitize(contrib[live[vis]]))
+        # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -----------------------------------------------------------------
+        u = rng.random((idx.size, 3), dtype=np.float32)
+        wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[:, 0], u[:, 1], u[:, 2])
+        wi = to_world(wi_l, s.ns, s.t, s.bt)
+        wi /= np.maximum(np.linalg.norm(wi, axis=1), 1e-12)[:, None]
+        ok = (pdf > 0) & (np.einsum("ij,ij->i", wi, s.ng) > 0)
+        throughput = throughput * f * (wi_l[:, 2] / np.maximum(pdf, 1e-30))[:, None]
+        if bounce + 1 >= ctx.rr_start:
+            q = np.clip(throughput.max(axis=1), 0.05, 1.0)
+            ok &= rng.random(idx.size, dtype=np.float32) < q
+            throughput /= q[:, None]
+        keep = np.flatnonzero(ok & np.isfinite(throughput).all(axis=1))
+        if keep.size == 0:
+            break
+        idx, throughput, prev_pdf = idx[keep], throughput[keep], pdf[keep]
+        o = offset_origin(s.p[keep], s.ng[keep], wi[keep])
+        d = wi[keep].astype(np.float32)
+        hits = ctx.geom_accel.intersect(o, d)
+        # emission found by the BSDF ray: lamps in front of the hit, then the hit itself, else the world
+        target = direct if bounce == 0 else indirect
+        if len(ctx.scene.lamps.tris):
+            lh = ctx.lamp_accel.intersect(o, d, hits.t)
+            sel = np.flatnonzero((lh.prim >= 0) & (lh.t < hits.t))
+            if sel.size:
+                le, pl = _lamp_emission(ctx, lh, o, d, sel)
+                w = _power_heuristic(prev_pdf[sel], pl)
+                np.add.at(target, idx[sel], _sanitize(throughput[sel] * le * w[:, None]))
+        hit = hits.prim >= 0
+        esc = np.flatnonzero(~hit)
+        if esc.size:  # film transparency affects camera rays only
+            np.add.at(target, idx[esc], _sanitize(throughput[esc] * ctx.scene.world_radiance))
+        hsel = np.flatnonzero(hit)
+        if hsel.size == 0:
+            break
+        hp = hits.prim[hsel]
+        light = ctx.lights.geom_to_light[hp]
+        em = np.flatnonzero(light >= 0)
+        if em.size:
+            hs = hsel[em]
+            le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
+            cos_l = -np.einsum("ij,ij->i", d[hs], ctx.geom_ng[hp[em]])
+            two = ctx.lights.tri_two_sided[light[em]]
+            le = np.where(((cos_l > 0) | two)[:, None], le, 0.0)
+            pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
+            w = _power_heuristic(prev_pdf[hs], pl)
+            np.add.at(target, idx[hs], _sanitize(throughput[hs] * le * w[:, None]))
+        idx, throughput, prev_pdf = idx[hsel], throughput[hsel], prev_pdf[hsel]
+        o, d = o[hsel], d[hsel]
+        prim, hu, hv, ht = hits.prim[hsel], hits.u[hsel], hits.v[hsel], hits.t[hsel]
+
+    return _sanitize(emitted), direct, indirect, depth, normal, alpha
+
+
+def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False) -> TraceContext:
+    geom = scene.geometry
+    lamps = scene.lamps
+    verts = np.concatenate([geom.verts.reshape(-1, 3), lamps.tris.verts.reshape(-1, 3)])
+    finite = verts[np.isfinite(verts).all(axis=1)]
+    radius = float(np.linalg.norm(finite.max(0) - finite.min(0)) / 2) if len(finite) else 1.0
+    geom_ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
+    lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
+    return TraceContext(scene=scene, geom_accel=Accel(geom.verts), lamp_accel=Accel(lamps.tris.verts),
+                        lights=LightTable(scene, max(radius, 1e-3)), geom_ng=geom_ng, lamp_ng=lamp_ng,
+                        max_bounces=int(max(0, max_bounces)), film_transparent=film_transparent)

@@ -1,0 +1,113 @@
+"""Random streams and discrete sampling.
+
+Every random number the renderer draws comes from a generator keyed by
+``(seed, frame, pass, stream, chunk)`` so that the same settings give the same image
+whatever the thread scheduling, and a different ``seed`` gives independent noise.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+# Stream identifiers: one per use of randomness, so adding a new use never shifts another.
+STREAM_CAMERA = 1
+STREAM_PATH = 2
+
+
+def rng(seed: int, frame: int, pass_index: int, stream: int, chunk: int = 0) -> np.random.Generator:
+    """A Philox generator keyed by the tuple; independent across any differing key."""
+    key = [int(seed) & 0xFFFFFFFF, int(frame) & 0xFFFFFFFF, int(pass_index) & 0xFFFFFFFF,
+           int(stream) & 0xFFFFFFFF, int(chunk) & 0xFFFFFFFF]
+    return np.random.Generator(np.random.Philox(np.random.SeedSequence(key)))
+
+
+class AliasTable:
+    """Walker/Vose alias table for O(1) sampling proportional to non-negative weights.
+
+    Built without a Python loop over items, by the prefix-sum form of the sweeping
+    construction: light items (weight below the mean) are assigned, in order, to the
+    heavy item whose cumulative excess covers their cumulative deficit; a heavy item
+    keeps as its own probability what is left after its last donation and aliases to
+    the next heavy item.
+
+    ``pdf`` holds the normalized probability of every item (zero-weight items get 0).
+    """
+
+    def __init__(self, weights: np.ndarray):
+        w = np.asarray(weights, dtype=np.float64).ravel()
+        w = np.where(np.isfinite(w) & (w > 0), w, 0.0)
+        n = w.size
+        total = w.sum()
+        if n == 0 or total <= 0:
+            raise ValueError("AliasTable needs at least one positive finite weight")
+        self.n = n
+        self.pdf = (w / total).astype(np.float64)
+        scaled = w * (n / total)  # mean 1 = one bucket
+        prob = np.ones(n, dtype=np.float64)
+        alias = np.arange(n, dtype=np.int64)
+        light = np.flatnonzero(scaled < 1.0)
+        heavy = np.flatnonzero(scaled >= 1.0)
+        if light.size and heavy.size:
+            demand = 1.0 - scaled[light]
+            d_incl = np.cumsum(demand)            # cumulative demand after each light item
+            d_excl = d_incl - demand               # ... before it
+            excess = np.cumsum(scaled[heavy] - 1.0)  # T_j: cumulative excess of heavies 1..j
+            # light item -> first heavy whose cumulative excess exceeds the demand before it
+            j = np.searchsorted(excess, d_excl, side="right")
+            j = np.minimum(j, heavy.size - 1)
+            prob[light] = scaled[light]
+            alias[light] = heavy[j]
+            # heavy j closes at the first cumulative demand >= T_j; residual 1 + T_j - D
+            k = np.searchsorted(d_incl, excess, side="left")
+            closes = k < light.size
+            closes[-1] = False  # the last heavy absorbs rounding error and keeps probability 1
+            hj = np.flatnonzero(closes)
+            prob[heavy[hj]] = np.clip(1.0 + excess[hj] - d_incl[k[hj]], 0.0, 1.0)
+            alias[heavy[hj]] = heavy[np.minimum(hj + 1, heavy.size - 1)]
+        elif light.size:  # cannot happen with a positive total, kept for safety
+            prob[:] = scaled
+        self.prob = prob
+        self.alias = alias
+
+    def sample(self, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+        """Item indices (int64) from two uniform [0,1) arrays."""
+        k = np.minimum((u1 * self.n).astype(np.int64), self.n - 1)
+        return np.where(u2 < self.prob[k], k, self.alias[k])
+
+    def implied_pdf(self) -> np.ndarray:
+        """Probabilities the table actually realizes (for verification)."""
+        p = self.prob.copy()
+        np.add.at(p, self.alias, 1.0 - self.prob)
+        return p / self.n
+
+
+def uniform_triangle(u1: np.ndarray, u2: np.ndarray):
+    """Uniform barycentrics (b1, b2) on a triangle, square-root mapping (area measure)."""
+    su = np.sqrt(u1)
+    return (1.0 - u2) * su, u2 * su
+
+
+def cosine_hemisphere(u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """Cosine-weighted directions around +z, shape (n, 3); pdf = cos/pi (solid angle)."""
+    r = np.sqrt(u1)
+    phi = 2.0 * np.pi * u2
+    z = np.sqrt(np.maximum(0.0, 1.0 - u1))
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1).astype(np.float32)
+
+
+def orthonormal_basis(n: np.ndarray):
+    """Tangent frames (t, b) for unit normals n (n, 3), branchless (Duff et al. 2017)."""
+    sign = np.where(n[:, 2] >= 0.0, 1.0, -1.0).astype(np.float32)
+    a = -1.0 / (sign + n[:, 2])
+    b = n[:, 0] * n[:, 1] * a
+    t = np.stack([1.0 + sign * n[:, 0] ** 2 * a, sign * b, -sign * n[:, 0]], axis=-1)
+    bb = np.stack([b, sign + n[:, 1] ** 2 * a, -n[:, 1]], axis=-1)
+    return t.astype(np.float32), bb.astype(np.float32)
+
+
+def to_world(local: np.ndarray, n: np.ndarray, t: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return local[:, 0:1] * t + local[:, 1:2] * b + local[:, 2:3] * n
+
+
+def to_local(v: np.ndarray, n: np.ndarray, t: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.stack([np.einsum("ij,ij->i", v, t), np.einsum("ij,ij->i", v, b),
+                     np.einsum("ij,ij->i", v, n)], axis=-1)

@@ -1,0 +1,137 @@
+"""Flat scene description handed from the exporter to the renderer.
+
+Conventions: world space is Blender's (right-handed, +Z up, metres as the scene unit);
+colours are scene-linear RGB; radiance is W·sr⁻¹·m⁻² (Cycles' emission colour x strength);
+all arrays are float32 unless stated.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class TriangleSet:
+    """Triangles as flat arrays.
+
+    verts    (n, 3, 3)  world-space corner positions
+    normals  (n, 3, 3)  per-corner unit shading normals (Blender's smooth/flat/auto-smooth result)
+    uvs      (n, 3, 2)  per-corner UVs, or None when no material needs a texture
+    material (n,) int32 index into :class:`MaterialTable`
+    """
+
+    verts: np.ndarray
+    normals: np.ndarray
+    material: np.ndarray
+    uvs: np.ndarray | None = None
+
+    @staticmethod
+    def empty() -> "TriangleSet":
+        return TriangleSet(np.zeros((0, 3, 3), np.float32), np.zeros((0, 3, 3), np.float32),
+                           np.zeros(0, np.int32))
+
+    def __len__(self) -> int:
+        return int(len(self.verts))
+
+
+@dataclass
+class MaterialTable:
+    """Per-material parameters of the Lambert + GGX model (see :mod:`.bsdf`).
+
+    base_color  (m, 3)  linear albedo
+    metallic    (m,)    0..1
+    roughness   (m,)    0..1 (GGX alpha = roughness²)
+    f0          (m,)    dielectric normal-incidence reflectance (0.04 for IOR 1.5; 0 = pure Lambert)
+    emission    (m, 3)  emitted radiance, W·sr⁻¹·m⁻² (colour x strength)
+    base_tex    (m,) int32  index into ``textures`` multiplying base_color, -1 = none
+    emit_tex    (m,) int32  index into ``textures`` multiplying emission, -1 = none
+    two_sided_emission (m,) bool  mesh emission leaves both faces (Cycles); lamps emit from the front only
+    textures    list of (h, w, 3) float32 linear images, row 0 at the bottom (Blender's order)
+    names       material names, for messages
+    """
+
+    base_color: np.ndarray
+    metallic: np.ndarray
+    roughness: np.ndarray
+    f0: np.ndarray
+    emission: np.ndarray
+    base_tex: np.ndarray
+    emit_tex: np.ndarray
+    two_sided_emission: np.ndarray
+    textures: list = field(default_factory=list)
+    names: list = field(default_factory=list)
+
+    @staticmethod
+    def build(rows: list[dict], textures: list | None = None) -> "MaterialTable":
+        """From a list of dicts with the field names above (missing fields take defaults)."""
+        def col(key, default, dtype=np.float32):
+            return np.array([r.get(key, default) for r in rows], dtype=dtype).reshape(len(rows), *np.shape(default))
+        return MaterialTable(
+            base_color=col("base_color", (0.8, 0.8, 0.8)), metallic=col("metallic", 0.0),
+            roughness=col("roughness", 0.5), f0=col("f0", 0.04), emission=col("emission", (0.0, 0.0, 0.0)),
+            base_tex=col("base_tex", -1, np.int32), emit_tex=col("emit_tex", -1, np.int32),
+            two_sided_emission=col("two_sided_emission", True, bool),
+            textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
+
+
+DEFAULT_MATERIAL = {"name": "(default grey)", "base_color": (0.8, 0.8, 0.8), "roughness": 0.5, "f0": 0.04}
+
+
+@dataclass
+class Lamps:
+    """Blender Light objects that are not scene geometry: they emit but never occlude (as in Cycles).
+
+    tris: emitting triangles (area shapes, spheres for point/spot). Per triangle:
+    spot_center (n, 3), spot_axis (n, 3) unit, spot_cos (n,) cos of the half cone angle
+    (-2 = no cone), spot_smooth (n,) blend width in cosine, camera_visible (n,) bool.
+    Suns (distant lights): sun_dir (s, 3) unit direction *towards* the sun,
+    sun_cos (s,) cos of the half angle (1 = delta), sun_irradiance (s, 3) W·m⁻² on a surface facing it.
+    """
+
+    tris: TriangleSet
+    spot_center: np.ndarray
+    spot_axis: np.ndarray
+    spot_cos: np.ndarray
+    spot_smooth: np.ndarray
+    camera_visible: np.ndarray
+    sun_dir: np.ndarray
+    sun_cos: np.ndarray
+    sun_irradiance: np.ndarray
+
+    @staticmethod
+    def empty() -> "Lamps":
+        z3 = np.zeros((0, 3), np.float32)
+        z = np.zeros(0, np.float32)
+        return Lamps(TriangleSet.empty(), z3, z3, z, z, np.zeros(0, bool), z3, z, z3)
+
+
+@dataclass
+class Camera:
+    """Pinhole or orthographic camera.
+
+    cam_to_world (4, 4) camera matrix (Blender: looks down -Z, +Y up)
+    ndc_to_cam   (4, 4) inverse of Blender's projection matrix (``calc_matrix_camera``)
+    width, height: full render resolution in pixels (after the percentage)
+    window: (x0, y0, w, h) pixel rectangle to render, y0 counted from the bottom row (border/crop)
+    clip_start, clip_end: camera clipping distances in scene units
+    """
+
+    cam_to_world: np.ndarray
+    ndc_to_cam: np.ndarray
+    width: int
+    height: int
+    window: tuple
+    ortho: bool = False
+    clip_start: float = 0.1
+    clip_end: float = 1000.0
+
+
+@dataclass
+class Scene:
+    geometry: TriangleSet
+    materials: MaterialTable
+    lamps: Lamps
+    camera: Camera
+    world_radiance: np.ndarray = field(default_factory=lambda: np.zeros(3, np.float32))
+    warnings: list = field(default_factory=list)

@@ -1,0 +1,43 @@
+"""Bilinear texture lookups (repeat wrap), vectorized over hits.
+
+Images are (h, w, 3) float32 scene-linear, row 0 at the bottom as Blender stores them,
+so uv (0, 0) is the bottom-left corner and texel (i, j) is centred at ((j+0.5)/w, (i+0.5)/h).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    h, w = image.shape[:2]
+    x = uv[:, 0] * w - 0.5
+    y = uv[:, 1] * h - 0.5
+    x = np.where(np.isfinite(x), x, 0.0)
+    y = np.where(np.isfinite(y), y, 0.0)
+    x0 = np.floor(x)
+    y0 = np.floor(y)
+    fx = (x - x0).astype(np.float32)[:, None]
+    fy = (y - y0).astype(np.float32)[:, None]
+    x0 = x0.astype(np.int64) % w
+    y0 = y0.astype(np.int64) % h
+    x1 = (x0 + 1) % w
+    y1 = (y0 + 1) % h
+    top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
+    bot = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
+    return (top * (1 - fy) + bot * fy).astype(np.float32)
+
+
+def apply_texture(values: np.ndarray, tex_index: np.ndarray, uv: np.ndarray | None, textures: list) -> np.ndarray:
+    """Multiply ``values`` (n, 3) by the texture each row names (-1 = none)."""
+    if uv is None or not textures:
+        return values
+    out = values.copy()
+    for t, image in enumerate(textures):  # loop over textures, not over hits
+        sel = np.flatnonzero(tex_index == t)
+        if sel.size:
+            out[sel] *= sample_bilinear(image, uv[sel])
+    return out
+
+
+def mean_color(image: np.ndarray) -> np.ndarray:
+    return image.reshape(-1, image.shape[-1]).mean(axis=0).astype(np.float32)

@@ -1,0 +1,61 @@
+"""Small analytic scenes built directly as core arrays (no bpy)."""
+from __future__ import annotations
+
+import numpy as np
+
+from restir_engine.core.scene import Camera, Lamps, MaterialTable, Scene, TriangleSet
+
+
+def quad(center, u, v):
+    """Two triangles spanning center ± u ± v, wound so the normal is u x v."""
+    c, u, v = (np.asarray(a, np.float32) for a in (center, u, v))
+    p = [c - u - v, c + u - v, c + u + v, c - u + v]
+    return np.array([[p[0], p[1], p[2]], [p[0], p[2], p[3]]], np.float32)
+
+
+def tris(verts: np.ndarray, material: int) -> TriangleSet:
+    ng = np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0])
+    ng /= np.linalg.norm(ng, axis=1)[:, None]
+    return TriangleSet(verts, np.repeat(ng[:, None], 3, axis=1).astype(np.float32),
+                       np.full(len(verts), material, np.int32))
+
+
+def concat(sets):
+    return TriangleSet(np.concatenate([s.verts for s in sets]), np.concatenate([s.normals for s in sets]),
+                       np.concatenate([s.material for s in sets]))
+
+
+def top_down_camera(width=32, height=32, height_above=2.0, half_extent=1.0) -> Camera:
+    """Orthographic camera looking down -Z from z = height_above, seeing [-e, e]² of the z=0 plane."""
+    c2w = np.eye(4, dtype=np.float64)
+    c2w[2, 3] = height_above
+    # orthographic projection inverse: ndc (x, y, z) -> camera (x e, y e, -(near..far))
+    near, far = 0.01, 100.0
+    ndc_to_cam = np.array([[half_extent, 0, 0, 0], [0, half_extent, 0, 0],
+                           [0, 0, -(far - near) / 2, -(far + near) / 2], [0, 0, 0, 1]], np.float64)
+    return Camera(c2w, ndc_to_cam, width, height, (0, 0, width, height), ortho=True, clip_start=near, clip_end=far)
+
+
+def plane_under_world(albedo=0.5, world=1.0, width=32) -> Scene:
+    """A large diffuse floor under a constant world: direct radiance = albedo * world exactly."""
+    mats = MaterialTable.build([{"base_color": (albedo,) * 3, "f0": 0.0}])
+    floor = tris(quad((0, 0, 0), (50, 0, 0), (0, 50, 0)), 0)
+    return Scene(floor, mats, Lamps.empty(), top_down_camera(width, width),
+                 world_radiance=np.full(3, world, np.float32))
+
+
+def floor_with_emitter(albedo=0.5, le=4.0, height=1.0, half=0.5, width=32, two_sided=True) -> Scene:
+    """A diffuse floor under an emissive square (facing down) of half size ``half`` at ``height``."""
+    mats = MaterialTable.build([{"base_color": (albedo,) * 3, "f0": 0.0},
+                                {"base_color": (0, 0, 0), "f0": 0.0, "emission": (le,) * 3,
+                                 "two_sided_emission": two_sided}])
+    floor = tris(quad((0, 0, 0), (50, 0, 0), (0, 50, 0)), 0)
+    light = tris(quad((0, 0, height), (0, half, 0), (half, 0, 0)), 1)  # normal -z
+    return Scene(concat([floor, light]), mats, Lamps.empty(), top_down_camera(width, width, height_above=0.5 * height))
+
+
+def irradiance_square(h: float, a: float) -> float:
+    """Irradiance / radiance at the point under the centre of a 2a x 2a square at height h:
+    E = L * 4 * (a/√(a²+h²)) * atan(a/√(a²+h²)) (unit-radiance square, standard form factor)."""
+    s = np.sqrt(a * a + h * h)
+    return 4 * (a / s) * np.arctan(a / s)
