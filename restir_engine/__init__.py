@@ -1,0 +1,24 @@
+"""ReSTIR render engine for Blender (extension ``restir_engine``).
+
+Only registration lives here; see engine.py (glue), export/ (depsgraph -> arrays) and core/
+(pure NumPy + Embree renderer).
+"""
+from __future__ import annotations
+
+
+def register():
+    import bpy
+
+    from . import engine, properties, ui
+    properties.register()
+    bpy.utils.register_class(engine.RestirRenderEngine)
+    ui.register()
+
+
+def unregister():
+    import bpy
+
+    from . import engine, properties, ui
+    ui.unregister()
+    bpy.utils.unregister_class(engine.RestirRenderEngine)
+    properties.unregister()

@@ -1,0 +1,82 @@
+"""The RenderEngine: thin glue between Blender and the core renderer."""
+from __future__ import annotations
+
+import time
+
+import bpy
+import numpy as np
+
+from . import passes as pass_table
+from .core.renderer import Cancelled, RenderSettings, render_frame
+from .export import ExportError, export_scene
+
+MAX_REPORTED_WARNINGS = 12
+
+
+def settings_from_scene(scene) -> RenderSettings:
+    s = scene.restir
+    return RenderSettings(samples=int(s.samples), seed=int(s.seed), max_bounces=int(s.max_bounces),
+                          frame=int(scene.frame_current), integrator=s.integrator,
+                          film_transparent=bool(scene.render.film_transparent))
+
+
+class RestirRenderEngine(bpy.types.RenderEngine):
+    bl_idname = "RESTIR"
+    bl_label = "ReSTIR"
+    bl_use_preview = False
+    bl_use_eevee_viewport = True
+    bl_use_shading_nodes_custom = False
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+
+    # Blender calls this on throwaway instances too: no instance state.
+    def update_render_passes(self, scene=None, renderlayer=None):
+        pass_table.register_passes(self, scene, renderlayer)
+
+    def render(self, depsgraph):
+        scene = depsgraph.scene
+        view_layer = depsgraph.view_layer
+        t0 = time.perf_counter()
+        self.update_stats("ReSTIR", "Exporting scene")
+        try:
+            core_scene = export_scene(depsgraph, self.camera_override)
+        except ExportError as exc:
+            self.report({"ERROR"}, str(exc))
+            self.error_set(str(exc))
+            return
+        for msg in core_scene.warnings[:MAX_REPORTED_WARNINGS]:
+            self.report({"WARNING"}, msg)
+        if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
+            self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
+        if len(core_scene.geometry) == 0 and len(core_scene.lamps.tris) == 0:
+            self.report({"WARNING"}, "The scene has nothing to render (no visible geometry)")
+        settings = settings_from_scene(scene)
+        t_export = time.perf_counter() - t0
+
+        def progress(fraction, message):
+            self.update_progress(fraction)
+            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {message}")
+
+        try:
+            result = render_frame(core_scene, settings, progress=progress, should_stop=self.test_break)
+        except Cancelled:
+            return
+        lights = result.stats.get("light_triangles", 0) + result.stats.get("suns", 0)
+        if lights == 0 and not np.any(core_scene.world_radiance > 0):
+            self.report({"WARNING"}, "The scene has no lights, no emissive materials and a black world: "
+                                     "the image is black")
+        self._write(result.passes, core_scene.camera.window, view_layer)
+        self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {result.samples_done} samples | "
+                                    f"export {t_export:.2f}s, render {result.seconds:.2f}s")
+
+    def _write(self, images: dict, window, view_layer):
+        _x0, _y0, w, h = window
+        result = self.begin_result(0, 0, w, h, layer=view_layer.name)
+        layer = result.layers[0] if len(result.layers) == 1 else result.layers[view_layer.name]
+        for name, chans, _ctype, _enabled, core_name in pass_table.enabled_passes(view_layer):
+            rp = layer.passes.find_by_name(name, "")
+            if rp is None or core_name not in images:
+                continue
+            rp.rect = np.ascontiguousarray(images[core_name], dtype=np.float32).reshape(w * h, len(chans))
+        self.end_result(result)

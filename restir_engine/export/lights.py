@@ -1,0 +1,136 @@
+"""Blender Light objects -> Lamps (non-occluding emitters) with Cycles' power conventions.
+
+  area  (square, rectangle, disk, ellipse): one-sided Lambertian emitter facing local -Z,
+        radiance L = P / (π A)  (A: world-space area, object scale included)
+  point: sphere of radius r (Radius; 1 mm when 0) emitting L = P / (π A_sphere) = P / (4π² r²),
+        i.e. intensity P / (4π) W/sr in every direction, as Cycles' sphere lights
+  spot : the point-light sphere with Cycles' cone attenuation smoothstep((cosθ - cos(size/2)) / (blend (1 - cos(size/2))))
+  sun  : distant light, irradiance = strength (W/m²) on a surface facing it, cone of the sun's angle
+Colours multiply the power; everything is scene-linear RGB.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.scene import Lamps, TriangleSet
+
+DISK_SEGMENTS = 48
+SPHERE_LEVEL = 3  # 320 triangles per point/spot light
+MIN_RADIUS = 1e-3
+
+
+def _icosphere(level: int) -> np.ndarray:
+    """Unit icosphere triangles (t, 3, 3) wound outward."""
+    p = (1 + 5 ** 0.5) / 2
+    v = np.array([[-1, p, 0], [1, p, 0], [-1, -p, 0], [1, -p, 0], [0, -1, p], [0, 1, p], [0, -1, -p], [0, 1, -p],
+                  [p, 0, -1], [p, 0, 1], [-p, 0, -1], [-p, 0, 1]], np.float64)
+    f = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
+                  [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
+                  [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]])
+    tris = v[f]
+    tris /= np.linalg.norm(tris, axis=2, keepdims=True)
+    for _ in range(level):
+        a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
+        ab, bc, ca = (a + b), (b + c), (c + a)
+        ab, bc, ca = (x / np.linalg.norm(x, axis=1, keepdims=True) for x in (ab, bc, ca))
+        tris = np.concatenate([np.stack(t, axis=1) for t in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))])
+    return tris
+
+
+_SPHERE = _icosphere(SPHERE_LEVEL)
+
+
+def _area_shape(light) -> np.ndarray:
+    """Local-space triangles of an area light (z = 0), wound so the normal is -Z (emission side)."""
+    sx = float(light.size)
+    sy = float(light.size_y) if light.shape in {"RECTANGLE", "ELLIPSE"} else sx
+    if light.shape in {"SQUARE", "RECTANGLE"}:
+        a, b = sx / 2, sy / 2
+        c = np.array([[-a, -b, 0], [a, -b, 0], [a, b, 0], [-a, b, 0]], np.float64)
+        tris = np.array([[c[0], c[2], c[1]], [c[0], c[3], c[2]]])
+    else:
+        ang = np.linspace(0, 2 * np.pi, DISK_SEGMENTS + 1)
+        ring = np.stack([np.cos(ang) * sx / 2, np.sin(ang) * sy / 2, np.zeros_like(ang)], axis=1)
+        center = np.zeros((DISK_SEGMENTS, 3))
+        tris = np.stack([center, ring[1:], ring[:-1]], axis=1)
+        # scale the polygon to the true ellipse area so the power is exact
+        poly_area = 0.5 * DISK_SEGMENTS * np.sin(2 * np.pi / DISK_SEGMENTS)
+        tris *= np.sqrt(np.pi / poly_area)
+    return tris
+
+
+def _area(tris: np.ndarray) -> float:
+    return float(0.5 * np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1).sum())
+
+
+def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
+    parts = []  # (world tris, material index, spot center, spot axis, spot cos, spot smooth, camera visible)
+    suns = []
+    for inst in depsgraph.object_instances:
+        obj = inst.object
+        if obj.type != "LIGHT" or not inst.show_self:
+            continue
+        light = obj.data
+        m = np.array(inst.matrix_world, np.float64)
+        power = np.array(light.color[:3], np.float64) * float(light.energy)
+        if getattr(light, "use_nodes", False) and light.node_tree is not None:
+            warnings.append(f"Light '{obj.name}': light node trees are ignored; colour x power is used")
+        if not np.isfinite(m).all() or not np.isfinite(power).all():
+            warnings.append(f"Light '{obj.name}' has a non-finite transform or power and was skipped")
+            continue
+        if power.max() <= 0:
+            continue
+        visible = bool(getattr(obj, "visible_camera", True))
+        if light.type == "SUN":
+            axis = m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-30)
+            suns.append((axis, np.cos(min(float(light.angle), np.pi) / 2), power))
+            continue
+        if light.type == "AREA":
+            local = _area_shape(light)
+            world = local @ m[:3, :3].T + m[:3, 3]
+            area = _area(world)
+            if area <= 0:
+                warnings.append(f"Light '{obj.name}' has zero area and was skipped")
+                continue
+            if getattr(light, "spread", np.pi) < np.pi - 1e-3:
+                warnings.append(f"Light '{obj.name}': area light spread below 180° is not supported (treated as 180°)")
+            radiance = power / (np.pi * area)
+            spot = (np.zeros(3), np.zeros(3), -2.0, 0.0)
+        elif light.type in {"POINT", "SPOT"}:
+            r = max(float(light.shadow_soft_size), MIN_RADIUS)
+            center = m[:3, 3]
+            world = _SPHERE * r + center  # lamps keep their radius whatever the object scale, as in Cycles
+            area = _area(world)
+            radiance = power / (np.pi * area)
+            if light.type == "SPOT":
+                axis = -m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-30)
+                cos_half = float(np.cos(float(light.spot_size) / 2))
+                spot = (center, axis, cos_half, (1 - cos_half) * float(light.spot_blend))
+            else:
+                spot = (center, np.zeros(3), -2.0, 0.0)
+        else:
+            warnings.append(f"Light '{obj.name}': type {light.type} is not supported")
+            continue
+        mat = registry.add_row({"name": f"(light {obj.name})", "base_color": (0, 0, 0), "f0": 0.0,
+                                "emission": tuple(radiance), "two_sided_emission": False})
+        parts.append((world.astype(np.float32), mat, spot, visible))
+
+    lamps = Lamps.empty()
+    if parts:
+        verts = np.concatenate([p[0] for p in parts])
+        counts = [len(p[0]) for p in parts]
+        ng = np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0])
+        ng /= np.maximum(np.linalg.norm(ng, axis=1), 1e-30)[:, None]
+        rep = lambda vals, dtype: np.repeat(np.array(vals, dtype), counts, axis=0)  # noqa: E731
+        lamps.tris = TriangleSet(verts, np.repeat(ng[:, None], 3, axis=1).astype(np.float32),
+                                 rep([p[1] for p in parts], np.int32))
+        lamps.spot_center = rep([p[2][0] for p in parts], np.float32)
+        lamps.spot_axis = rep([p[2][1] for p in parts], np.float32)
+        lamps.spot_cos = rep([p[2][2] for p in parts], np.float32)
+        lamps.spot_smooth = rep([p[2][3] for p in parts], np.float32)
+        lamps.camera_visible = rep([p[3] for p in parts], bool)
+    if suns:
+        lamps.sun_dir = np.array([s[0] for s in suns], np.float32)
+        lamps.sun_cos = np.array([s[1] for s in suns], np.float32)
+        lamps.sun_irradiance = np.array([s[2] for s in suns], np.float32)
+    return lamps

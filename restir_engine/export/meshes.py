@@ -1,0 +1,138 @@
+"""Evaluated mesh instances -> world-space TriangleSet.
+
+Every visible instance in ``depsgraph.object_instances`` (modifiers, particles, geometry-node
+instances included; curves, text, surfaces and metaballs through their evaluated mesh) is
+triangulated with ``calc_loop_triangles`` and read with ``foreach_get``. Local-space arrays are
+cached per evaluated datablock so instances of one mesh are read once; no Python loop over triangles.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.scene import TriangleSet
+
+GEOMETRY_TYPES = {"MESH", "CURVE", "CURVES", "SURFACE", "FONT", "META"}
+MAX_COORD = 1e7  # beyond this float32 precision makes ray offsets meaningless
+
+
+def _read_mesh(mesh, want_uv: bool) -> dict | None:
+    """Local-space triangle arrays of a mesh datablock: verts (t,3,3), normals (t,3,3),
+    uvs (t,3,2) or None, slot (t,) int32 material slot index."""
+    mesh.calc_loop_triangles()
+    tris = mesh.loop_triangles
+    nt = len(tris)
+    if nt == 0:
+        return None
+    nv = len(mesh.vertices)
+    co = np.empty(nv * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    vidx = np.empty(nt * 3, np.int32)
+    tris.foreach_get("vertices", vidx)
+    loops = np.empty(nt * 3, np.int32)
+    tris.foreach_get("loops", loops)
+    nrm = np.empty(nt * 9, np.float32)
+    try:
+        tris.foreach_get("split_normals", nrm)
+        nrm = nrm.reshape(nt, 3, 3)
+    except (AttributeError, RuntimeError, TypeError):
+        cn = np.empty(len(mesh.loops) * 3, np.float32)
+        mesh.corner_normals.foreach_get("vector", cn)
+        nrm = cn.reshape(-1, 3)[loops].reshape(nt, 3, 3)
+    slot = np.empty(nt, np.int32)
+    tris.foreach_get("material_index", slot)
+    uvs = None
+    if want_uv and mesh.uv_layers.active is not None:
+        layer = next((u for u in mesh.uv_layers if u.active_render), mesh.uv_layers.active)
+        uv = np.empty(len(mesh.loops) * 2, np.float32)
+        layer.data.foreach_get("uv", uv)
+        uvs = uv.reshape(-1, 2)[loops].reshape(nt, 3, 2)
+    return {"verts": co.reshape(-1, 3)[vidx].reshape(nt, 3, 3), "normals": nrm, "uvs": uvs, "slot": slot}
+
+
+def export_geometry(depsgraph, registry, warnings: list):
+    """Returns (TriangleSet, stats dict)."""
+    blocks: list[tuple] = []  # (local arrays, matrix, material index map)
+    cache: dict = {}
+    slot_cache: dict = {}
+    for inst in depsgraph.object_instances:
+        obj = inst.object
+        if obj.type not in GEOMETRY_TYPES or not inst.show_self:
+            continue
+        if not getattr(obj, "visible_camera", True) and not getattr(obj, "visible_diffuse", True):
+            continue
+        data = obj.data
+        key = data.as_pointer() if (obj.type == "MESH" and data is not None) else obj.as_pointer()
+        mats_key = (key, tuple(s.material.name_full if s.material else "" for s in obj.material_slots))
+        if mats_key not in slot_cache:
+            slot_cache[mats_key] = np.array([registry.material_index(s.material) for s in obj.material_slots] or [0],
+                                            np.int32)
+        if key not in cache:
+            try:
+                mesh = obj.to_mesh()
+            except RuntimeError:
+                mesh = None
+            if mesh is None:
+                cache[key] = None
+                continue
+            try:
+                want_uv = registry.uses_textures(slot_cache[mats_key])
+                cache[key] = _read_mesh(mesh, want_uv)
+            finally:
+                obj.to_mesh_clear()
+        arrays = cache[key]
+        if arrays is None:
+            continue
+        blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name))
+
+    if not blocks:
+        return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0}
+    total = sum(len(b[0]["verts"]) for b in blocks)
+    verts = np.empty((total, 3, 3), np.float32)
+    normals = np.empty((total, 3, 3), np.float32)
+    material = np.empty(total, np.int32)
+    need_uv = any(b[0]["uvs"] is not None for b in blocks)
+    uvs = np.zeros((total, 3, 2), np.float32) if need_uv else None
+    at = 0
+    for arrays, m, slot_map, _name in blocks:  # loop over instances, each vectorized over its triangles
+        n = len(arrays["verts"])
+        lin = m[:3, :3]
+        verts[at:at + n] = (arrays["verts"].reshape(-1, 3) @ lin.T + m[:3, 3]).reshape(n, 3, 3)
+        try:
+            nm = np.linalg.inv(lin).T
+        except np.linalg.LinAlgError:
+            nm = lin
+        nn = arrays["normals"].reshape(-1, 3) @ nm.T
+        nn /= np.maximum(np.linalg.norm(nn, axis=1), 1e-30)[:, None]
+        normals[at:at + n] = nn.reshape(n, 3, 3)
+        material[at:at + n] = slot_map[np.clip(arrays["slot"], 0, len(slot_map) - 1)]
+        if uvs is not None and arrays["uvs"] is not None:
+            uvs[at:at + n] = arrays["uvs"]
+        at += n
+    # drop unusable triangles: non-finite or huge coordinates, zero area
+    finite = np.isfinite(verts).all(axis=(1, 2)) & (np.abs(verts).max(axis=(1, 2)) < MAX_COORD)
+    if not finite.all():
+        bad_names = sorted({b[3] for b, s, e in _spans(blocks) if not finite[s:e].all()})
+        warnings.append(f"{int((~finite).sum())} triangles with NaN, infinite or huge (>{MAX_COORD:g}) coordinates "
+                        f"were skipped (objects: {', '.join(bad_names[:5])})")
+    with np.errstate(invalid="ignore", over="ignore"):
+        area2 = np.linalg.norm(np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0]), axis=1)
+    keep = finite & (area2 > 0) & np.isfinite(area2)
+    n_degenerate = int((finite & ~keep).sum())
+    if n_degenerate:
+        warnings.append(f"{n_degenerate} zero-area triangles were skipped")
+    if not keep.all():
+        verts, normals, material = verts[keep], normals[keep], material[keep]
+        uvs = uvs[keep] if uvs is not None else None
+    bad_n = ~np.isfinite(normals).all(axis=2)
+    if bad_n.any():
+        normals[bad_n] = 0.0  # the shader falls back to the geometric normal
+    stats = {"triangles": int(len(verts)), "instances": len(blocks), "dropped": int((~keep).sum())}
+    return TriangleSet(verts, normals, material, uvs), stats
+
+
+def _spans(blocks):
+    at = 0
+    for b in blocks:
+        n = len(b[0]["verts"])
+        yield b, at, at + n
+        at += n

@@ -1,0 +1,53 @@
+"""Settings stored in the .blend: ``scene.restir`` (render) and ``view_layer.restir`` (passes)."""
+from __future__ import annotations
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, IntProperty, PointerProperty
+
+
+def _update_passes(self, context):
+    """Pass toggles change the render result layout: ask Blender to re-query the pass list."""
+    view_layer = getattr(context, "view_layer", None)
+    if view_layer is not None:
+        view_layer.update_render_passes()
+
+
+class RestirSceneSettings(bpy.types.PropertyGroup):
+    integrator: EnumProperty(
+        name="Integrator",
+        description="Light transport algorithm",
+        items=[("PATH", "Path Tracing", "Unbiased reference path tracer: next-event estimation and BSDF sampling "
+                "combined by multiple importance sampling", 0)],
+        default="PATH")
+    samples: IntProperty(name="Samples", description="Iterations averaged per frame", default=16, min=1,
+                         soft_max=4096)
+    seed: IntProperty(name="Seed", description="Noise pattern; different seeds give independent noise", default=0,
+                      min=0)
+    max_bounces: IntProperty(name="Max Bounces", description="Indirect bounces (0 = direct light only)",
+                             default=4, min=0, soft_max=32, max=1024)
+
+
+class RestirViewLayerSettings(bpy.types.PropertyGroup):
+    use_pass_direct: BoolProperty(name="Direct", description="Direct lighting (one bounce) as its own pass",
+                                  default=False, update=_update_passes)
+    use_pass_indirect: BoolProperty(name="Indirect", description="Indirect lighting (two or more bounces)",
+                                    default=False, update=_update_passes)
+    use_pass_emission: BoolProperty(name="Emission", description="Emission seen directly by the camera",
+                                    default=False, update=_update_passes)
+
+
+CLASSES = (RestirSceneSettings, RestirViewLayerSettings)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.restir = PointerProperty(type=RestirSceneSettings)
+    bpy.types.ViewLayer.restir = PointerProperty(type=RestirViewLayerSettings)
+
+
+def unregister():
+    del bpy.types.ViewLayer.restir
+    del bpy.types.Scene.restir
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

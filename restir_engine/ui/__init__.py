@@ -1,0 +1,4 @@
+from . import panels  # noqa: F401
+
+register = panels.register
+unregister = panels.unregister

@@ -1,0 +1,104 @@
+"""Render Properties panels (Cycles-style) shown only for the ReSTIR engine, plus opt-in to the
+standard Blender panels that apply to it."""
+from __future__ import annotations
+
+import bpy
+
+ENGINE = "RESTIR"
+
+# Standard panels that work unchanged with this engine (output, format, colour management,
+# dimensions, camera, object, material surface, lights, world).
+STANDARD_PANELS = (
+    "RENDER_PT_color_management", "RENDER_PT_color_management_curve", "RENDER_PT_color_management_display_settings",
+    "RENDER_PT_color_management_white_balance", "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_stereoscopy",
+    "RENDER_PT_time_stretching", "RENDER_PT_output", "RENDER_PT_encoding", "RENDER_PT_encoding_video",
+    "RENDER_PT_encoding_audio", "RENDER_PT_format_presets", "RENDER_PT_post_processing", "RENDER_PT_stamp",
+    "RENDER_PT_stamp_burn", "RENDER_PT_stamp_note", "RENDER_PT_output_views", "RENDER_PT_output_color_management",
+    "DATA_PT_camera", "DATA_PT_camera_display", "DATA_PT_lens", "DATA_PT_camera_safe_areas",
+    "DATA_PT_camera_background_image", "DATA_PT_context_camera", "DATA_PT_context_light", "DATA_PT_light",
+    "DATA_PT_area", "DATA_PT_spot", "DATA_PT_context_mesh", "DATA_PT_normals", "DATA_PT_uv_texture",
+    "DATA_PT_vertex_groups", "DATA_PT_shape_keys", "DATA_PT_customdata", "DATA_PT_custom_props_mesh",
+    "OBJECT_PT_context_object", "OBJECT_PT_transform", "OBJECT_PT_delta_transform", "OBJECT_PT_relations",
+    "OBJECT_PT_collections", "OBJECT_PT_instancing", "OBJECT_PT_visibility", "OBJECT_PT_custom_props",
+    "MATERIAL_PT_context_material", "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_surface", "MATERIAL_PT_custom_props",
+    "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface", "VIEWLAYER_PT_layer", "SCENE_PT_scene", "SCENE_PT_unit",
+    "PARTICLE_PT_context_particles", "PARTICLE_PT_emission", "PARTICLE_PT_render",
+)
+
+
+class RestirPanel:
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+
+class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
+    bl_label = "Sampling"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        s = context.scene.restir
+        layout.prop(s, "integrator")
+        col = layout.column(align=True)
+        col.prop(s, "samples")
+        col.prop(s, "seed")
+
+
+class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):
+    bl_label = "Light Paths"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(context.scene.restir, "max_bounces")
+        layout.prop(context.scene.render, "film_transparent")
+
+
+class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
+    bl_label = "Passes"
+    bl_context = "view_layer"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        vl = context.view_layer
+        col = layout.column(heading="Data", align=True)
+        col.prop(vl, "use_pass_z")
+        col.prop(vl, "use_pass_normal")
+        col = layout.column(heading="Light", align=True)
+        col.prop(vl.restir, "use_pass_direct")
+        col.prop(vl.restir, "use_pass_indirect")
+        col.prop(vl.restir, "use_pass_emission")
+
+
+PANELS = (RESTIR_PT_sampling, RESTIR_PT_light_paths, RESTIR_PT_passes)
+
+
+def _standard_panels():
+    for name in STANDARD_PANELS:
+        panel = getattr(bpy.types, name, None)
+        if panel is not None and hasattr(panel, "COMPAT_ENGINES"):
+            yield panel
+
+
+def register():
+    for cls in PANELS:
+        bpy.utils.register_class(cls)
+    for panel in _standard_panels():
+        panel.COMPAT_ENGINES.add(ENGINE)
+
+
+def unregister():
+    for panel in _standard_panels():
+        panel.COMPAT_ENGINES.discard(ENGINE)
+    for cls in reversed(PANELS):
+        bpy.utils.unregister_class(cls)
