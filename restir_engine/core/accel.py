@@ -53,6 +53,23 @@ def offset_origin(p: np.ndarray, ng: np.ndarray, direction: np.ndarray) -> np.nd
     return (p + ng * (side * mag * 1e-4)[:, None]).astype(np.float32)
 
 
+def shadow_rays(p: np.ndarray, ng: np.ndarray, light_pos: np.ndarray, wi: np.ndarray, dist: np.ndarray):
+    """Origins, unit directions and tmax of shadow rays from surface points p towards light points.
+
+    The direction and length are recomputed from the *offset* origin: at grazing angles the offset
+    along the normal changes the distance to the light's plane by far more than any epsilon, so a
+    tmax taken before the offset would stop short of (or pass) the light. Points with an infinite
+    ``dist`` (distant lights) keep ``wi`` and get tmax = 1e30.
+    """
+    o = offset_origin(p, ng, wi)
+    finite = np.isfinite(dist)
+    d = np.where(finite[:, None], light_pos - o, wi)
+    ln = np.linalg.norm(d, axis=1)
+    d = d / np.maximum(ln, 1e-30)[:, None]
+    far = np.where(finite, ln * (1.0 - 1e-4), 1e30)
+    return o, d.astype(np.float32), far.astype(np.float32)
+
+
 class Hits:
     """Closest-hit results, SoA: prim (int32, -1 = miss), t (float32 distance), u, v (barycentrics)."""
 

@@ -76,7 +76,8 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
     co = wo[:, 2]
     ci = wi[:, 2]
     valid = (co > 0) & (ci > 0)
-    fd = 1.0 - _schlick(p.f0_dielectric, co)
+    # a lobe with f0 = 0 does not exist (Diffuse BSDF): no Fresnel split, no grazing specular
+    fd = np.where(p.f0_dielectric > 0, 1.0 - _schlick(p.f0_dielectric, co), 1.0)
     f = p.diffuse * (fd * INV_PI)[:, None]
     pdf_d = np.maximum(ci, 0) * INV_PI
     h = wo + wi
@@ -87,7 +88,8 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
     d = _ggx_d(p.alpha, cos_h)
     g = 1.0 / (1.0 + _smith_lambda(p.alpha, co) + _smith_lambda(p.alpha, ci))
     fr = _schlick(p.f0, odh[:, None])
-    spec = (d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr
+    spec_on = (p.f0.max(axis=1) > 0).astype(np.float32)
+    spec = (spec_on * d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr
     f = f + spec
     pdf_s = d * cos_h / (4.0 * odh)
     pdf = (1 - p.p_spec) * pdf_d + p.p_spec * pdf_s

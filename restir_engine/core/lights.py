@@ -59,8 +59,10 @@ def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray
 @dataclass
 class LightSample:
     """Per shading point: unit direction wi (n, 3), distance (n,) (inf for suns), radiance Le (n, 3)
-    arriving along -wi, pdf (n,) in solid angle (selection included; 0 = no light), delta (n,) bool."""
+    arriving along -wi, pdf (n,) in solid angle (selection included; 0 = no light), delta (n,) bool,
+    pos (n, 3) the sampled point on a triangle light (unused for suns)."""
 
+    pos: np.ndarray
     wi: np.ndarray
     dist: np.ndarray
     le: np.ndarray
@@ -132,13 +134,14 @@ class LightTable:
         """Pick one light per point p (n, 3) with power-proportional probability and a point on it.
         ``u`` is (n, 4) uniforms."""
         n = len(p)
+        pos = np.zeros((n, 3), np.float32)
         wi = np.zeros((n, 3), np.float32)
         dist = np.zeros(n, np.float32)
         le = np.zeros((n, 3), np.float32)
         pdf = np.zeros(n, np.float32)
         delta = np.zeros(n, bool)
         if self.alias is None or n == 0:
-            return LightSample(wi, dist, le, pdf, delta)
+            return LightSample(pos, wi, dist, le, pdf, delta)
         light = self.alias.sample(u[:, 0], u[:, 1])
         tri = light < self.n_tri
         if tri.any():
@@ -154,6 +157,7 @@ class LightTable:
             rad = self.radiance_of(li, b1, b2, p[tri])
             pd = self.tri_pdf_solid_angle(li, dl, cos_l)
             ok = facing & (dl > 0) & (np.abs(cos_l) > 1e-8) & np.isfinite(pd)
+            pos[tri] = q
             wi[tri] = w
             dist[tri] = dl
             le[tri] = np.where(ok[:, None], rad, 0.0)
@@ -182,4 +186,4 @@ class LightTable:
             le[sun] = np.where(is_delta[:, None], lamps.sun_irradiance[s], rad)
             pdf[sun] = np.where(is_delta, p_sel, p_sel / np.maximum(solid, 1e-30))
             delta[sun] = True  # suns are never hit by BSDF rays: no MIS
-        return LightSample(wi, dist, le, pdf, delta)
+        return LightSample(pos, wi, dist, le, pdf, delta)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import camera as camera_mod
-from .accel import Accel, offset_origin
+from .accel import Accel, offset_origin, shadow_rays
 from .bsdf import SurfaceParams, eval_bsdf, sample_bsdf
 from .lights import LightTable, spot_factor, triangle_geometry, emitted_radiance
 from .sampling import orthonormal_basis, to_local, to_world
@@ -166,10 +166,8 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
             contrib = throughput * f * (np.abs(wi_l[:, 2]) * w / np.maximum(ls.pdf, 1e-30))[:, None] * ls.le
             live = np.flatnonzero(geo_ok & (ls.pdf > 0) & (contrib.max(axis=1) > 0))
             if live.size:
-                so = offset_origin(s.p[live], s.ng[live], ls.wi[live])
-                dist = ls.dist[live]
-                far = np.where(np.isfinite(dist), dist * (1 - 2e-4), 1e30)
-                vis = ~ctx.geom_accel.occluded(so, ls.wi[live], far)
+                so, sd, far = shadow_rays(s.p[live], s.ng[live], ls.pos[live], ls.wi[live], ls.dist[live])
+                vis = ~ctx.geom_accel.occluded(so, sd, far)
                 np.add.at(target, idx[live[vis]], _sanitize(contrib[live[vis]]))
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -----------------------------------------------------------------
         u = rng.random((idx.size, 3), dtype=np.float32)
