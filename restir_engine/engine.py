@@ -20,6 +20,16 @@ def settings_from_scene(scene) -> RenderSettings:
                           film_transparent=bool(scene.render.film_transparent))
 
 
+def scene_problems(core_scene, light_count: int) -> list[str]:
+    """Messages for scenes that render but not as the user probably expects."""
+    problems = []
+    if len(core_scene.geometry) == 0 and len(core_scene.lamps.tris) == 0:
+        problems.append("The scene has nothing to render (no visible geometry)")
+    if light_count == 0 and not np.any(core_scene.world_radiance > 0):
+        problems.append("The scene has no lights, no emissive materials and a black world: the image is black")
+    return problems
+
+
 class RestirRenderEngine(bpy.types.RenderEngine):
     bl_idname = "RESTIR"
     bl_label = "ReSTIR"
@@ -49,8 +59,6 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, msg)
         if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
             self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
-        if len(core_scene.geometry) == 0 and len(core_scene.lamps.tris) == 0:
-            self.report({"WARNING"}, "The scene has nothing to render (no visible geometry)")
         settings = settings_from_scene(scene)
         t_export = time.perf_counter() - t0
 
@@ -62,10 +70,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             result = render_frame(core_scene, settings, progress=progress, should_stop=self.test_break)
         except Cancelled:
             return
-        lights = result.stats.get("light_triangles", 0) + result.stats.get("suns", 0)
-        if lights == 0 and not np.any(core_scene.world_radiance > 0):
-            self.report({"WARNING"}, "The scene has no lights, no emissive materials and a black world: "
-                                     "the image is black")
+        for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):
+            self.report({"WARNING"}, msg)
         self._write(result.passes, core_scene.camera.window, view_layer)
         self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {result.samples_done} samples | "
                                     f"export {t_export:.2f}s, render {result.seconds:.2f}s")

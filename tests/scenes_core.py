@@ -59,3 +59,16 @@ def irradiance_square(h: float, a: float) -> float:
     E = L * 4 * (a/√(a²+h²)) * atan(a/√(a²+h²)) (unit-radiance square, standard form factor)."""
     s = np.sqrt(a * a + h * h)
     return 4 * (a / s) * np.arctan(a / s)
+
+
+def emissive_furnace(albedo=0.5, le=1.0, width=24) -> Scene:
+    """Inside a closed cube whose walls all emit ``le`` (two-sided) and reflect ``albedo`` (Lambert):
+    radiance with k bounces is le * sum_{j=0}^{k+1} albedo^j (emission, direct, indirect ...)."""
+    mats = MaterialTable.build([{"base_color": (albedo,) * 3, "f0": 0.0, "emission": (le,) * 3}])
+    faces = [quad((0, 0, -1), (1, 0, 0), (0, 1, 0)), quad((0, 0, 1), (0, 1, 0), (1, 0, 0)),
+             quad((0, -1, 0), (0, 0, 1), (1, 0, 0)), quad((0, 1, 0), (1, 0, 0), (0, 0, 1)),
+             quad((-1, 0, 0), (0, 1, 0), (0, 0, 1)), quad((1, 0, 0), (0, 0, 1), (0, 1, 0))]
+    box = concat([tris(f, 0) for f in faces])
+    cam = top_down_camera(width, width, height_above=0.5, half_extent=0.9)
+    cam.clip_start = 0.01
+    return Scene(box, mats, Lamps.empty(), cam)

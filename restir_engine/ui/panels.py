@@ -9,20 +9,31 @@ ENGINE = "RESTIR"
 # Standard panels that work unchanged with this engine (output, format, colour management,
 # dimensions, camera, object, material surface, lights, world).
 STANDARD_PANELS = (
-    "RENDER_PT_color_management", "RENDER_PT_color_management_curve", "RENDER_PT_color_management_display_settings",
-    "RENDER_PT_color_management_white_balance", "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_stereoscopy",
-    "RENDER_PT_time_stretching", "RENDER_PT_output", "RENDER_PT_encoding", "RENDER_PT_encoding_video",
-    "RENDER_PT_encoding_audio", "RENDER_PT_format_presets", "RENDER_PT_post_processing", "RENDER_PT_stamp",
-    "RENDER_PT_stamp_burn", "RENDER_PT_stamp_note", "RENDER_PT_output_views", "RENDER_PT_output_color_management",
-    "DATA_PT_camera", "DATA_PT_camera_display", "DATA_PT_lens", "DATA_PT_camera_safe_areas",
-    "DATA_PT_camera_background_image", "DATA_PT_context_camera", "DATA_PT_context_light", "DATA_PT_light",
-    "DATA_PT_area", "DATA_PT_spot", "DATA_PT_context_mesh", "DATA_PT_normals", "DATA_PT_uv_texture",
-    "DATA_PT_vertex_groups", "DATA_PT_shape_keys", "DATA_PT_customdata", "DATA_PT_custom_props_mesh",
-    "OBJECT_PT_context_object", "OBJECT_PT_transform", "OBJECT_PT_delta_transform", "OBJECT_PT_relations",
-    "OBJECT_PT_collections", "OBJECT_PT_instancing", "OBJECT_PT_visibility", "OBJECT_PT_custom_props",
-    "MATERIAL_PT_context_material", "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_surface", "MATERIAL_PT_custom_props",
-    "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface", "VIEWLAYER_PT_layer", "SCENE_PT_scene", "SCENE_PT_unit",
-    "PARTICLE_PT_context_particles", "PARTICLE_PT_emission", "PARTICLE_PT_render",
+    # render: output, format, frame range, colour management, post processing, stamp
+    "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_time_stretching", "RENDER_PT_stereoscopy",
+    "RENDER_PT_output", "RENDER_PT_output_views", "RENDER_PT_output_color_management", "RENDER_PT_output_pixel_density",
+    "RENDER_PT_encoding", "RENDER_PT_encoding_video", "RENDER_PT_encoding_audio", "RENDER_PT_post_processing",
+    "RENDER_PT_stamp", "RENDER_PT_stamp_note", "RENDER_PT_stamp_burn", "RENDER_PT_color_management",
+    "RENDER_PT_color_management_advanced", "RENDER_PT_color_management_curves",
+    "RENDER_PT_color_management_white_balance", "RENDER_PT_color_management_working_space",
+    "VIEWLAYER_PT_layer", "VIEWLAYER_PT_context_layer",
+    # camera
+    "DATA_PT_context_camera", "DATA_PT_lens", "DATA_PT_camera", "DATA_PT_camera_display",
+    "DATA_PT_camera_display_composition_guides", "DATA_PT_camera_safe_areas", "DATA_PT_camera_safe_areas_center_cut",
+    "DATA_PT_camera_background_image", "DATA_PT_camera_stereoscopy", "DATA_PT_custom_props_camera",
+    # lights
+    "DATA_PT_context_light", "DATA_PT_preview", "DATA_PT_light", "DATA_PT_spot", "DATA_PT_cone",
+    "DATA_PT_custom_props_light",
+    # object and mesh data
+    "OBJECT_PT_visibility", "OBJECT_PT_custom_props", "DATA_PT_context_mesh", "DATA_PT_uv_texture",
+    "DATA_PT_vertex_groups", "DATA_PT_shape_keys", "DATA_PT_mesh_attributes", "DATA_PT_texture_space",
+    "DATA_PT_customdata", "DATA_PT_custom_props_mesh", "DATA_PT_remesh",
+    # materials (surface node panel and slots) and world
+    "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface", "MATERIAL_PT_preview",
+    "MATERIAL_PT_custom_props", "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface", "WORLD_PT_custom_props",
+    # particles (instancing)
+    "PARTICLE_PT_context_particles", "PARTICLE_PT_emission", "PARTICLE_PT_render", "PARTICLE_PT_render_object",
+    "PARTICLE_PT_render_collection",
 )
 
 

@@ -1,0 +1,58 @@
+import bpy
+
+
+def engine_selectable(engine_id="RESTIR") -> bool:
+    scene = bpy.context.scene
+    old = scene.render.engine
+    try:
+        scene.render.engine = engine_id
+    except TypeError:
+        return False
+    scene.render.engine = old
+    return True
+
+
+def test_engine_is_registered_and_selectable(addon):
+    assert engine_selectable()
+    scene = bpy.context.scene
+    scene.render.engine = "RESTIR"
+    assert scene.render.engine == "RESTIR"
+    from restir_engine.engine import RestirRenderEngine
+    assert RestirRenderEngine.bl_label == "ReSTIR"
+    assert RestirRenderEngine.bl_use_shading_nodes_custom is False
+    assert RestirRenderEngine.bl_use_eevee_viewport is True
+
+
+def test_settings_defaults(addon):
+    s = bpy.context.scene.restir
+    assert (s.samples, s.seed, s.max_bounces, s.integrator) == (16, 0, 4, "PATH")
+    vl = bpy.context.view_layer.restir
+    assert not vl.use_pass_direct and not vl.use_pass_indirect and not vl.use_pass_emission
+
+
+def test_panels_registered_and_only_for_this_engine(addon):
+    for name in ("RESTIR_PT_sampling", "RESTIR_PT_light_paths", "RESTIR_PT_passes"):
+        panel = getattr(bpy.types, name)
+        assert panel.COMPAT_ENGINES == {"RESTIR"}
+
+        class Ctx:
+            engine = "RESTIR"
+        assert panel.poll(Ctx)
+        Ctx.engine = "CYCLES"
+        assert not panel.poll(Ctx)
+    for name in ("RENDER_PT_format", "RENDER_PT_output", "RENDER_PT_color_management", "DATA_PT_lens",
+                 "EEVEE_MATERIAL_PT_context_material", "EEVEE_MATERIAL_PT_surface", "DATA_PT_camera",
+                 "DATA_PT_light", "OBJECT_PT_visibility", "EEVEE_WORLD_PT_surface"):
+        assert "RESTIR" in getattr(bpy.types, name).COMPAT_ENGINES, name
+
+
+def test_unregister_and_register_again(addon):
+    addon.unregister()
+    try:
+        assert not hasattr(bpy.types.Scene, "restir")
+        assert not engine_selectable()
+        assert "RESTIR" not in bpy.types.RENDER_PT_format.COMPAT_ENGINES
+    finally:
+        addon.register()
+    assert hasattr(bpy.types.Scene, "restir")
+    bpy.context.scene.render.engine = "RESTIR"
