@@ -16,7 +16,8 @@ import bpy
 
 def _material(name, color, roughness=0.8, metallic=0.0, emission=None, strength=0.0):
     m = bpy.data.materials.new(name)
-    m.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
     bsdf = m.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
     bsdf.inputs["Roughness"].default_value = roughness
@@ -79,7 +80,8 @@ def build_demo(frames: int = 8, resolution=(640, 360)):
     cam.keyframe_insert("location", frame=frames)
     cam.keyframe_insert("rotation_euler", frame=frames)
     world = bpy.data.worlds.new("World")
-    world.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
     scene.world = world
     scene.render.resolution_x, scene.render.resolution_y = resolution

@@ -9,6 +9,11 @@ import bpy
 import numpy as np
 
 
+def enable_nodes(idblock):
+    if bpy.app.version < (5, 0, 0):
+        idblock.use_nodes = True
+
+
 def reset():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
@@ -18,7 +23,7 @@ def reset():
 
 def diffuse(name, color):
     m = bpy.data.materials.new(name)
-    m.use_nodes = True
+    enable_nodes(m)
     nodes = m.node_tree.nodes
     nodes.remove(nodes["Principled BSDF"])
     d = nodes.new("ShaderNodeBsdfDiffuse")
@@ -30,7 +35,7 @@ def diffuse(name, color):
 
 def emission(name, color, strength):
     m = bpy.data.materials.new(name)
-    m.use_nodes = True
+    enable_nodes(m)
     nodes = m.node_tree.nodes
     nodes.remove(nodes["Principled BSDF"])
     e = nodes.new("ShaderNodeEmission")
@@ -104,7 +109,7 @@ def cornell_box(light_kind="EMISSIVE", size=(48, 48)):
     camera((0, -3.2, 1.0), (math.pi / 2, 0, 0), lens=30)
     scene.render.resolution_x, scene.render.resolution_y = size
     world = bpy.data.worlds.new("World")
-    world.use_nodes = True
+    enable_nodes(world)
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
     scene.world = world
     return scene

@@ -84,7 +84,8 @@ def test_smooth_and_flat_normals(scene):
 def test_principled_parameters_and_emission(scene):
     bpy.ops.mesh.primitive_plane_add()
     m = bpy.data.materials.new("P")
-    m.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
     b = m.node_tree.nodes["Principled BSDF"]
     b.inputs["Base Color"].default_value = (0.2, 0.4, 0.6, 1)
     b.inputs["Metallic"].default_value = 0.3
@@ -104,7 +105,8 @@ def test_principled_parameters_and_emission(scene):
 def test_unsupported_node_is_approximated_and_reported(scene):
     bpy.ops.mesh.primitive_plane_add()
     m = bpy.data.materials.new("Glass")
-    m.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
     nodes = m.node_tree.nodes
     g = nodes.new("ShaderNodeBsdfGlass")
     m.node_tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
@@ -123,7 +125,8 @@ def test_image_texture_feeds_base_color(scene):
     img.pixels.foreach_set(px.ravel())
     bpy.ops.mesh.primitive_plane_add()
     m = bpy.data.materials.new("Tex")
-    m.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
     t = m.node_tree.nodes.new("ShaderNodeTexImage")
     t.image = img
     m.node_tree.links.new(t.outputs["Color"], m.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
@@ -144,7 +147,8 @@ def test_srgb_byte_image_is_linearized(scene):
     img.pixels.foreach_set(np.array([0.5, 0.5, 0.5, 1], np.float32))
     bpy.ops.mesh.primitive_plane_add()
     m = bpy.data.materials.new("Tex")
-    m.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
     t = m.node_tree.nodes.new("ShaderNodeTexImage")
     t.image = img
     m.node_tree.links.new(t.outputs["Color"], m.node_tree.nodes["Principled BSDF"].inputs["Base Color"])

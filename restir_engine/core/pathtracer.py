@@ -112,8 +112,7 @@ def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
 def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Generator):
     """Trace one path per raster sample point (x, y).
 
-    Returns radiance (n, 3) split into direct (n, 3) and indirect (n, 3) parts, planar depth (n,),
-    world normal (n, 3) and alpha (n,) of the first hit.
+    Returns emission seen directly (n, 3), direct (n, 3) and indirect (n, 3) radiance, and alpha (n,).
     """
     cam = ctx.scene.camera
     n = len(x)
@@ -121,8 +120,6 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
     direct = np.zeros((n, 3), np.float32)
     indirect = np.zeros((n, 3), np.float32)
     emitted = np.zeros((n, 3), np.float32)
-    depth = np.full(n, 1e10, np.float32)
-    normal = np.zeros((n, 3), np.float32)
     alpha = np.ones(n, np.float32)
     hits = ctx.geom_accel.intersect(o, d, tmax)
     alive = hits.prim >= 0
@@ -141,9 +138,7 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
         emitted[miss] += ctx.scene.world_radiance
     idx = np.flatnonzero(alive)
     if idx.size == 0:
-        return _sanitize(emitted), direct, indirect, depth, normal, alpha
-    fwd = camera_mod.forward(cam)
-    cam_pos = camera_mod.position(cam)
+        return _sanitize(emitted), direct, indirect, alpha
     o, d = o[idx], d[idx]
     prim, hu, hv, ht = hits.prim[idx], hits.u[idx], hits.v[idx], hits.t[idx]
     throughput = np.ones((idx.size, 3), np.float32)
@@ -153,8 +148,6 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
         s = Surface(ctx, prim, hu, hv, o, d, ht)
         target = direct if bounce == 0 else indirect
         if bounce == 0:
-            depth[idx] = np.einsum("ij,j->i", s.p - cam_pos, fwd)
-            normal[idx] = s.ns
             emitted[idx] += s.emission(ctx)
         # --- next-event estimation -------------------------------------------------------
         if not ctx.lights.empty:
@@ -219,7 +212,23 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
         o, d = o[hsel], d[hsel]
         prim, hu, hv, ht = hits.prim[hsel], hits.u[hsel], hits.v[hsel], hits.t[hsel]
 
-    return _sanitize(emitted), direct, indirect, depth, normal, alpha
+    return _sanitize(emitted), direct, indirect, alpha
+
+
+def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
+    """First hit at raster points (x, y): planar depth along the camera axis (n,) (1e10 = nothing,
+    as Cycles) and the world-space shading normal facing the camera (n, 3) (zero = nothing)."""
+    cam = ctx.scene.camera
+    o, d, tmax = camera_mod.generate_rays(cam, x, y)
+    hits = ctx.geom_accel.intersect(o, d, tmax)
+    depth = np.full(len(x), 1e10, np.float32)
+    normal = np.zeros((len(x), 3), np.float32)
+    hit = np.flatnonzero(hits.prim >= 0)
+    if hit.size:
+        s = Surface(ctx, hits.prim[hit], hits.u[hit], hits.v[hit], o[hit], d[hit], hits.t[hit])
+        depth[hit] = np.einsum("ij,j->i", s.p - camera_mod.position(cam), camera_mod.forward(cam))
+        normal[hit] = s.ns
+    return depth, normal
 
 
 def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False) -> TraceContext:

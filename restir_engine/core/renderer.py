@@ -68,9 +68,20 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     x0, y0, w, h = scene.camera.window
     tiles = _tiles(w, h, settings.tile_pixels)
     acc = {"emit": np.zeros((h, w, 3), np.float64), "direct": np.zeros((h, w, 3), np.float64),
-           "indirect": np.zeros((h, w, 3), np.float64), "alpha": np.zeros((h, w), np.float64),
-           "normal": np.zeros((h, w, 3), np.float64)}
-    depth = np.full((h, w), np.inf, np.float32)
+           "indirect": np.zeros((h, w, 3), np.float64), "alpha": np.zeros((h, w), np.float64)}
+    # data passes at pixel centres (one ray per pixel; no mixing of depths at silhouettes, as Cycles)
+    depth = np.empty((h, w, 1), np.float32)
+    normal = np.empty((h, w, 3), np.float32)
+
+    def gbuffer_tile(tile):
+        tx, ty, tw, th = tile
+        cy, cx = np.mgrid[0:th, 0:tw]
+        dep, nrm = pathtracer.gbuffer(ctx, (x0 + tx + cx.ravel() + 0.5).astype(np.float32),
+                                      (y0 + ty + cy.ravel() + 0.5).astype(np.float32))
+        depth[ty:ty + th, tx:tx + tw] = dep.reshape(th, tw, 1)
+        normal[ty:ty + th, tx:tx + tw] = nrm.reshape(th, tw, 3)
+
+    list(pool().map(gbuffer_tile, tiles))
     done = 0
     cancelled = False
     total_units = max(1, settings.samples * len(tiles))
@@ -106,27 +117,22 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
         if stop:
             cancelled = True
             break
-        for (tx, ty, tw, th), (emit, direct, indirect, dep, nrm, alpha) in pass_out:
+        for (tx, ty, tw, th), (emit, direct, indirect, alpha) in pass_out:
             sl = (slice(ty, ty + th), slice(tx, tx + tw))
             acc["emit"][sl] += emit.reshape(th, tw, 3)
             acc["direct"][sl] += direct.reshape(th, tw, 3)
             acc["indirect"][sl] += indirect.reshape(th, tw, 3)
             acc["alpha"][sl] += alpha.reshape(th, tw)
-            acc["normal"][sl] += nrm.reshape(th, tw, 3)
-            depth[sl] = np.minimum(depth[sl], dep.reshape(th, tw))
         done += 1
     if done == 0:
         raise Cancelled("render cancelled before the first sample pass finished")
     inv = 1.0 / done
     emit, direct, indirect = (acc[k] * inv for k in ("emit", "direct", "indirect"))
     rgb = emit + direct + indirect
-    nrm = acc["normal"]
-    nl = np.linalg.norm(nrm, axis=2, keepdims=True)
-    nrm = np.where(nl > 0, nrm / np.maximum(nl, 1e-12), 0.0)
     passes = {
         "Combined": np.concatenate([rgb, (acc["alpha"] * inv)[..., None]], axis=2).astype(np.float32),
-        "Depth": np.where(np.isfinite(depth), depth, 1e10).astype(np.float32)[..., None],
-        "Normal": nrm.astype(np.float32),
+        "Depth": depth,
+        "Normal": normal,
         "Direct": direct.astype(np.float32),
         "Indirect": indirect.astype(np.float32),
         "Emission": emit.astype(np.float32),

@@ -59,6 +59,22 @@ def _area_shape(light) -> np.ndarray:
     return tris
 
 
+def _light_node_scale(light):
+    """RGB factor of a light node tree that is a constant Emission node (Color x Strength), 1 without
+    nodes, None when the tree does something else (textures, falloff nodes ...)."""
+    tree = light.node_tree
+    if tree is None or not getattr(light, "use_nodes", True):
+        return np.ones(3)
+    outs = [n for n in tree.nodes if n.type == "OUTPUT_LIGHT" and n.is_active_output] or \
+           [n for n in tree.nodes if n.type == "OUTPUT_LIGHT"]
+    if not outs or not outs[0].inputs["Surface"].is_linked:
+        return np.zeros(3)
+    node = outs[0].inputs["Surface"].links[0].from_node
+    if node.type != "EMISSION" or any(i.is_linked for i in node.inputs):
+        return None
+    return np.array(node.inputs["Color"].default_value[:3], np.float64) * float(node.inputs["Strength"].default_value)
+
+
 def _area(tris: np.ndarray) -> float:
     return float(0.5 * np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1).sum())
 
@@ -73,8 +89,11 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
         light = obj.data
         m = np.array(inst.matrix_world, np.float64)
         power = np.array(light.color[:3], np.float64) * float(light.energy)
-        if getattr(light, "use_nodes", False) and light.node_tree is not None:
-            warnings.append(f"Light '{obj.name}': light node trees are ignored; colour x power is used")
+        node_scale = _light_node_scale(light)
+        if node_scale is None:
+            warnings.append(f"Light '{obj.name}': its node tree is not a plain Emission node; colour x power is used")
+        else:
+            power = power * node_scale
         if not np.isfinite(m).all() or not np.isfinite(power).all():
             warnings.append(f"Light '{obj.name}' has a non-finite transform or power and was skipped")
             continue

@@ -7,6 +7,7 @@ reported once per render, naming the material and the reason.
 """
 from __future__ import annotations
 
+import bpy
 import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
@@ -16,6 +17,13 @@ MAGENTA = (1.0, 0.0, 1.0)
 
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+def uses_nodes(idblock) -> bool:
+    """Whether a material/world is defined by its node tree (always, from Blender 5.0 on)."""
+    if idblock.node_tree is None:
+        return False
+    return True if bpy.app.version >= (5, 0, 0) else bool(idblock.use_nodes)
 
 
 def _value(socket, default):
@@ -66,7 +74,7 @@ class MaterialRegistry:
         self.warnings.append(f"Material '{material.name}': {reason}")
 
     def _convert(self, material) -> dict:
-        if not material.use_nodes or material.node_tree is None:
+        if not uses_nodes(material):
             return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                     "roughness": float(material.roughness), "f0": 0.04}
         tree = material.node_tree

@@ -3,12 +3,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from .materials import uses_nodes
+
 
 def export_world(scene, warnings: list) -> np.ndarray:
     world = scene.world
     if world is None:
         return np.zeros(3, np.float32)
-    if not world.use_nodes or world.node_tree is None:
+    if not uses_nodes(world):
         return np.array(world.color[:3], np.float32)
     tree = world.node_tree
     outputs = [n for n in tree.nodes if n.type == "OUTPUT_WORLD" and n.is_active_output] or \

@@ -1,0 +1,92 @@
+"""The engine inside Blender: passes, their conventions (checked against Cycles), border, alpha."""
+import math
+
+import bpy
+import numpy as np
+import pytest
+
+from bpy_scenes import configure_cycles, configure_restir, cornell_box, render_passes
+
+
+@pytest.fixture
+def box(addon):
+    scene = cornell_box("EMISSIVE", (40, 30))
+    vl = scene.view_layers[0]
+    vl.use_pass_z = vl.use_pass_normal = True
+    vl.restir.use_pass_direct = vl.restir.use_pass_indirect = vl.restir.use_pass_emission = True
+    return scene
+
+
+def test_all_passes_written_finite_and_consistent(box):
+    configure_restir(box, 4, 2)
+    p = render_passes(box)
+    assert set(p) >= {"Combined", "Depth", "Normal", "Direct", "Indirect", "Emission"}
+    for name, img in p.items():
+        assert img.shape[:2] == (30, 40), name
+        assert np.isfinite(img).all(), name
+    assert np.allclose(p["Combined"][..., :3], p["Emission"] + p["Direct"] + p["Indirect"], atol=1e-4)
+    assert p["Indirect"].mean() > 0 and p["Direct"].mean() > 0
+    assert np.allclose(p["Combined"][..., 3], 1.0)
+
+
+def test_rows_are_bottom_up_floor_below_ceiling(box):
+    configure_restir(box, 1, 0)
+    n = render_passes(box)["Normal"]
+    assert np.allclose(n[0, 20], [0, 0, 1], atol=1e-3)    # bottom row, middle: the floor
+    assert np.allclose(n[-1, 20], [0, 0, -1], atol=1e-3)  # top row, middle: the ceiling
+
+
+def test_depth_and_normal_follow_cycles_conventions(box):
+    configure_restir(box, 4, 0)
+    ours = render_passes(box)
+    configure_cycles(box, 4, 0)
+    ref = render_passes(box)
+    # pixel-centre data: compare where both see the same flat surface (away from edges)
+    flat = (np.abs(np.diff(ref["Depth"][..., 0], axis=1, prepend=0)) < 0.05)
+    assert np.allclose(ours["Depth"][..., 0][flat], ref["Depth"][..., 0][flat], rtol=0.01)
+    dots = (ours["Normal"] * ref["Normal"]).sum(axis=2)
+    assert np.median(dots) > 0.999
+
+
+def test_border_with_and_without_crop(box):
+    configure_restir(box, 1, 0)
+    r = box.render
+    r.use_border = True
+    r.border_min_x, r.border_max_x, r.border_min_y, r.border_max_y = 0.5, 1.0, 0.0, 0.5
+    r.use_crop_to_border = True
+    cropped = render_passes(box)["Combined"]
+    assert cropped.shape[:2] == (15, 20)
+    r.use_crop_to_border = False
+    full = render_passes(box)["Combined"]
+    assert full.shape[:2] == (30, 40)
+    assert full[15:, :, 3].max() == 0 and full[:, :20, 3].max() == 0  # outside the border: empty
+    assert np.allclose(full[:15, 20:], cropped)
+
+
+def test_film_transparent_gives_alpha(addon):
+    scene = cornell_box("SUN", (32, 32))
+    configure_restir(scene, 2, 0)
+    scene.render.film_transparent = True
+    world = scene.world.node_tree.nodes["Background"].inputs["Color"]
+    world.default_value = (1, 1, 1, 1)
+    c = render_passes(scene)["Combined"]
+    assert c[..., 3].min() == 0.0 and c[..., 3].max() == 1.0
+    sky = c[..., 3] == 0
+    assert np.allclose(c[sky, :3], 0.0)
+
+
+def test_animation_frames_render_each_frame(addon, tmp_path):
+    scene = cornell_box("EMISSIVE", (16, 16))
+    configure_restir(scene, 1, 0)
+    cam = scene.camera
+    cam.keyframe_insert("location", frame=1)
+    cam.location.x += 0.5
+    cam.keyframe_insert("location", frame=2)
+    scene.frame_start, scene.frame_end = 1, 2
+    scene.render.filepath = str(tmp_path / "f_")
+    scene.render.image_settings.file_format = "PNG"
+    bpy.ops.render.render(animation=True)
+    assert (tmp_path / "f_0001.png").exists() and (tmp_path / "f_0002.png").exists()
+    a = bpy.data.images.load(str(tmp_path / "f_0001.png"))
+    b = bpy.data.images.load(str(tmp_path / "f_0002.png"))
+    assert not np.array_equal(np.array(a.pixels[:]), np.array(b.pixels[:]))  # the camera moved
