@@ -1,9 +1,9 @@
 """The reference path tracer against closed-form answers (no bpy)."""
 import numpy as np
 import pytest
+from scenes_core import emissive_furnace, floor_with_emitter, irradiance_square, plane_under_world
 
 from restir_engine.core.renderer import Cancelled, RenderSettings, render_frame
-from scenes_core import emissive_furnace, floor_with_emitter, irradiance_square, plane_under_world
 
 
 def test_plane_under_constant_world_is_exact():

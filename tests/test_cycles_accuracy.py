@@ -7,7 +7,6 @@ scaled by 1.03 (a 3 % light-unit mistake) must fail the whole-image comparison.
 """
 import numpy as np
 import pytest
-
 from bpy_scenes import configure_cycles, configure_restir, cornell_box, render_passes
 from stats import compare
 

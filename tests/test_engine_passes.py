@@ -1,10 +1,8 @@
 """The engine inside Blender: passes, their conventions (checked against Cycles), border, alpha."""
-import math
 
 import bpy
 import numpy as np
 import pytest
-
 from bpy_scenes import configure_cycles, configure_restir, cornell_box, render_passes
 
 

@@ -4,8 +4,8 @@ import math
 import bpy
 import numpy as np
 import pytest
+from bpy_scenes import camera, emission, light, plane, reset
 
-from bpy_scenes import camera, diffuse, emission, light, plane, reset
 from restir_engine.export import ExportError, export_scene
 
 

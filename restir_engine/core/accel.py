@@ -86,7 +86,7 @@ class Accel:
     """A static triangle scene. ``triangles`` is (n, 3, 3) float32 world-space vertices."""
 
     def __init__(self, triangles: np.ndarray):
-        self.n_triangles = int(len(triangles))
+        self.n_triangles = len(triangles)
         self._scene = None
         if self.n_triangles:
             from embreex import rtcore_scene

@@ -100,7 +100,6 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
 
 def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.ndarray, u2: np.ndarray):
     """Sample wi; returns wi (n, 3), f (n, 3), pdf (n,) (the mixture pdf, so MIS-ready)."""
-    n = len(wo)
     spec = u_lobe < p.p_spec
     wi = cosine_hemisphere(u1, u2)
     if spec.any():

@@ -18,7 +18,7 @@ import numpy as np
 from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
 from .bsdf import SurfaceParams, eval_bsdf, sample_bsdf
-from .lights import LightTable, spot_factor, triangle_geometry, emitted_radiance
+from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
 from .sampling import orthonormal_basis, to_local, to_world
 from .scene import Scene
 from .textures import apply_texture

@@ -27,12 +27,12 @@ class TriangleSet:
     uvs: np.ndarray | None = None
 
     @staticmethod
-    def empty() -> "TriangleSet":
+    def empty() -> TriangleSet:
         return TriangleSet(np.zeros((0, 3, 3), np.float32), np.zeros((0, 3, 3), np.float32),
                            np.zeros(0, np.int32))
 
     def __len__(self) -> int:
-        return int(len(self.verts))
+        return len(self.verts)
 
 
 @dataclass
@@ -63,7 +63,7 @@ class MaterialTable:
     names: list = field(default_factory=list)
 
     @staticmethod
-    def build(rows: list[dict], textures: list | None = None) -> "MaterialTable":
+    def build(rows: list[dict], textures: list | None = None) -> MaterialTable:
         """From a list of dicts with the field names above (missing fields take defaults)."""
         def col(key, default, dtype=np.float32):
             return np.array([r.get(key, default) for r in rows], dtype=dtype).reshape(len(rows), *np.shape(default))
@@ -100,7 +100,7 @@ class Lamps:
     sun_irradiance: np.ndarray
 
     @staticmethod
-    def empty() -> "Lamps":
+    def empty() -> Lamps:
         z3 = np.zeros((0, 3), np.float32)
         z = np.zeros(0, np.float32)
         return Lamps(TriangleSet.empty(), z3, z3, z, z, np.zeros(0, bool), z3, z, z3)

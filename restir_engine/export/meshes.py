@@ -126,7 +126,7 @@ def export_geometry(depsgraph, registry, warnings: list):
     bad_n = ~np.isfinite(normals).all(axis=2)
     if bad_n.any():
         normals[bad_n] = 0.0  # the shader falls back to the geometric normal
-    stats = {"triangles": int(len(verts)), "instances": len(blocks), "dropped": int((~keep).sum())}
+    stats = {"triangles": len(verts), "instances": len(blocks), "dropped": int((~keep).sum())}
     return TriangleSet(verts, normals, material, uvs), stats
 
 

@@ -1,4 +1,4 @@
-from . import panels  # noqa: F401
+from . import panels
 
 register = panels.register
 unregister = panels.unregister
