@@ -39,6 +39,15 @@ class RestirRenderEngine(bpy.types.RenderEngine):
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
+        self._viewport = None
+        self._texture = None
+
+    def __del__(self):
+        try:
+            if getattr(self, "_viewport", None) is not None:
+                self._viewport.halt()
+        except ReferenceError:  # the RNA struct may already be gone
+            pass
 
     # Blender calls this on throwaway instances too: no instance state.
     def update_render_passes(self, scene=None, renderlayer=None):
@@ -75,6 +84,63 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         self._write(result.passes, core_scene.camera.window, view_layer)
         self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {result.samples_done} samples | "
                                     f"export {t_export:.2f}s, render {result.seconds:.2f}s")
+
+    # -- viewport (Rendered shading) ----------------------------------------------------------
+    def view_update(self, context, depsgraph):
+        """Blender's thread: export the scene; the worker thread renders it."""
+        from .viewport import ViewportSession, view_camera
+        scene = depsgraph.scene
+        region = context.region
+        if self._viewport is None:
+            self._viewport = ViewportSession(self.tag_redraw)
+        w, h = self._view_size(context)
+        space = context.space_data
+        cam = view_camera(context.region_data, w, h, space.clip_start, space.clip_end)
+        try:
+            core_scene = export_scene(depsgraph, camera=cam)
+        except ExportError as exc:
+            self.report({"ERROR"}, str(exc))
+            return
+        settings = settings_from_scene(scene)
+        settings.samples = 1
+        settings.tile_pixels = 4096  # small tiles: the view reacts quickly to navigation
+        self._viewport.set_scene(core_scene, settings)
+        self._viewport.set_view(cam, self._view_key(context, w, h))
+        del region
+
+    def _view_size(self, context):
+        pixel = max(1, int(self.get_preview_pixel_size(context.scene))) * 2  # half resolution for speed
+        return max(1, context.region.width // pixel), max(1, context.region.height // pixel)
+
+    @staticmethod
+    def _view_key(context, w, h):
+        rd = context.region_data
+        return (tuple(map(tuple, rd.view_matrix)), tuple(map(tuple, rd.window_matrix)), w, h)
+
+    def view_draw(self, context, depsgraph):
+        """UI thread: restart on view changes, draw the running mean. Must stay cheap."""
+        import gpu
+        from gpu_extras.presets import draw_texture_2d
+
+        from .viewport import view_camera
+        if self._viewport is None:
+            return
+        w, h = self._view_size(context)
+        space = context.space_data
+        self._viewport.set_view(view_camera(context.region_data, w, h, space.clip_start, space.clip_end),
+                                self._view_key(context, w, h))
+        image, samples = self._viewport.latest()
+        if image is None:
+            return
+        ih, iw = image.shape[:2]
+        buf = gpu.types.Buffer("FLOAT", iw * ih * 4, np.ascontiguousarray(image).ravel())
+        self._texture = gpu.types.GPUTexture((iw, ih), format="RGBA16F", data=buf)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        self.bind_display_space_shader(depsgraph.scene)
+        draw_texture_2d(self._texture, (0, 0), context.region.width, context.region.height)
+        self.unbind_display_space_shader()
+        gpu.state.blend_set("NONE")
+        self.update_stats("ReSTIR", f"Viewport | {samples} samples")
 
     def _write(self, images: dict, window, view_layer):
         _x0, _y0, w, h = window

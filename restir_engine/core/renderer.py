@@ -54,92 +54,127 @@ def _tiles(w: int, h: int, tile_pixels: int):
     return [(x, y, min(side, w - x), min(side, h - y)) for y in range(0, h, side) for x in range(0, w, side)]
 
 
+class FrameRenderer:
+    """One frame's acceleration structures and light table, rendering sample passes into accumulators.
+
+    ``render_frame`` drives it for final renders; the viewport keeps one alive between redraws and
+    swaps the camera with :meth:`set_camera` (geometry and lights stay built).
+    """
+
+    def __init__(self, scene: Scene, settings: RenderSettings):
+        if settings.integrator not in INTEGRATORS:
+            raise ValueError(f"unknown integrator {settings.integrator!r}; available: {INTEGRATORS}")
+        t0 = time.perf_counter()
+        self.settings = settings
+        self.ctx = pathtracer.build_context(scene, settings.max_bounces, settings.film_transparent)
+        self.build_seconds = time.perf_counter() - t0
+        self.set_camera(scene.camera)
+
+    def set_camera(self, camera) -> None:
+        """Use another camera (same scene) and restart accumulation."""
+        self.ctx.scene.camera = camera
+        _x0, _y0, w, h = camera.window
+        self.tiles = _tiles(w, h, self.settings.tile_pixels)
+        self.acc = {"emit": np.zeros((h, w, 3), np.float64), "direct": np.zeros((h, w, 3), np.float64),
+                    "indirect": np.zeros((h, w, 3), np.float64), "alpha": np.zeros((h, w), np.float64)}
+        self.samples_done = 0
+        self._data = None
+
+    def data_passes(self):
+        """Depth (h, w, 1) and Normal (h, w, 3) at pixel centres (one ray per pixel: no mixing of depths
+        at silhouettes, as Cycles)."""
+        if self._data is None:
+            x0, y0, w, h = self.ctx.scene.camera.window
+            depth = np.empty((h, w, 1), np.float32)
+            normal = np.empty((h, w, 3), np.float32)
+
+            def gbuffer_tile(tile):
+                tx, ty, tw, th = tile
+                cy, cx = np.mgrid[0:th, 0:tw]
+                dep, nrm = pathtracer.gbuffer(self.ctx, (x0 + tx + cx.ravel() + 0.5).astype(np.float32),
+                                              (y0 + ty + cy.ravel() + 0.5).astype(np.float32))
+                depth[ty:ty + th, tx:tx + tw] = dep.reshape(th, tw, 1)
+                normal[ty:ty + th, tx:tx + tw] = nrm.reshape(th, tw, 3)
+
+            list(pool().map(gbuffer_tile, self.tiles))
+            self._data = (depth, normal)
+        return self._data
+
+    def _run_tile(self, args):
+        s, ti, (tx, ty, tw, th) = args
+        st = self.settings
+        x0, y0 = self.ctx.scene.camera.window[:2]
+        cam_rng = rng(st.seed, st.frame, s, STREAM_CAMERA, ti)
+        path_rng = rng(st.seed, st.frame, s, STREAM_PATH, ti)
+        jy, jx = np.mgrid[0:th, 0:tw]
+        j = cam_rng.random((th * tw, 2), dtype=np.float32)
+        x = x0 + tx + jx.ravel().astype(np.float32) + j[:, 0]
+        y = y0 + ty + jy.ravel().astype(np.float32) + j[:, 1]
+        return (tx, ty, tw, th), pathtracer.trace(self.ctx, x, y, path_rng)
+
+    def sample_pass(self, progress=None, should_stop=None) -> bool:
+        """Render the next sample pass (one path per pixel) into the accumulators. Returns False, keeping
+        the accumulators unchanged, when ``should_stop`` asked to stop part-way."""
+        s = self.samples_done
+        futures = {pool().submit(self._run_tile, (s, ti, t)) for ti, t in enumerate(self.tiles)}
+        results = []
+        while futures:
+            finished, futures = wait(futures, timeout=0.25, return_when=FIRST_COMPLETED)
+            results.extend(f.result() for f in finished)
+            if progress:
+                progress(len(results) / len(self.tiles))
+            if should_stop and should_stop():
+                for f in futures:
+                    f.cancel()
+                wait(futures)
+                return False
+        for (tx, ty, tw, th), (emit, direct, indirect, alpha) in results:
+            sl = (slice(ty, ty + th), slice(tx, tx + tw))
+            self.acc["emit"][sl] += emit.reshape(th, tw, 3)
+            self.acc["direct"][sl] += direct.reshape(th, tw, 3)
+            self.acc["indirect"][sl] += indirect.reshape(th, tw, 3)
+            self.acc["alpha"][sl] += alpha.reshape(th, tw)
+        self.samples_done += 1
+        return True
+
+    def combined(self) -> np.ndarray:
+        """The running mean of Combined (h, w, 4) float32."""
+        inv = 1.0 / max(1, self.samples_done)
+        rgb = (self.acc["emit"] + self.acc["direct"] + self.acc["indirect"]) * inv
+        out = np.concatenate([rgb, (self.acc["alpha"] * inv)[..., None]], axis=2).astype(np.float32)
+        return np.where(np.isfinite(out), out, 0.0).astype(np.float32)
+
+    def passes(self) -> dict:
+        """All passes (see :class:`FrameResult`); finite everywhere."""
+        inv = 1.0 / max(1, self.samples_done)
+        depth, normal = self.data_passes()
+        out = {"Combined": self.combined(), "Depth": depth, "Normal": normal,
+               "Direct": self.acc["direct"] * inv, "Indirect": self.acc["indirect"] * inv,
+               "Emission": self.acc["emit"] * inv}
+        return {k: np.where(np.isfinite(v), v, 0.0).astype(np.float32) for k, v in out.items()}
+
+
 def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None) -> FrameResult:
     """Render one frame with the chosen integrator.
 
     progress(fraction, message) is called after every tile; should_stop() is polled after every tile,
     and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none).
     """
-    if settings.integrator not in INTEGRATORS:
-        raise ValueError(f"unknown integrator {settings.integrator!r}; available: {INTEGRATORS}")
     t0 = time.perf_counter()
-    ctx = pathtracer.build_context(scene, settings.max_bounces, settings.film_transparent)
-    t_build = time.perf_counter() - t0
-    x0, y0, w, h = scene.camera.window
-    tiles = _tiles(w, h, settings.tile_pixels)
-    acc = {"emit": np.zeros((h, w, 3), np.float64), "direct": np.zeros((h, w, 3), np.float64),
-           "indirect": np.zeros((h, w, 3), np.float64), "alpha": np.zeros((h, w), np.float64)}
-    # data passes at pixel centres (one ray per pixel; no mixing of depths at silhouettes, as Cycles)
-    depth = np.empty((h, w, 1), np.float32)
-    normal = np.empty((h, w, 3), np.float32)
-
-    def gbuffer_tile(tile):
-        tx, ty, tw, th = tile
-        cy, cx = np.mgrid[0:th, 0:tw]
-        dep, nrm = pathtracer.gbuffer(ctx, (x0 + tx + cx.ravel() + 0.5).astype(np.float32),
-                                      (y0 + ty + cy.ravel() + 0.5).astype(np.float32))
-        depth[ty:ty + th, tx:tx + tw] = dep.reshape(th, tw, 1)
-        normal[ty:ty + th, tx:tx + tw] = nrm.reshape(th, tw, 3)
-
-    list(pool().map(gbuffer_tile, tiles))
-    done = 0
+    fr = FrameRenderer(scene, settings)
     cancelled = False
-    total_units = max(1, settings.samples * len(tiles))
-
-    def run_tile(args):
-        s, ti, (tx, ty, tw, th) = args
-        cam_rng = rng(settings.seed, settings.frame, s, STREAM_CAMERA, ti)
-        path_rng = rng(settings.seed, settings.frame, s, STREAM_PATH, ti)
-        jy, jx = np.mgrid[0:th, 0:tw]
-        jx = jx.ravel().astype(np.float32)
-        jy = jy.ravel().astype(np.float32)
-        j = cam_rng.random((jx.size, 2), dtype=np.float32)
-        x = x0 + tx + jx + j[:, 0]
-        y = y0 + ty + jy + j[:, 1]
-        out = pathtracer.trace(ctx, x, y, path_rng)
-        return (tx, ty, tw, th), out
-
     for s in range(settings.samples):
-        futures = {pool().submit(run_tile, (s, ti, t)) for ti, t in enumerate(tiles)}
-        pass_out = []
-        stop = False
-        while futures:
-            finished, futures = wait(futures, timeout=0.25, return_when=FIRST_COMPLETED)
-            pass_out.extend(f.result() for f in finished)
-            if progress:
-                progress((s * len(tiles) + len(pass_out)) / total_units, f"Sample {s + 1}/{settings.samples}")
-            if should_stop and should_stop():
-                for f in futures:
-                    f.cancel()
-                wait(futures)
-                stop = True
-                break
-        if stop:
+        report = None
+        if progress:
+            def report(f, s=s):
+                progress((s + f) / settings.samples, f"Sample {s + 1}/{settings.samples}")
+        if not fr.sample_pass(report, should_stop):
             cancelled = True
             break
-        for (tx, ty, tw, th), (emit, direct, indirect, alpha) in pass_out:
-            sl = (slice(ty, ty + th), slice(tx, tx + tw))
-            acc["emit"][sl] += emit.reshape(th, tw, 3)
-            acc["direct"][sl] += direct.reshape(th, tw, 3)
-            acc["indirect"][sl] += indirect.reshape(th, tw, 3)
-            acc["alpha"][sl] += alpha.reshape(th, tw)
-        done += 1
-    if done == 0:
+    if fr.samples_done == 0:
         raise Cancelled("render cancelled before the first sample pass finished")
-    inv = 1.0 / done
-    emit, direct, indirect = (acc[k] * inv for k in ("emit", "direct", "indirect"))
-    rgb = emit + direct + indirect
-    passes = {
-        "Combined": np.concatenate([rgb, (acc["alpha"] * inv)[..., None]], axis=2).astype(np.float32),
-        "Depth": depth,
-        "Normal": normal,
-        "Direct": direct.astype(np.float32),
-        "Indirect": indirect.astype(np.float32),
-        "Emission": emit.astype(np.float32),
-    }
-    for k, v in passes.items():
-        passes[k] = np.where(np.isfinite(v), v, 0.0).astype(np.float32)
-    seconds = time.perf_counter() - t0
-    return FrameResult(passes, done, seconds, cancelled,
-                       {"build_seconds": t_build, "triangles": len(scene.geometry),
+    passes = fr.passes()
+    ctx = fr.ctx
+    return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled,
+                       {"build_seconds": fr.build_seconds, "triangles": len(scene.geometry),
                         "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun})

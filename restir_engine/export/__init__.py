@@ -16,15 +16,16 @@ from .world import export_world
 __all__ = ["ExportError", "export_scene"]
 
 
-def export_scene(depsgraph, camera_override=None, engine_resolution=None) -> Scene:
+def export_scene(depsgraph, camera_override=None, camera=None) -> Scene:
     """Export everything visible in ``depsgraph``; raises :class:`ExportError` on unusable input.
 
-    engine_resolution: (width, height) the engine was given, used to cross-check the border window.
+    camera: a ready core Camera (the viewport's view) instead of the scene's camera object.
     """
     t0 = time.perf_counter()
     scene = depsgraph.scene
     warnings: list[str] = []
-    camera = export_camera(depsgraph, camera_override, warnings)
+    if camera is None:
+        camera = export_camera(depsgraph, camera_override, warnings)
     registry = MaterialRegistry(warnings)
     geometry, stats = export_geometry(depsgraph, registry, warnings)
     lamps = export_lamps(depsgraph, registry, warnings)
