@@ -12,6 +12,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .sampling import dot, norm
+
 CHUNK_RAYS = 32768  # rays per Embree call: large enough to amortize the call, small for load balance
 
 _POOL: ThreadPoolExecutor | None = None
@@ -48,7 +50,7 @@ def offset_origin(p: np.ndarray, ng: np.ndarray, direction: np.ndarray) -> np.nd
 
     The offset scales with the coordinate magnitude (float32 spacing) so it works at any scene scale.
     """
-    side = np.where(np.einsum("ij,ij->i", ng, direction) >= 0.0, 1.0, -1.0).astype(np.float32)
+    side = np.where(dot(ng, direction) >= 0.0, 1.0, -1.0).astype(np.float32)
     mag = np.maximum(np.abs(p).max(axis=1), 1.0).astype(np.float32)
     return (p + ng * (side * mag * 1e-4)[:, None]).astype(np.float32)
 
@@ -64,7 +66,7 @@ def shadow_rays(p: np.ndarray, ng: np.ndarray, light_pos: np.ndarray, wi: np.nda
     o = offset_origin(p, ng, wi)
     finite = np.isfinite(dist)
     d = np.where(finite[:, None], light_pos - o, wi)
-    ln = np.linalg.norm(d, axis=1)
+    ln = norm(d)
     d = d / np.maximum(ln, 1e-30)[:, None]
     far = np.where(finite, ln * (1.0 - 1e-4), 1e30)
     return o, d.astype(np.float32), far.astype(np.float32)

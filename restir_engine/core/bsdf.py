@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .sampling import cosine_hemisphere
+from .sampling import cosine_hemisphere, dot, norm
 
 ALPHA_MIN = 1e-3
 INV_PI = np.float32(1.0 / np.pi)
@@ -29,13 +29,20 @@ def luminance(rgb: np.ndarray) -> np.ndarray:
 
 @dataclass
 class SurfaceParams:
-    """Per-hit BSDF parameters: diffuse (n, 3), f0 (n, 3), f0_dielectric (n,), alpha (n,), p_spec (n,)."""
+    """Per-hit (or per-material) BSDF parameters: diffuse (n, 3), f0 (n, 3), f0_dielectric (n,),
+    alpha (n,), p_spec (n,) probability of sampling the specular lobe, spec_on (n,) 1 where a specular
+    lobe exists (0 for Diffuse BSDF)."""
 
     diffuse: np.ndarray
     f0: np.ndarray
     f0_dielectric: np.ndarray
     alpha: np.ndarray
     p_spec: np.ndarray
+    spec_on: np.ndarray
+
+    def take(self, rows: np.ndarray) -> "SurfaceParams":
+        return SurfaceParams(self.diffuse[rows], self.f0[rows], self.f0_dielectric[rows], self.alpha[rows],
+                             self.p_spec[rows], self.spec_on[rows])
 
     @staticmethod
     def from_material(base: np.ndarray, metallic: np.ndarray, roughness: np.ndarray, f0_d: np.ndarray):
@@ -49,7 +56,8 @@ class SurfaceParams:
         p = np.where(tot > 0, ws / np.maximum(tot, 1e-12), 0.0)
         both = (ws > 0) & (wd > 0)
         p = np.where(both, np.clip(p, 0.1, 0.9), p).astype(np.float32)
-        return SurfaceParams(diffuse, f0, f0_d.astype(np.float32), alpha, p)
+        spec_on = (f0.max(axis=1) > 0).astype(np.float32)
+        return SurfaceParams(diffuse, f0, f0_d.astype(np.float32), alpha, p, spec_on)
 
 
 def _schlick(f0, cos):
@@ -81,15 +89,14 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
     f = p.diffuse * (fd * INV_PI)[:, None]
     pdf_d = np.maximum(ci, 0) * INV_PI
     h = wo + wi
-    hn = np.linalg.norm(h, axis=1)
+    hn = norm(h)
     h = h / np.maximum(hn, 1e-12)[:, None]
     cos_h = np.clip(h[:, 2], 0, 1)
-    odh = np.clip(np.einsum("ij,ij->i", wo, h), 1e-6, 1.0)
+    odh = np.clip(dot(wo, h), 1e-6, 1.0)
     d = _ggx_d(p.alpha, cos_h)
     g = 1.0 / (1.0 + _smith_lambda(p.alpha, co) + _smith_lambda(p.alpha, ci))
     fr = _schlick(p.f0, odh[:, None])
-    spec_on = (p.f0.max(axis=1) > 0).astype(np.float32)
-    spec = (spec_on * d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr
+    spec = (p.spec_on * d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr
     f = f + spec
     pdf_s = d * cos_h / (4.0 * odh)
     pdf = (1 - p.p_spec) * pdf_d + p.p_spec * pdf_s
@@ -111,7 +118,7 @@ def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.nda
         phi = 2 * np.pi * uu2
         h = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=-1)
         o = wo[spec]
-        wi[spec] = (2.0 * np.einsum("ij,ij->i", o, h)[:, None] * h - o).astype(np.float32)
+        wi[spec] = (2.0 * dot(o, h)[:, None] * h - o).astype(np.float32)
     f, pdf = eval_bsdf(p, wo, wi)
     ok = (pdf > 0) & (wi[:, 2] > 0)
     return wi, np.where(ok[:, None], f, 0.0).astype(np.float32), np.where(ok, pdf, 0.0).astype(np.float32)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bsdf import luminance
-from .sampling import AliasTable, orthonormal_basis, uniform_triangle
+from .sampling import AliasTable, dot, norm, orthonormal_basis, uniform_triangle
 from .scene import Lamps, MaterialTable, Scene, TriangleSet
 from .textures import apply_texture, mean_color
 
@@ -23,7 +23,7 @@ GEOM, LAMP, SUN = 0, 1, 2
 def triangle_geometry(verts: np.ndarray):
     """Unit geometric normals (winding order) and areas of (n, 3, 3) triangles."""
     c = np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0])
-    ln = np.linalg.norm(c, axis=1)
+    ln = norm(c)
     ng = c / np.maximum(ln, 1e-30)[:, None]
     return ng.astype(np.float32), (0.5 * ln).astype(np.float32)
 
@@ -34,8 +34,7 @@ def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarra
     mat = tris.material[tri]
     le = materials.emission[mat]
     if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
-        uv3 = tris.uvs[tri]
-        uv = uv3[:, 0] * (1 - b1 - b2)[:, None] + uv3[:, 1] * b1[:, None] + uv3[:, 2] * b2[:, None]
+        uv = np.einsum("ijk,ij->ik", tris.uvs[tri], np.stack([1 - b1 - b2, b1, b2], axis=1))
         le = apply_texture(le, materials.emit_tex[mat], uv, materials.textures)
     return le
 
@@ -47,8 +46,8 @@ def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray
     spot = cos_cut > -1.5
     if spot.any():
         d = p[spot] - lamps.spot_center[lamp_tri[spot]]
-        d /= np.maximum(np.linalg.norm(d, axis=1), 1e-30)[:, None]
-        t = np.einsum("ij,ij->i", d, lamps.spot_axis[lamp_tri[spot]])
+        d /= np.maximum(norm(d), 1e-30)[:, None]
+        t = dot(d, lamps.spot_axis[lamp_tri[spot]])
         sm = lamps.spot_smooth[lamp_tri[spot]]
         x = np.where(sm > 0, (t - cos_cut[spot]) / np.maximum(sm, 1e-12), np.where(t > cos_cut[spot], 1.0, 0.0))
         x = np.clip(x, 0.0, 1.0)
@@ -147,12 +146,11 @@ class LightTable:
         if tri.any():
             li = light[tri]
             b1, b2 = uniform_triangle(u[tri, 2], u[tri, 3])
-            v = self.tri_verts[li]
-            q = v[:, 0] * (1 - b1 - b2)[:, None] + v[:, 1] * b1[:, None] + v[:, 2] * b2[:, None]
+            q = np.einsum("ijk,ij->ik", self.tri_verts[li], np.stack([1 - b1 - b2, b1, b2], axis=1))
             d = q - p[tri]
-            dl = np.linalg.norm(d, axis=1)
+            dl = norm(d)
             w = d / np.maximum(dl, 1e-30)[:, None]
-            cos_l = -np.einsum("ij,ij->i", w, self.tri_normal[li])
+            cos_l = -dot(w, self.tri_normal[li])
             facing = (cos_l > 0) | self.tri_two_sided[li]
             rad = self.radiance_of(li, b1, b2, p[tri])
             pd = self.tri_pdf_solid_angle(li, dl, cos_l)

@@ -19,7 +19,7 @@ from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
 from .bsdf import SurfaceParams, eval_bsdf, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
-from .sampling import orthonormal_basis, to_local, to_world
+from .sampling import dot, norm, orthonormal_basis, to_local, to_world
 from .scene import Scene
 from .textures import apply_texture
 
@@ -34,6 +34,7 @@ class TraceContext:
     lights: LightTable
     geom_ng: np.ndarray  # (n, 3) unit geometric normals
     lamp_ng: np.ndarray
+    material_params: SurfaceParams  # per material, untextured (gathered per hit)
     max_bounces: int
     rr_start: int = 3
     film_transparent: bool = False
@@ -42,6 +43,11 @@ class TraceContext:
 def _power_heuristic(a, b):
     a2 = a * a
     return np.where(a2 > 0, a2 / np.maximum(a2 + b * b, 1e-30), 0.0).astype(np.float32)
+
+
+def _accumulate(target: np.ndarray, rows: np.ndarray, values: np.ndarray) -> None:
+    """target[rows] += values; ``rows`` are unique path indices, so buffered indexing is exact."""
+    target[rows] += values
 
 
 def _sanitize(x: np.ndarray) -> np.ndarray:
@@ -57,34 +63,37 @@ class Surface:
         mats = scene.materials
         self.prim = prim
         self.b1, self.b2 = u, v
-        w0 = (1 - u - v)[:, None]
         self.p = (o + d * t[:, None]).astype(np.float32)
         ng = ctx.geom_ng[prim]
-        cn = geom.normals[prim]
-        ns = cn[:, 0] * w0 + cn[:, 1] * u[:, None] + cn[:, 2] * v[:, None]
-        ns /= np.maximum(np.linalg.norm(ns, axis=1), 1e-12)[:, None]
-        bad = ~np.isfinite(ns).all(axis=1) | (np.linalg.norm(ns, axis=1) < 0.5)
+        bary = np.stack([1 - u - v, u, v], axis=1)
+        ns = np.einsum("ijk,ij->ik", geom.normals[prim], bary)
+        ns /= np.maximum(norm(ns), 1e-12)[:, None]
+        bad = ~np.isfinite(ns).all(axis=1) | (norm(ns) < 0.5)
         ns[bad] = ng[bad]
-        ns = np.where((np.einsum("ij,ij->i", ns, ng) < 0)[:, None], -ns, ns)
-        flip = np.einsum("ij,ij->i", ng, d) > 0
+        ns = np.where((dot(ns, ng) < 0)[:, None], -ns, ns)
+        flip = dot(ng, d) > 0
         s = np.where(flip, -1.0, 1.0).astype(np.float32)[:, None]
         self.ng = (ng * s).astype(np.float32)
         self.ns = (ns * s).astype(np.float32)
         self.wo = (-d).astype(np.float32)
         mat = geom.material[prim]
         self.mat = mat
-        base = mats.base_color[mat]
+        self.params = ctx.material_params.take(mat)
         self.uv = None
         if geom.uvs is not None:
-            uv3 = geom.uvs[prim]
-            self.uv = uv3[:, 0] * w0 + uv3[:, 1] * u[:, None] + uv3[:, 2] * v[:, None]
-            base = apply_texture(base, mats.base_tex[mat], self.uv, mats.textures)
-        self.params = SurfaceParams.from_material(base, mats.metallic[mat], mats.roughness[mat], mats.f0[mat])
+            self.uv = np.einsum("ijk,ij->ik", geom.uvs[prim], bary)
+            textured = np.flatnonzero(mats.base_tex[mat] >= 0)
+            if textured.size:  # re-derive the parameters where a texture drives the base colour
+                tm = mat[textured]
+                base = apply_texture(mats.base_color[tm], mats.base_tex[tm], self.uv[textured], mats.textures)
+                sub = SurfaceParams.from_material(base, mats.metallic[tm], mats.roughness[tm], mats.f0[tm])
+                for field in ("diffuse", "f0", "f0_dielectric", "alpha", "p_spec", "spec_on"):
+                    getattr(self.params, field)[textured] = getattr(sub, field)
         self.t, self.bt = orthonormal_basis(self.ns)
         self.wo_l = to_local(self.wo, self.ns, self.t, self.bt)
         # view vectors below the shading hemisphere (shading-normal artefact): bend to the horizon
         self.wo_l[:, 2] = np.maximum(self.wo_l[:, 2], 1e-4)
-        self.wo_l /= np.linalg.norm(self.wo_l, axis=1)[:, None]
+        self.wo_l /= norm(self.wo_l)[:, None]
 
     def emission(self, ctx: TraceContext):
         """Emitted radiance (n, 3) towards the incoming ray (mesh emission is two-sided by default)."""
@@ -97,7 +106,7 @@ def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
     prim = lh.prim[sel]
     t = lh.t[sel]
     ng = ctx.lamp_ng[prim]
-    cos_l = -np.einsum("ij,ij->i", d[sel], ng)
+    cos_l = -dot(d[sel], ng)
     lamps = ctx.scene.lamps
     p = o[sel] + d[sel] * t[:, None]
     le = emitted_radiance(lamps.tris, ctx.scene.materials, prim, lh.u[sel], lh.v[sel])
@@ -154,20 +163,20 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
             ls = ctx.lights.sample(s.p, rng.random((idx.size, 4), dtype=np.float32))
             wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
             f, pdf_b = eval_bsdf(s.params, s.wo_l, wi_l)
-            geo_ok = np.einsum("ij,ij->i", ls.wi, s.ng) > 0
+            geo_ok = dot(ls.wi, s.ng) > 0
             w = np.where(ls.delta, 1.0, _power_heuristic(ls.pdf, pdf_b))
             contrib = throughput * f * (np.abs(wi_l[:, 2]) * w / np.maximum(ls.pdf, 1e-30))[:, None] * ls.le
             live = np.flatnonzero(geo_ok & (ls.pdf > 0) & (contrib.max(axis=1) > 0))
             if live.size:
                 so, sd, far = shadow_rays(s.p[live], s.ng[live], ls.pos[live], ls.wi[live], ls.dist[live])
                 vis = ~ctx.geom_accel.occluded(so, sd, far)
-                np.add.at(target, idx[live[vis]], _sanitize(contrib[live[vis]]))
+                _accumulate(target, idx[live[vis]], _sanitize(contrib[live[vis]]))
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -----------------------------------------------------------------
         u = rng.random((idx.size, 3), dtype=np.float32)
         wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[:, 0], u[:, 1], u[:, 2])
         wi = to_world(wi_l, s.ns, s.t, s.bt)
-        wi /= np.maximum(np.linalg.norm(wi, axis=1), 1e-12)[:, None]
-        ok = (pdf > 0) & (np.einsum("ij,ij->i", wi, s.ng) > 0)
+        wi /= np.maximum(norm(wi), 1e-12)[:, None]
+        ok = (pdf > 0) & (dot(wi, s.ng) > 0)
         throughput = throughput * f * (wi_l[:, 2] / np.maximum(pdf, 1e-30))[:, None]
         if bounce + 1 >= ctx.rr_start:
             q = np.clip(throughput.max(axis=1), 0.05, 1.0)
@@ -188,11 +197,11 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
             if sel.size:
                 le, pl = _lamp_emission(ctx, lh, o, d, sel)
                 w = _power_heuristic(prev_pdf[sel], pl)
-                np.add.at(target, idx[sel], _sanitize(throughput[sel] * le * w[:, None]))
+                _accumulate(target, idx[sel], _sanitize(throughput[sel] * le * w[:, None]))
         hit = hits.prim >= 0
         esc = np.flatnonzero(~hit)
         if esc.size:  # film transparency affects camera rays only
-            np.add.at(target, idx[esc], _sanitize(throughput[esc] * ctx.scene.world_radiance))
+            _accumulate(target, idx[esc], _sanitize(throughput[esc] * ctx.scene.world_radiance))
         hsel = np.flatnonzero(hit)
         if hsel.size == 0:
             break
@@ -202,12 +211,12 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
         if em.size:
             hs = hsel[em]
             le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
-            cos_l = -np.einsum("ij,ij->i", d[hs], ctx.geom_ng[hp[em]])
+            cos_l = -dot(d[hs], ctx.geom_ng[hp[em]])
             two = ctx.lights.tri_two_sided[light[em]]
             le = np.where(((cos_l > 0) | two)[:, None], le, 0.0)
             pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
             w = _power_heuristic(prev_pdf[hs], pl)
-            np.add.at(target, idx[hs], _sanitize(throughput[hs] * le * w[:, None]))
+            _accumulate(target, idx[hs], _sanitize(throughput[hs] * le * w[:, None]))
         idx, throughput, prev_pdf = idx[hsel], throughput[hsel], prev_pdf[hsel]
         o, d = o[hsel], d[hsel]
         prim, hu, hv, ht = hits.prim[hsel], hits.u[hsel], hits.v[hsel], hits.t[hsel]
@@ -241,4 +250,7 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
     return TraceContext(scene=scene, geom_accel=Accel(geom.verts), lamp_accel=Accel(lamps.tris.verts),
                         lights=LightTable(scene, max(radius, 1e-3)), geom_ng=geom_ng, lamp_ng=lamp_ng,
+                        material_params=SurfaceParams.from_material(
+                            scene.materials.base_color, scene.materials.metallic, scene.materials.roughness,
+                            scene.materials.f0),
                         max_bounces=int(max(0, max_bounces)), film_transparent=film_transparent)

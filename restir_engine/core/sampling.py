@@ -94,6 +94,16 @@ def cosine_hemisphere(u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1).astype(np.float32)
 
 
+def norm(v: np.ndarray) -> np.ndarray:
+    """Row lengths of (n, 3) vectors (faster than np.linalg.norm on float32 rows)."""
+    return np.sqrt(np.einsum("ij,ij->i", v, v))
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot products of (n, 3) arrays."""
+    return np.einsum("ij,ij->i", a, b)
+
+
 def orthonormal_basis(n: np.ndarray):
     """Tangent frames (t, b) for unit normals n (n, 3), branchless (Duff et al. 2017)."""
     sign = np.where(n[:, 2] >= 0.0, 1.0, -1.0).astype(np.float32)
