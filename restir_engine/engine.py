@@ -12,6 +12,10 @@ from .export import ExportError, export_scene
 
 MAX_REPORTED_WARNINGS = 12
 
+# Figures of the last finished frame (seconds of export and of the core render, samples done), for
+# benchmarks and the evaluation harness; a diagnostic, not state that rendering depends on.
+LAST_FRAME_STATS: dict = {}
+
 
 def settings_from_scene(scene) -> RenderSettings:
     s = scene.restir
@@ -82,6 +86,9 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):
             self.report({"WARNING"}, msg)
         self._write(result.passes, core_scene.camera.window, view_layer)
+        LAST_FRAME_STATS.clear()
+        LAST_FRAME_STATS.update(export_seconds=t_export, core_seconds=result.seconds, samples=result.samples_done,
+                                frame=scene.frame_current, cancelled=result.cancelled, **result.stats)
         self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {result.samples_done} samples | "
                                     f"export {t_export:.2f}s, render {result.seconds:.2f}s")
 
