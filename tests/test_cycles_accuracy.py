@@ -2,7 +2,8 @@
 
 Each side renders REPS independent seeds; block means (4 quadrants + whole image) are compared with
 Welch z-scores. Z_MAX = 5 is the statistical bound (two-sided p ≈ 2e-5 per comparison for t with ~30
-degrees of freedom; many cheap repetitions keep the standard-error estimate itself reliable). Every case also proves it has the power to see a unit error: the same images
+degrees of freedom; many cheap repetitions keep the standard-error estimate itself reliable).
+Every case also proves it has the power to see a unit error: the same images
 scaled by 1.03 (a 3 % light-unit mistake) must fail the whole-image comparison.
 """
 import numpy as np

@@ -68,7 +68,8 @@ def test_collection_instances_via_depsgraph(scene):
 def test_smooth_and_flat_normals(scene):
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1, segments=16, ring_count=8)
     flat = export()
-    ng = np.cross(flat.geometry.verts[:, 1] - flat.geometry.verts[:, 0], flat.geometry.verts[:, 2] - flat.geometry.verts[:, 0])
+    v = flat.geometry.verts
+    ng = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
     ng /= np.linalg.norm(ng, axis=1)[:, None]
     assert np.allclose(flat.geometry.normals, ng[:, None, :], atol=1e-4)
     bpy.ops.object.shade_smooth()
@@ -212,3 +213,29 @@ def test_export_of_a_million_triangles_takes_seconds(scene):
     dt = time.perf_counter() - t0
     assert len(s.geometry) > 990_000
     assert dt < 30.0  # behaviour guard only (a per-triangle Python loop takes minutes); speed is in the benchmark
+
+
+def test_metaball_and_emission_texture(scene):
+    bpy.ops.object.metaball_add(type="BALL", location=(0, 0, 0))
+    img = bpy.data.images.new("glow", 2, 2, float_buffer=True)
+    img.colorspace_settings.name = "Linear Rec.709"
+    img.pixels.foreach_set(np.tile(np.array([0.5, 0.25, 1.0, 1.0], np.float32), 4))
+    bpy.ops.mesh.primitive_plane_add(location=(3, 0, 0))
+    m = bpy.data.materials.new("Glow")
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
+    bsdf = m.node_tree.nodes["Principled BSDF"]
+    t = m.node_tree.nodes.new("ShaderNodeTexImage")
+    t.image = img
+    m.node_tree.links.new(t.outputs["Color"], bsdf.inputs["Emission Color"])
+    bsdf.inputs["Emission Strength"].default_value = 2.0
+    bpy.context.active_object.data.materials.append(m)
+    s = export()
+    assert len(s.geometry) > 100  # the metaball's evaluated mesh plus the plane
+    i = s.materials.names.index("Glow")
+    assert s.materials.emit_tex[i] >= 0 and np.allclose(s.materials.emission[i], 2.0)
+    from restir_engine.core.lights import LightTable
+    table = LightTable(s, 10.0)
+    assert table.n_geom == 2  # the plane's two triangles are lights, with the texture's mean in their power
+    lum = 0.2126 * 0.5 + 0.7152 * 0.25 + 0.0722 * 1.0
+    assert np.isclose(table.power[:2].sum(), np.pi * 2 * 2.0 * lum * 4.0, rtol=1e-4)

@@ -171,7 +171,7 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
                 so, sd, far = shadow_rays(s.p[live], s.ng[live], ls.pos[live], ls.wi[live], ls.dist[live])
                 vis = ~ctx.geom_accel.occluded(so, sd, far)
                 _accumulate(target, idx[live[vis]], _sanitize(contrib[live[vis]]))
-        # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -----------------------------------------------------------------
+        # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -------
         u = rng.random((idx.size, 3), dtype=np.float32)
         wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[:, 0], u[:, 1], u[:, 2])
         wi = to_world(wi_l, s.ns, s.t, s.bt)

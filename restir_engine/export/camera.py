@@ -38,7 +38,8 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
         raise ExportError("No camera: add a camera to the scene and make it active (Scene Properties > Camera)")
     cam_obj = cam_obj.evaluated_get(depsgraph)
     if cam_obj.type != "CAMERA":
-        warnings.append(f"Active camera '{cam_obj.name}' is a {cam_obj.type.lower()} object; using its transform as a 50 mm camera")
+        warnings.append(f"Active camera '{cam_obj.name}' is a {cam_obj.type.lower()} object; "
+                        "using its transform as a 50 mm camera")
     render = scene.render
     width, height = render_size(render)
     proj = cam_obj.calc_matrix_camera(depsgraph, x=width, y=height,

@@ -140,7 +140,8 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
         counts = [len(p[0]) for p in parts]
         ng = np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0])
         ng /= np.maximum(np.linalg.norm(ng, axis=1), 1e-30)[:, None]
-        rep = lambda vals, dtype: np.repeat(np.array(vals, dtype), counts, axis=0)
+        def rep(vals, dtype):
+            return np.repeat(np.array(vals, dtype), counts, axis=0)
         lamps.tris = TriangleSet(verts, np.repeat(ng[:, None], 3, axis=1).astype(np.float32),
                                  rep([p[1] for p in parts], np.int32))
         lamps.spot_center = rep([p[2][0] for p in parts], np.float32)
