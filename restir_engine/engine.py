@@ -20,7 +20,8 @@ LAST_FRAME_STATS: dict = {}
 def settings_from_scene(scene) -> RenderSettings:
     s = scene.restir
     return RenderSettings(samples=int(s.samples), seed=int(s.seed), max_bounces=int(s.max_bounces),
-                          frame=int(scene.frame_current), integrator=s.integrator,
+                          frame=int(scene.frame_current), integrator=s.integrator, direct_method=s.direct_method,
+                          light_candidates=int(s.light_candidates), bsdf_candidates=int(s.bsdf_candidates),
                           film_transparent=bool(scene.render.film_transparent))
 
 
@@ -85,7 +86,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             return
         for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):
             self.report({"WARNING"}, msg)
-        self._write(result.passes, core_scene.camera.window, view_layer)
+        self._write(result.passes, core_scene.camera.window, scene, view_layer)
         LAST_FRAME_STATS.clear()
         LAST_FRAME_STATS.update(export_seconds=t_export, core_seconds=result.seconds, samples=result.samples_done,
                                 frame=scene.frame_current, cancelled=result.cancelled, **result.stats)
@@ -149,11 +150,11 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         gpu.state.blend_set("NONE")
         self.update_stats("ReSTIR", f"Viewport | {samples} samples")
 
-    def _write(self, images: dict, window, view_layer):
+    def _write(self, images: dict, window, scene, view_layer):
         _x0, _y0, w, h = window
         result = self.begin_result(0, 0, w, h, layer=view_layer.name)
         layer = result.layers[0] if len(result.layers) == 1 else result.layers[view_layer.name]
-        for name, chans, _ctype, _enabled, core_name in pass_table.enabled_passes(view_layer):
+        for name, chans, _ctype, _enabled, core_name in pass_table.enabled_passes(scene, view_layer):
             rp = layer.passes.find_by_name(name, "")
             if rp is None or core_name not in images:
                 continue

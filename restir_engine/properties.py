@@ -17,8 +17,21 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
         name="Integrator",
         description="Light transport algorithm",
         items=[("PATH", "Path Tracing", "Unbiased reference path tracer: next-event estimation and BSDF sampling "
-                "combined by multiple importance sampling", 0)],
-        default="PATH")
+                "combined by multiple importance sampling", 0),
+               ("RESTIR", "ReSTIR", "Direct light of the first hit by resampled importance sampling (ReSTIR DI "
+                "stages, see Direct Method); indirect light path traced", 1)],
+        default="PATH", update=_update_passes)
+    direct_method: EnumProperty(
+        name="Direct Method",
+        description="How the ReSTIR integrator estimates direct light at the first hit",
+        items=[("LIGHT_SAMPLING", "Light Sampling", "Baseline: one light sample and one BSDF sample combined by MIS", 0),
+               ("RIS", "RIS", "Resampled importance sampling: pick one of many light and BSDF candidates by the "
+                "unshadowed contribution, then trace one shadow ray (unbiased)", 1)],
+        default="RIS", update=_update_passes)
+    light_candidates: IntProperty(name="Light Candidates", description="Light samples per pixel resampled by RIS",
+                                  default=32, min=0, soft_max=256)
+    bsdf_candidates: IntProperty(name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",
+                                 default=1, min=0, soft_max=8)
     samples: IntProperty(name="Samples", description="Iterations averaged per frame", default=16, min=1,
                          soft_max=4096)
     seed: IntProperty(name="Seed", description="Noise pattern; different seeds give independent noise", default=0,
@@ -34,6 +47,11 @@ class RestirViewLayerSettings(bpy.types.PropertyGroup):
                                     default=False, update=_update_passes)
     use_pass_emission: BoolProperty(name="Emission", description="Emission seen directly by the camera",
                                     default=False, update=_update_passes)
+    use_pass_reservoir_m: BoolProperty(name="Reservoir M", description="Confidence M of the shaded reservoir "
+                                       "(ReSTIR integrator with RIS)", default=False, update=_update_passes)
+    use_pass_reservoir_ucw: BoolProperty(name="Reservoir UCW", description="Unbiased contribution weight W of the "
+                                         "shaded reservoir (ReSTIR integrator with RIS)", default=False,
+                                         update=_update_passes)
 
 
 CLASSES = (RestirSceneSettings, RestirViewLayerSettings)

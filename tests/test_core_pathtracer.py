@@ -85,3 +85,18 @@ def test_cancel_before_first_pass_raises_and_later_keeps_finished_passes():
     r = render_frame(scene, RenderSettings(samples=8, tile_pixels=256), should_stop=stop_later)
     assert r.cancelled and r.samples_done == 1
     assert np.isfinite(r.passes["Combined"]).all()
+
+
+def test_ris_direct_light_converges_to_the_path_tracer():
+    """RIS (light + BSDF candidates, balance heuristic) estimates the same direct light as NEE + MIS."""
+    from scenes_core import floor_with_emitter
+    scene = floor_with_emitter(width=32)
+    ris = RenderSettings(samples=8, max_bounces=0, integrator="RESTIR", direct_method="RIS", light_candidates=8)
+    ref = RenderSettings(samples=8, max_bounces=0)
+    a = [render_frame(scene, RenderSettings(**{**ris.__dict__, "seed": s})).passes["Combined"][..., 0].mean()
+         for s in range(8)]
+    b = [render_frame(scene, RenderSettings(**{**ref.__dict__, "seed": s})).passes["Combined"][..., 0].mean()
+         for s in range(8)]
+    se = np.sqrt(np.var(a, ddof=1) / len(a) + np.var(b, ddof=1) / len(b))
+    assert se < 0.005 * np.mean(b)
+    assert abs(np.mean(a) - np.mean(b)) < 5 * se, (np.mean(a), np.mean(b), se)

@@ -116,3 +116,18 @@ def test_camera_models_match_cycles_geometry(box, ortho):
     assert flat.mean() > 0.2
     assert np.allclose(ours["Depth"][..., 0][flat], ref["Depth"][..., 0][flat], rtol=0.01)
     assert np.median((ours["Normal"] * ref["Normal"]).sum(axis=2)[flat]) > 0.999
+
+
+def test_reservoir_passes_only_with_reservoirs(box):
+    vl = box.view_layers[0]
+    vl.restir.use_pass_reservoir_m = vl.restir.use_pass_reservoir_ucw = True
+    configure_restir(box, 2, 1)
+    assert "Reservoir M" not in render_passes(box)  # the path tracer has no reservoirs: no placeholder pass
+    configure_restir(box, 2, 1, integrator="RESTIR", direct_method="RIS", light_candidates=8)
+    p = render_passes(box)
+    m, w = p["Reservoir M"][..., 0], p["Reservoir UCW"][..., 0]
+    inside = interior(p["Depth"][..., 0])  # away from silhouettes, where jittered samples mix hit and miss
+    assert np.allclose(m[inside], 1.0)  # one initial RIS reservoir per pixel and sample
+    assert ((m >= 0) & (m <= 1)).all()
+    assert np.isfinite(w).all() and (w >= 0).all() and w[inside].mean() > 0
+    assert np.allclose(p["Combined"][..., :3], p["Emission"] + p["Direct"] + p["Indirect"], atol=1e-4)

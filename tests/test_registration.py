@@ -24,10 +24,15 @@ def test_engine_is_registered_and_selectable(addon):
 
 
 def test_settings_defaults(addon):
-    s = bpy.context.scene.restir
-    assert (s.samples, s.seed, s.max_bounces, s.integrator) == (16, 0, 4, "PATH")
-    vl = bpy.context.view_layer.restir
-    assert not vl.use_pass_direct and not vl.use_pass_indirect and not vl.use_pass_emission
+    scene = bpy.data.scenes.new("fresh")
+    try:
+        s = scene.restir
+        assert (s.samples, s.seed, s.max_bounces, s.integrator) == (16, 0, 4, "PATH")
+        assert (s.direct_method, s.light_candidates, s.bsdf_candidates) == ("RIS", 32, 1)
+        vl = scene.view_layers[0].restir
+        assert not (vl.use_pass_direct or vl.use_pass_indirect or vl.use_pass_emission or vl.use_pass_reservoir_m)
+    finally:
+        bpy.data.scenes.remove(scene)
 
 
 def test_panels_registered_and_only_for_this_engine(addon):

@@ -99,6 +99,9 @@ class LightTable:
         self.lamp_to_light = np.full(len(lamps.tris), -1, np.int64)
         self.lamp_to_light[l_idx] = len(g_idx) + np.arange(len(l_idx))
         self.alias = AliasTable(power) if (power > 0).any() else None
+        # separate tables for ReSTIR: triangle lights are resampled, suns are light-sampled on their own
+        self.tri_alias = AliasTable(power[:self.n_tri]) if (power[:self.n_tri] > 0).any() else None
+        self.sun_alias = AliasTable(power[self.n_tri:]) if (power[self.n_tri:] > 0).any() else None
         self.scene = scene
 
     @property
@@ -112,6 +115,27 @@ class LightTable:
         p_sel = self.alias.pdf[light]
         area = np.maximum(self.tri_area[light], 1e-30)
         return (p_sel / area * dist * dist / np.maximum(np.abs(cos_light), 1e-8)).astype(np.float32)
+
+    def point_towards(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, p: np.ndarray):
+        """Triangle light ``light`` at barycentrics (b1, b2) seen from points p (n, 3): the light point
+        (n, 3), unit direction wi from p (n, 3), distance (n,), cos at the light (n,) and the radiance
+        arriving at p (n, 3) (zero from a back face of a one-sided emitter, spot cones applied)."""
+        q = np.einsum("ijk,ij->ik", self.tri_verts[light], np.stack([1 - b1 - b2, b1, b2], axis=1))
+        d = q - p
+        dl = norm(d)
+        w = d / np.maximum(dl, 1e-30)[:, None]
+        cos_l = -dot(w, self.tri_normal[light])
+        facing = ((cos_l > 0) | self.tri_two_sided[light]) & (dl > 0) & (np.abs(cos_l) > 1e-8)
+        le = np.where(facing[:, None], self.radiance_of(light, b1, b2, p), 0.0).astype(np.float32)
+        return q.astype(np.float32), w.astype(np.float32), dl.astype(np.float32), cos_l.astype(np.float32), le
+
+    def tri_only_pdf_solid_angle(self, light: np.ndarray, dist: np.ndarray, cos_light: np.ndarray) -> np.ndarray:
+        """Solid-angle pdf of a point of triangle light ``light`` under ``tri_alias`` (suns excluded)."""
+        if self.tri_alias is None:
+            return np.zeros(len(light), np.float32)
+        area = np.maximum(self.tri_area[light], 1e-30)
+        pdf = self.tri_alias.pdf[light] / area * dist * dist / np.maximum(np.abs(cos_light), 1e-8)
+        return np.where(np.isfinite(pdf), pdf, 0.0).astype(np.float32)
 
     def radiance_of(self, light: np.ndarray, b1, b2, p_receiver: np.ndarray) -> np.ndarray:
         """Radiance (n, 3) leaving triangle light ``light`` at (b1, b2) towards p_receiver,
@@ -146,15 +170,9 @@ class LightTable:
         if tri.any():
             li = light[tri]
             b1, b2 = uniform_triangle(u[tri, 2], u[tri, 3])
-            q = np.einsum("ijk,ij->ik", self.tri_verts[li], np.stack([1 - b1 - b2, b1, b2], axis=1))
-            d = q - p[tri]
-            dl = norm(d)
-            w = d / np.maximum(dl, 1e-30)[:, None]
-            cos_l = -dot(w, self.tri_normal[li])
-            facing = (cos_l > 0) | self.tri_two_sided[li]
-            rad = self.radiance_of(li, b1, b2, p[tri])
+            q, w, dl, cos_l, rad = self.point_towards(li, b1, b2, p[tri])
             pd = self.tri_pdf_solid_angle(li, dl, cos_l)
-            ok = facing & (dl > 0) & (np.abs(cos_l) > 1e-8) & np.isfinite(pd)
+            ok = (rad.max(axis=1) > 0) & np.isfinite(pd)
             pos[tri] = q
             wi[tri] = w
             dist[tri] = dl
@@ -162,26 +180,42 @@ class LightTable:
             pdf[tri] = np.where(ok, pd, 0.0)
         sun = ~tri
         if sun.any():
-            s = light[sun] - self.n_tri
-            lamps = self.scene.lamps
-            axis = lamps.sun_dir[s]
-            cmax = lamps.sun_cos[s]
-            is_delta = cmax >= 1.0 - 1e-9
-            # uniform direction in the cone around the sun axis
-            cos_t = 1.0 - u[sun, 2] * (1.0 - cmax)
-            sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
-            phi = 2 * np.pi * u[sun, 3]
-            t, b = orthonormal_basis(axis)
-            dvec = (t * (sin_t * np.cos(phi))[:, None] + b * (sin_t * np.sin(phi))[:, None] + axis * cos_t[:, None])
-            solid = 2 * np.pi * (1.0 - cmax)
-            p_sel = self.alias.pdf[light[sun]]
-            # radiance of a disc of half-angle a whose cosine-weighted integral is the irradiance E
-            sin2 = np.maximum(1.0 - cmax * cmax, 1e-30)
-            rad = lamps.sun_irradiance[s] / (np.pi * sin2)[:, None]
-            wi[sun] = np.where(is_delta[:, None], axis, dvec)
-            dist[sun] = np.inf
-            # for a delta sun store Le·(1/p_sel) with pdf = p_sel and flag delta: the estimator divides by pdf
-            le[sun] = np.where(is_delta[:, None], lamps.sun_irradiance[s], rad)
-            pdf[sun] = np.where(is_delta, p_sel, p_sel / np.maximum(solid, 1e-30))
-            delta[sun] = True  # suns are never hit by BSDF rays: no MIS
+            self._sun_sample(light[sun] - self.n_tri, self.alias.pdf[light[sun]], u[sun], sun, wi, dist, le, pdf, delta)
         return LightSample(pos, wi, dist, le, pdf, delta)
+
+    def sample_suns(self, n: int, u: np.ndarray) -> LightSample:
+        """One sun per point, chosen by power among suns only (ReSTIR's companion to resampled
+        triangle lights). ``u`` is (n, 4) uniforms; all samples are flagged ``delta`` (no MIS)."""
+        pos = np.zeros((n, 3), np.float32)
+        wi = np.zeros((n, 3), np.float32)
+        dist = np.zeros(n, np.float32)
+        le = np.zeros((n, 3), np.float32)
+        pdf = np.zeros(n, np.float32)
+        delta = np.zeros(n, bool)
+        if self.sun_alias is not None and n:
+            s = self.sun_alias.sample(u[:, 0], u[:, 1])
+            self._sun_sample(s, self.sun_alias.pdf[s], u, np.ones(n, bool), wi, dist, le, pdf, delta)
+        return LightSample(pos, wi, dist, le, pdf, delta)
+
+    def _sun_sample(self, s, p_sel, u, sun, wi, dist, le, pdf, delta):
+        """Fill rows ``sun`` of the output arrays with a direction in sun ``s``'s cone."""
+        lamps = self.scene.lamps
+        axis = lamps.sun_dir[s]
+        cmax = lamps.sun_cos[s]
+        is_delta = cmax >= 1.0 - 1e-9
+        # uniform direction in the cone around the sun axis
+        cos_t = 1.0 - u[:, 2] * (1.0 - cmax)
+        sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+        phi = 2 * np.pi * u[:, 3]
+        t, b = orthonormal_basis(axis)
+        dvec = (t * (sin_t * np.cos(phi))[:, None] + b * (sin_t * np.sin(phi))[:, None] + axis * cos_t[:, None])
+        solid = 2 * np.pi * (1.0 - cmax)
+        # radiance of a disc of half-angle a whose cosine-weighted integral is the irradiance E
+        sin2 = np.maximum(1.0 - cmax * cmax, 1e-30)
+        rad = lamps.sun_irradiance[s] / (np.pi * sin2)[:, None]
+        wi[sun] = np.where(is_delta[:, None], axis, dvec)
+        dist[sun] = np.inf
+        # for a delta sun store Le·(1/p_sel) with pdf = p_sel and flag delta: the estimator divides by pdf
+        le[sun] = np.where(is_delta[:, None], lamps.sun_irradiance[s], rad)
+        pdf[sun] = np.where(is_delta, p_sel, p_sel / np.maximum(solid, 1e-30))
+        delta[sun] = True  # suns are never hit by BSDF rays: no MIS

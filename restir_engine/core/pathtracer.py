@@ -18,6 +18,7 @@ import numpy as np
 from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
 from .bsdf import SurfaceParams, eval_bsdf, sample_bsdf
+from . import restir_di
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
 from .sampling import dot, norm, orthonormal_basis, to_local, to_world
 from .scene import Scene
@@ -118,10 +119,14 @@ def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
     return le.astype(np.float32), pdf.astype(np.float32)
 
 
-def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Generator):
+def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Generator, di=None, reservoir=None):
     """Trace one path per raster sample point (x, y).
 
     Returns emission seen directly (n, 3), direct (n, 3) and indirect (n, 3) radiance, and alpha (n,).
+    With ``di`` (a restir_di.DISettings with method 'RIS') the direct light of the primary hit comes
+    from resampled importance sampling instead of NEE + MIS (triangle emitters found by the first BSDF
+    ray then belong to RIS and are not added again); ``reservoir`` (dict of (n,) arrays "M", "W") then
+    receives the shaded reservoirs' confidence and unbiased contribution weight.
     """
     cam = ctx.scene.camera
     n = len(x)
@@ -156,10 +161,17 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
     for bounce in range(ctx.max_bounces + 1):
         s = Surface(ctx, prim, hu, hv, o, d, ht)
         target = direct if bounce == 0 else indirect
+        ris_here = bounce == 0 and di is not None and di.method == "RIS"
         if bounce == 0:
             emitted[idx] += s.emission(ctx)
+        if ris_here:
+            res = restir_di.initial_ris(ctx, s, rng, di)
+            direct[idx] += restir_di.shade(ctx, s, res, rng)
+            if reservoir is not None:
+                reservoir["M"][idx] = res.M
+                reservoir["W"][idx] = res.W
         # --- next-event estimation -------------------------------------------------------
-        if not ctx.lights.empty:
+        elif not ctx.lights.empty:
             ls = ctx.lights.sample(s.p, rng.random((idx.size, 4), dtype=np.float32))
             wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
             f, pdf_b = eval_bsdf(s.params, s.wo_l, wi_l)
@@ -191,7 +203,7 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
         hits = ctx.geom_accel.intersect(o, d)
         # emission found by the BSDF ray: lamps in front of the hit, then the hit itself, else the world
         target = direct if bounce == 0 else indirect
-        if len(ctx.scene.lamps.tris):
+        if len(ctx.scene.lamps.tris) and not ris_here:
             lh = ctx.lamp_accel.intersect(o, d, hits.t)
             sel = np.flatnonzero((lh.prim >= 0) & (lh.t < hits.t))
             if sel.size:
@@ -208,7 +220,7 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
         hp = hits.prim[hsel]
         light = ctx.lights.geom_to_light[hp]
         em = np.flatnonzero(light >= 0)
-        if em.size:
+        if em.size and not ris_here:
             hs = hsel[em]
             le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
             cos_l = -dot(d[hs], ctx.geom_ng[hp[em]])

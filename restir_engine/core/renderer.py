@@ -11,12 +11,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import pathtracer
+from . import pathtracer, restir_di
 from .accel import pool
 from .sampling import STREAM_CAMERA, STREAM_PATH, rng
 from .scene import Scene
 
-INTEGRATORS = ("PATH",)
+INTEGRATORS = ("PATH", "RESTIR")
 
 
 class Cancelled(Exception):
@@ -33,6 +33,9 @@ class RenderSettings:
     max_bounces: int = 4
     frame: int = 0
     integrator: str = "PATH"
+    direct_method: str = "RIS"  # with integrator RESTIR: "LIGHT_SAMPLING" (NEE + MIS) or "RIS"
+    light_candidates: int = 32
+    bsdf_candidates: int = 1
     film_transparent: bool = False
     tile_pixels: int = 16384
 
@@ -66,6 +69,12 @@ class FrameRenderer:
             raise ValueError(f"unknown integrator {settings.integrator!r}; available: {INTEGRATORS}")
         t0 = time.perf_counter()
         self.settings = settings
+        self.di = None
+        if settings.integrator == "RESTIR":
+            if settings.direct_method not in restir_di.DIRECT_METHODS:
+                raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {restir_di.DIRECT_METHODS}")
+            self.di = restir_di.DISettings(settings.direct_method, max(0, settings.light_candidates),
+                                           max(0, settings.bsdf_candidates))
         self.ctx = pathtracer.build_context(scene, settings.max_bounces, settings.film_transparent)
         self.build_seconds = time.perf_counter() - t0
         self.set_camera(scene.camera)
@@ -76,7 +85,8 @@ class FrameRenderer:
         _x0, _y0, w, h = camera.window
         self.tiles = _tiles(w, h, self.settings.tile_pixels)
         self.acc = {"emit": np.zeros((h, w, 3), np.float64), "direct": np.zeros((h, w, 3), np.float64),
-                    "indirect": np.zeros((h, w, 3), np.float64), "alpha": np.zeros((h, w), np.float64)}
+                    "indirect": np.zeros((h, w, 3), np.float64), "alpha": np.zeros((h, w), np.float64),
+                    "res_m": np.zeros((h, w), np.float64), "res_w": np.zeros((h, w), np.float64)}
         self.samples_done = 0
         self._data = None
 
@@ -110,7 +120,11 @@ class FrameRenderer:
         j = cam_rng.random((th * tw, 2), dtype=np.float32)
         x = x0 + tx + jx.ravel().astype(np.float32) + j[:, 0]
         y = y0 + ty + jy.ravel().astype(np.float32) + j[:, 1]
-        return (tx, ty, tw, th), pathtracer.trace(self.ctx, x, y, path_rng)
+        reservoir = None
+        if self.di is not None:
+            reservoir = {"M": np.zeros(th * tw, np.float32), "W": np.zeros(th * tw, np.float32)}
+        out = pathtracer.trace(self.ctx, x, y, path_rng, di=self.di, reservoir=reservoir)
+        return (tx, ty, tw, th), (*out, reservoir)
 
     def sample_pass(self, progress=None, should_stop=None) -> bool:
         """Render the next sample pass (one path per pixel) into the accumulators. Returns False, keeping
@@ -128,12 +142,15 @@ class FrameRenderer:
                     f.cancel()
                 wait(futures)
                 return False
-        for (tx, ty, tw, th), (emit, direct, indirect, alpha) in results:
+        for (tx, ty, tw, th), (emit, direct, indirect, alpha, reservoir) in results:
             sl = (slice(ty, ty + th), slice(tx, tx + tw))
             self.acc["emit"][sl] += emit.reshape(th, tw, 3)
             self.acc["direct"][sl] += direct.reshape(th, tw, 3)
             self.acc["indirect"][sl] += indirect.reshape(th, tw, 3)
             self.acc["alpha"][sl] += alpha.reshape(th, tw)
+            if reservoir is not None:
+                self.acc["res_m"][sl] += reservoir["M"].reshape(th, tw)
+                self.acc["res_w"][sl] += reservoir["W"].reshape(th, tw)
         self.samples_done += 1
         return True
 
@@ -151,6 +168,9 @@ class FrameRenderer:
         out = {"Combined": self.combined(), "Depth": depth, "Normal": normal,
                "Direct": self.acc["direct"] * inv, "Indirect": self.acc["indirect"] * inv,
                "Emission": self.acc["emit"] * inv}
+        if self.di is not None and self.di.method == "RIS":
+            out["Reservoir M"] = (self.acc["res_m"] * inv)[..., None]
+            out["Reservoir UCW"] = (self.acc["res_w"] * inv)[..., None]
         return {k: np.where(np.isfinite(v), v, 0.0).astype(np.float32) for k, v in out.items()}
 
 

@@ -60,6 +60,12 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
         col = layout.column(align=True)
         col.prop(s, "samples")
         col.prop(s, "seed")
+        if s.integrator == "RESTIR":
+            layout.prop(s, "direct_method")
+            col = layout.column(align=True)
+            col.active = s.direct_method == "RIS"
+            col.prop(s, "light_candidates")
+            col.prop(s, "bsdf_candidates")
 
 
 class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):
@@ -89,6 +95,10 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl.restir, "use_pass_direct")
         col.prop(vl.restir, "use_pass_indirect")
         col.prop(vl.restir, "use_pass_emission")
+        col = layout.column(heading="ReSTIR", align=True)
+        col.active = context.scene.restir.integrator == "RESTIR" and context.scene.restir.direct_method == "RIS"
+        col.prop(vl.restir, "use_pass_reservoir_m")
+        col.prop(vl.restir, "use_pass_reservoir_ucw")
 
 
 PANELS = (RESTIR_PT_sampling, RESTIR_PT_light_paths, RESTIR_PT_passes)
