@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, IntProperty, PointerProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 
 def _update_passes(self, context):
@@ -26,12 +26,27 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
         description="How the ReSTIR integrator estimates direct light at the first hit",
         items=[("LIGHT_SAMPLING", "Light Sampling", "Baseline: one light sample and one BSDF sample combined by MIS", 0),
                ("RIS", "RIS", "Resampled importance sampling: pick one of many light and BSDF candidates by the "
-                "unshadowed contribution, then trace one shadow ray (unbiased)", 1)],
+                "unshadowed contribution, then trace one shadow ray (unbiased)", 1),
+               ("RESTIR", "ReSTIR (spatial)", "RIS, then reuse of neighbouring pixels' reservoirs (spatial reuse); "
+                "temporal reuse is not available yet", 2)],
         default="RIS", update=_update_passes)
     light_candidates: IntProperty(name="Light Candidates", description="Light samples per pixel resampled by RIS",
                                   default=32, min=0, soft_max=256)
     bsdf_candidates: IntProperty(name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",
                                  default=1, min=0, soft_max=8)
+    spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring reservoirs merged per spatial pass",
+                                   default=5, min=0, soft_max=16)
+    spatial_radius: FloatProperty(name="Radius", description="Spatial reuse radius in pixels", default=30.0,
+                                  min=1.0, soft_max=100.0, subtype="PIXEL")
+    spatial_passes: IntProperty(name="Passes", description="Spatial reuse passes (more passes add correlation)",
+                                default=1, min=0, soft_max=4)
+    bias_correction: EnumProperty(
+        name="Bias Correction",
+        description="How merged reservoirs are normalized",
+        items=[("NONE", "None (1/M)", "Fastest; darkens where neighbours could not have produced the sample", 0),
+               ("UNBIASED", "Unbiased (1/Z)", "Counts only neighbours whose target is non-zero at the chosen sample "
+                "(converges to the path tracer)", 1)],
+        default="UNBIASED")
     samples: IntProperty(name="Samples", description="Iterations averaged per frame", default=16, min=1,
                          soft_max=4096)
     seed: IntProperty(name="Seed", description="Noise pattern; different seeds give independent noise", default=0,

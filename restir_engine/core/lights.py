@@ -129,13 +129,11 @@ class LightTable:
         le = np.where(facing[:, None], self.radiance_of(light, b1, b2, p), 0.0).astype(np.float32)
         return q.astype(np.float32), w.astype(np.float32), dl.astype(np.float32), cos_l.astype(np.float32), le
 
-    def tri_only_pdf_solid_angle(self, light: np.ndarray, dist: np.ndarray, cos_light: np.ndarray) -> np.ndarray:
-        """Solid-angle pdf of a point of triangle light ``light`` under ``tri_alias`` (suns excluded)."""
+    def tri_only_pdf_area(self, light: np.ndarray) -> np.ndarray:
+        """Area-measure pdf (m⁻²) of a uniform point of triangle light ``light`` chosen by ``tri_alias``."""
         if self.tri_alias is None:
             return np.zeros(len(light), np.float32)
-        area = np.maximum(self.tri_area[light], 1e-30)
-        pdf = self.tri_alias.pdf[light] / area * dist * dist / np.maximum(np.abs(cos_light), 1e-8)
-        return np.where(np.isfinite(pdf), pdf, 0.0).astype(np.float32)
+        return (self.tri_alias.pdf[light] / np.maximum(self.tri_area[light], 1e-30)).astype(np.float32)
 
     def radiance_of(self, light: np.ndarray, b1, b2, p_receiver: np.ndarray) -> np.ndarray:
         """Radiance (n, 3) leaving triangle light ``light`` at (b1, b2) towards p_receiver,

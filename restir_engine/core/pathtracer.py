@@ -123,10 +123,12 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
     """Trace one path per raster sample point (x, y).
 
     Returns emission seen directly (n, 3), direct (n, 3) and indirect (n, 3) radiance, and alpha (n,).
-    With ``di`` (a restir_di.DISettings with method 'RIS') the direct light of the primary hit comes
+    With ``di`` (a restir_di.DISettings with method 'RIS' or 'RESTIR') the direct light of the primary hit comes
     from resampled importance sampling instead of NEE + MIS (triangle emitters found by the first BSDF
     ray then belong to RIS and are not added again); ``reservoir`` (dict of (n,) arrays "M", "W") then
-    receives the shaded reservoirs' confidence and unbiased contribution weight.
+    receives the shaded reservoirs' confidence and unbiased contribution weight. With method 'RESTIR'
+    the primary hits and initial reservoirs are written to ``reservoir["gbuf"]`` and ``reservoir["res"]``
+    at frame rows ``reservoir["rows"]`` instead, and shaded after spatial reuse.
     """
     cam = ctx.scene.camera
     n = len(x)
@@ -161,15 +163,23 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
     for bounce in range(ctx.max_bounces + 1):
         s = Surface(ctx, prim, hu, hv, o, d, ht)
         target = direct if bounce == 0 else indirect
-        ris_here = bounce == 0 and di is not None and di.method == "RIS"
+        ris_here = bounce == 0 and di is not None and di.method in ("RIS", "RESTIR")
         if bounce == 0:
             emitted[idx] += s.emission(ctx)
         if ris_here:
             res = restir_di.initial_ris(ctx, s, rng, di)
-            direct[idx] += restir_di.shade(ctx, s, res, rng)
-            if reservoir is not None:
-                reservoir["M"][idx] = res.M
-                reservoir["W"][idx] = res.W
+            if di.method == "RIS":
+                direct[idx] += restir_di.shade(ctx, s, res, rng)
+                if reservoir is not None:
+                    reservoir["M"][idx] = res.M
+                    reservoir["W"][idx] = res.W
+            else:  # spatial reuse follows at frame level: hand over surfaces and reservoirs
+                rows = reservoir["rows"][idx]
+                depth = dot(s.p - camera_mod.position(cam), np.broadcast_to(camera_mod.forward(cam), s.p.shape))
+                reservoir["gbuf"].store(rows, s, depth)
+                frame_res = reservoir["res"]
+                for name in ("light", "b1", "b2", "M", "W", "p_hat"):
+                    getattr(frame_res, name)[rows] = getattr(res, name)
         # --- next-event estimation -------------------------------------------------------
         elif not ctx.lights.empty:
             ls = ctx.lights.sample(s.p, rng.random((idx.size, 4), dtype=np.float32))

@@ -13,7 +13,7 @@ import numpy as np
 
 from . import pathtracer, restir_di
 from .accel import pool
-from .sampling import STREAM_CAMERA, STREAM_PATH, rng
+from .sampling import STREAM_CAMERA, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, rng
 from .scene import Scene
 
 INTEGRATORS = ("PATH", "RESTIR")
@@ -36,6 +36,10 @@ class RenderSettings:
     direct_method: str = "RIS"  # with integrator RESTIR: "LIGHT_SAMPLING" (NEE + MIS) or "RIS"
     light_candidates: int = 32
     bsdf_candidates: int = 1
+    spatial_neighbors: int = 5
+    spatial_radius: float = 30.0
+    spatial_passes: int = 1
+    bias_correction: str = "UNBIASED"  # spatial reuse: "NONE" (1/M) or "UNBIASED" (1/Z)
     film_transparent: bool = False
     tile_pixels: int = 16384
 
@@ -75,6 +79,11 @@ class FrameRenderer:
                 raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {restir_di.DIRECT_METHODS}")
             self.di = restir_di.DISettings(settings.direct_method, max(0, settings.light_candidates),
                                            max(0, settings.bsdf_candidates))
+            if settings.bias_correction not in restir_di.BIAS_CORRECTIONS:
+                raise ValueError(f"unknown bias correction {settings.bias_correction!r}")
+            self.spatial = restir_di.SpatialSettings(max(0, settings.spatial_neighbors),
+                                                     max(1.0, float(settings.spatial_radius)),
+                                                     max(0, settings.spatial_passes), settings.bias_correction)
         self.ctx = pathtracer.build_context(scene, settings.max_bounces, settings.film_transparent)
         self.build_seconds = time.perf_counter() - t0
         self.set_camera(scene.camera)
@@ -121,8 +130,12 @@ class FrameRenderer:
         x = x0 + tx + jx.ravel().astype(np.float32) + j[:, 0]
         y = y0 + ty + jy.ravel().astype(np.float32) + j[:, 1]
         reservoir = None
-        if self.di is not None:
+        if self.di is not None and self.di.method == "RIS":
             reservoir = {"M": np.zeros(th * tw, np.float32), "W": np.zeros(th * tw, np.float32)}
+        elif self.di is not None and self.di.method == "RESTIR":
+            w = self.ctx.scene.camera.window[2]
+            ly, lx = np.mgrid[ty:ty + th, tx:tx + tw]
+            reservoir = {"rows": (ly * w + lx).ravel(), "gbuf": self._gbuf, "res": self._res}
         out = pathtracer.trace(self.ctx, x, y, path_rng, di=self.di, reservoir=reservoir)
         return (tx, ty, tw, th), (*out, reservoir)
 
@@ -130,6 +143,11 @@ class FrameRenderer:
         """Render the next sample pass (one path per pixel) into the accumulators. Returns False, keeping
         the accumulators unchanged, when ``should_stop`` asked to stop part-way."""
         s = self.samples_done
+        spatial = self.di is not None and self.di.method == "RESTIR"
+        if spatial:  # frame-wide primary hits and initial reservoirs, filled by the tiles
+            _x0, _y0, w, h = self.ctx.scene.camera.window
+            self._gbuf = restir_di.GBuffer(w * h, self.ctx.material_params)
+            self._res = restir_di.Reservoirs.empty(w * h)
         futures = {pool().submit(self._run_tile, (s, ti, t)) for ti, t in enumerate(self.tiles)}
         results = []
         while futures:
@@ -142,17 +160,53 @@ class FrameRenderer:
                     f.cancel()
                 wait(futures)
                 return False
+        if spatial:
+            self._spatial_and_shade(results, s)
         for (tx, ty, tw, th), (emit, direct, indirect, alpha, reservoir) in results:
             sl = (slice(ty, ty + th), slice(tx, tx + tw))
             self.acc["emit"][sl] += emit.reshape(th, tw, 3)
             self.acc["direct"][sl] += direct.reshape(th, tw, 3)
             self.acc["indirect"][sl] += indirect.reshape(th, tw, 3)
             self.acc["alpha"][sl] += alpha.reshape(th, tw)
-            if reservoir is not None:
+            if reservoir is not None and "M" in reservoir:
                 self.acc["res_m"][sl] += reservoir["M"].reshape(th, tw)
                 self.acc["res_w"][sl] += reservoir["W"].reshape(th, tw)
         self.samples_done += 1
         return True
+
+    def _spatial_and_shade(self, results, s: int):
+        """Spatial passes over the frame's reservoirs, then one shadow ray per pixel; adds the direct light
+        and the reservoir figures into each tile's outputs."""
+        _x0, _y0, w, h = self.ctx.scene.camera.window
+        st = self.settings
+        res = self._res
+        spans = [np.arange(a, min(w * h, a + st.tile_pixels)) for a in range(0, w * h, st.tile_pixels)]
+        for k in range(self.spatial.passes if self.spatial.neighbors else 0):
+            parts = list(pool().map(lambda a: (a[1], restir_di.spatial_reuse(
+                self.ctx, self._gbuf, res, w, h, a[1], self.spatial,
+                rng(st.seed, st.frame, s, STREAM_SPATIAL + k, a[0]))), enumerate(spans)))
+            nxt = restir_di.Reservoirs.empty(w * h)
+            for rows, part in parts:
+                for name in ("light", "b1", "b2", "M", "W", "p_hat"):
+                    getattr(nxt, name)[rows] = getattr(part, name)
+            res = nxt
+        direct = np.zeros((w * h, 3), np.float32)
+
+        def shade(a):
+            ti, rows = a
+            live = rows[self._gbuf.valid[rows]]
+            if live.size:
+                sub = restir_di._SurfaceRows(self._gbuf, live)
+                part = restir_di.Reservoirs(res.light[live], res.b1[live], res.b2[live], res.M[live], res.W[live],
+                                            res.p_hat[live])
+                direct[live] = restir_di.shade(self.ctx, sub, part, rng(st.seed, st.frame, s, STREAM_SHADE, ti))
+
+        list(pool().map(shade, enumerate(spans)))
+        for (tx, ty, tw, th), (_e, d, _i, _a, reservoir) in results:
+            rows = reservoir["rows"]
+            d += direct[rows]
+            reservoir["M"] = res.M[rows]
+            reservoir["W"] = res.W[rows]
 
     def combined(self) -> np.ndarray:
         """The running mean of Combined (h, w, 4) float32."""
@@ -168,7 +222,7 @@ class FrameRenderer:
         out = {"Combined": self.combined(), "Depth": depth, "Normal": normal,
                "Direct": self.acc["direct"] * inv, "Indirect": self.acc["indirect"] * inv,
                "Emission": self.acc["emit"] * inv}
-        if self.di is not None and self.di.method == "RIS":
+        if self.di is not None and self.di.method in ("RIS", "RESTIR"):
             out["Reservoir M"] = (self.acc["res_m"] * inv)[..., None]
             out["Reservoir UCW"] = (self.acc["res_w"] * inv)[..., None]
         return {k: np.where(np.isfinite(v), v, 0.0).astype(np.float32) for k, v in out.items()}

@@ -7,10 +7,14 @@ Bitterli et al. 2020 §3-4), with candidates from two strategies combined by the
   BSDF candidates:  ``bsdf_candidates`` BSDF-sampled rays; a ray that reaches emitters yields the lamp
                     it crosses and the emissive surface it stops at (each generated with p_b), a ray
                     that reaches none is a null candidate (it still counts in M_b, never re-drawn)
-Resampling weight of candidate y:  w = p̂(y) / (M_l p_l(y) + M_b p_b(y)),
-target p̂(y) = luminance(f(ωo, ωi) · Le(y) · |cos θ_s|) (unshadowed integrand, solid-angle measure),
-unbiased contribution weight W = Σw / p̂(y_selected). The selected sample is shaded with one shadow ray:
-L_direct = f · Le · |cos θ_s| · V · W. Suns are not resampled: one light-sampled sun per pixel is added.
+Everything is in AREA measure on the lights, so a sample (a point on a light) and its weight W mean the
+same at every pixel and can be reused across pixels without a Jacobian:
+  geometry term G(x, y) = |cos θ_s| |cos θ_l| / d²
+  target p̂(y) = luminance(f(ωo, ωi) · Le(y)) · G  (the unshadowed integrand)
+  light pdf p_l(y) = p_select / A, BSDF pdf p_b(y) = p_b,ω · |cos θ_l| / d²
+Resampling weight of candidate y:  w = p̂(y) / (M_l p_l(y) + M_b p_b(y)); unbiased contribution weight
+W = Σw / p̂(y_selected) (units m²). The selected sample is shaded with one shadow ray:
+L_direct = f · Le · G · V · W. Suns are not resampled: one light-sampled sun per pixel is added.
 
 Reservoir memory per pixel: light index (int32), barycentrics b1, b2, confidence M, W, cached p̂
 (float32 each) = 24 bytes.
@@ -25,7 +29,7 @@ from .accel import offset_origin, shadow_rays
 from .bsdf import eval_bsdf, luminance, sample_bsdf
 from .sampling import dot, to_local, to_world, uniform_triangle
 
-DIRECT_METHODS = ("LIGHT_SAMPLING", "RIS")
+DIRECT_METHODS = ("LIGHT_SAMPLING", "RIS", "RESTIR")
 
 
 @dataclass
@@ -52,14 +56,16 @@ class Reservoirs:
         return Reservoirs(np.full(n, -1, np.int32), z.copy(), z.copy(), z.copy(), z.copy(), z.copy())
 
 
-def _target(surf, wi: np.ndarray, le: np.ndarray):
-    """p̂ (n,), f (n, 3), |cos θ_s| (n,) and BSDF pdf (n,) of directions wi (world) at the surfaces."""
+def _target(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l: np.ndarray):
+    """Area-measure target p̂ (n,), f (n, 3), geometry term G (n,) and the BSDF's pdf converted to area
+    measure (n,) for light points in directions wi (world) at distances dist from the surfaces."""
     wi_l = to_local(wi, surf.ns, surf.t, surf.bt)
     f, pdf_b = eval_bsdf(surf.params, surf.wo_l, wi_l)
-    cos_s = np.abs(wi_l[:, 2])
-    ok = dot(wi, surf.ng) > 0
-    p_hat = np.where(ok, luminance(f * le) * cos_s, 0.0).astype(np.float32)
-    return p_hat, f, cos_s, np.where(ok, pdf_b, 0.0).astype(np.float32)
+    ok = (dot(wi, surf.ng) > 0) & (dist > 0)
+    to_area = np.abs(cos_l) / np.maximum(dist * dist, 1e-30)
+    g = np.abs(wi_l[:, 2]) * to_area
+    p_hat = np.where(ok, luminance(f * le) * g, 0.0).astype(np.float32)
+    return p_hat, f, np.where(ok, g, 0.0).astype(np.float32), np.where(ok, pdf_b * to_area, 0.0).astype(np.float32)
 
 
 class _Stream:
@@ -102,8 +108,8 @@ def initial_ris(ctx, surf, rng: np.random.Generator, cfg: DISettings) -> Reservo
         li = lights.tri_alias.sample(u[:, 0], u[:, 1]).astype(np.int32)
         b1, b2 = uniform_triangle(u[:, 2], u[:, 3])
         _q, wi, dist, cos_l, le = lights.point_towards(li, b1, b2, surf.p)
-        p_l = lights.tri_only_pdf_solid_angle(li, dist, cos_l)
-        p_hat, _f, _c, p_b = _target(surf, wi, le)
+        p_l = lights.tri_only_pdf_area(li)
+        p_hat, _f, _g, p_b = _target(surf, wi, le, dist, cos_l)
         stream.add(rows, li, b1, b2, p_hat / np.maximum(m_l * p_l + m_b * p_b, 1e-30), p_hat)
     for _ in range(m_b):
         u = rng.random((n, 3), dtype=np.float32)
@@ -133,9 +139,9 @@ def initial_ris(ctx, surf, rng: np.random.Generator, cfg: DISettings) -> Reservo
             li = light[sel].astype(np.int32)
             b1, b2 = cu[sel].astype(np.float32), cv[sel].astype(np.float32)
             _q, wdir, dist, cos_l, le = lights.point_towards(li, b1, b2, surf.p[r])
-            p_l = lights.tri_only_pdf_solid_angle(li, dist, cos_l)
+            p_l = lights.tri_only_pdf_area(li)
             sub = _SurfaceRows(surf, r)
-            p_hat, _f2, _c2, pb = _target(sub, wdir, le)
+            p_hat, _f2, _g2, pb = _target(sub, wdir, le, dist, cos_l)
             stream.add(r, li, b1, b2, p_hat / np.maximum(m_l * p_l + m_b * pb, 1e-30), p_hat)
     return stream.finish(1.0)
 
@@ -158,9 +164,9 @@ def shade(ctx, surf, res: Reservoirs, rng: np.random.Generator) -> np.ndarray:
     live = np.flatnonzero((res.light >= 0) & (res.W > 0))
     if live.size:
         sub = _SurfaceRows(surf, live)
-        q, wi, dist, _cos_l, le = lights.point_towards(res.light[live], res.b1[live], res.b2[live], sub.p)
-        _p, f, cos_s, _pb = _target(sub, wi, le)
-        contrib = f * le * (cos_s * res.W[live])[:, None] * (dot(wi, sub.ng) > 0)[:, None]
+        q, wi, dist, cos_l, le = lights.point_towards(res.light[live], res.b1[live], res.b2[live], sub.p)
+        _p, f, g, _pb = _target(sub, wi, le, dist, cos_l)
+        contrib = f * le * (g * res.W[live])[:, None]
         go = np.flatnonzero(contrib.max(axis=1) > 0)
         if go.size:
             so, sd, far = shadow_rays(sub.p[go], sub.ng[go], q[go], wi[go], dist[go])
@@ -168,11 +174,125 @@ def shade(ctx, surf, res: Reservoirs, rng: np.random.Generator) -> np.ndarray:
             out[live[go[vis]]] = contrib[go[vis]]
     if lights.sun_alias is not None:
         ls = lights.sample_suns(n, rng.random((n, 4), dtype=np.float32))
-        p_hat, f, cos_s, _pb = _target(surf, ls.wi, ls.le)
-        contrib = f * ls.le * (cos_s / np.maximum(ls.pdf, 1e-30))[:, None] * (dot(ls.wi, surf.ng) > 0)[:, None]
+        wi_l = to_local(ls.wi, surf.ns, surf.t, surf.bt)
+        f, _pb = eval_bsdf(surf.params, surf.wo_l, wi_l)
+        ok = (dot(ls.wi, surf.ng) > 0) & (ls.pdf > 0)
+        contrib = f * ls.le * (np.abs(wi_l[:, 2]) / np.maximum(ls.pdf, 1e-30) * ok)[:, None]
         go = np.flatnonzero(contrib.max(axis=1) > 0)
         if go.size:
             so, sd, far = shadow_rays(surf.p[go], surf.ng[go], ls.pos[go], ls.wi[go], ls.dist[go])
             vis = ~ctx.geom_accel.occluded(so, sd, far)
             out[go[vis]] += contrib[go[vis]]
     return np.where(np.isfinite(out), out, 0.0).astype(np.float32)
+
+
+# -- frame-level stages: G-buffer, spatial reuse, shading ------------------------------------------
+SPATIAL_DEPTH_TOLERANCE = 0.1    # relative depth difference above which a neighbour is rejected
+SPATIAL_NORMAL_COS = 0.906       # cos 25°: normals further apart are rejected
+BIAS_CORRECTIONS = ("NONE", "UNBIASED")
+
+
+@dataclass
+class SpatialSettings:
+    neighbors: int = 5
+    radius: float = 30.0
+    passes: int = 1
+    bias_correction: str = "UNBIASED"
+
+
+class GBuffer:
+    """Primary-hit surfaces of one sample pass over the whole window (SoA, row-major pixel index).
+
+    Fields mirror the path tracer's Surface (p, ng, ns, t, bt, wo_l, params) plus depth (planar, for
+    neighbour similarity), material (int32) and valid (bool, a surface was hit)."""
+
+    def __init__(self, n: int, material_params):
+        f3 = lambda: np.zeros((n, 3), np.float32)  # noqa: E731
+        self.p, self.ng, self.ns, self.t, self.bt, self.wo_l = f3(), f3(), f3(), f3(), f3(), f3()
+        self.depth = np.zeros(n, np.float32)
+        self.material = np.zeros(n, np.int32)
+        self.valid = np.zeros(n, bool)
+        self.params = material_params.take(np.zeros(n, np.int64))  # placeholder rows, overwritten per hit
+
+    def store(self, rows: np.ndarray, surf, depth: np.ndarray):
+        for name in ("p", "ng", "ns", "t", "bt", "wo_l"):
+            getattr(self, name)[rows] = getattr(surf, name)
+        for name in ("diffuse", "f0", "f0_dielectric", "alpha", "p_spec", "spec_on"):
+            getattr(self.params, name)[rows] = getattr(surf.params, name)
+        self.depth[rows] = depth
+        self.material[rows] = surf.mat
+        self.valid[rows] = True
+
+
+def neighbor_offsets(k: int, radius: float, rng: np.random.Generator, n: int):
+    """Per-pixel neighbour offsets (n, k, 2) in pixels: a golden-angle spiral filling the disc of
+    ``radius`` (low discrepancy), rotated by a random angle per pixel and pass (no ring artefacts)."""
+    j = np.arange(k, dtype=np.float32)
+    r = radius * np.sqrt((j + 0.5) / k)
+    phi = j * 2.39996323 + rng.random((n, 1), dtype=np.float32) * 2 * np.pi
+    return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=-1)
+
+
+def spatial_reuse(ctx, gb: GBuffer, res: Reservoirs, width: int, height: int, rows: np.ndarray,
+                  cfg: SpatialSettings, rng: np.random.Generator) -> Reservoirs:
+    """One spatial pass for pixels ``rows``: merge ``cfg.neighbors`` similar neighbours' reservoirs
+    (weights p̂_p(y_q)·W_q·M_q) into the pixel's own. NONE: W = Σw / (p̂ ΣM) (fast, darkens where
+    neighbours cannot produce the sample); UNBIASED: W = Σw / (p̂ Z), Z = Σ M_q over the merged
+    reservoirs whose target is non-zero at the chosen sample (Bitterli et al. 2020, Alg. 6)."""
+    n = len(rows)
+    lights = ctx.lights
+    me = _SurfaceRows(gb, rows)
+    stream = _Stream(n, rng)
+    m_total = np.zeros(n, np.float32)
+    local = np.arange(n)
+    # the pixel's own reservoir
+    own = res.light[rows] >= 0
+    stream.w_sum[:] = 0
+    w_own = np.where(own, res.p_hat[rows] * res.W[rows] * res.M[rows], 0.0)
+    stream.add(local, res.light[rows], res.b1[rows], res.b2[rows], w_own, res.p_hat[rows])
+    m_total += np.where(gb.valid[rows], res.M[rows], 0.0)
+    offs = neighbor_offsets(cfg.neighbors, cfg.radius, rng, n)
+    px, py = rows % width, rows // width
+    merged = []
+    for k in range(cfg.neighbors):
+        qx = np.round(px + offs[:, k, 0]).astype(np.int64)
+        qy = np.round(py + offs[:, k, 1]).astype(np.int64)
+        inside = (qx >= 0) & (qx < width) & (qy >= 0) & (qy < height)
+        q = np.where(inside, qy * width + qx, rows)
+        # a neighbour outside the window, the pixel itself or one already merged would be a correlated
+        # duplicate (biased): skip it
+        ok = inside & gb.valid[q] & (q != rows) & gb.valid[rows]
+        for q_prev, _ok_prev in merged:
+            ok &= q != q_prev
+        ok &= np.abs(gb.depth[q] - gb.depth[rows]) <= SPATIAL_DEPTH_TOLERANCE * np.maximum(gb.depth[rows], 1e-6)
+        ok &= dot(gb.ns[q], gb.ns[rows]) >= SPATIAL_NORMAL_COS
+        merged.append((q, ok))
+        m_total += np.where(ok, res.M[q], 0.0)
+        sel = np.flatnonzero(ok & (res.light[q] >= 0))
+        if sel.size == 0:
+            continue
+        qs = q[sel]
+        sub = _SurfaceRows(me, sel)
+        _p, wi, dist, cos_l, le = lights.point_towards(res.light[qs], res.b1[qs], res.b2[qs], sub.p)
+        p_hat, _f, _g, _pb = _target(sub, wi, le, dist, cos_l)
+        stream.add(sel, res.light[qs], res.b1[qs], res.b2[qs], p_hat * res.W[qs] * res.M[qs], p_hat)
+    out = stream.res
+    chosen = out.light >= 0
+    if cfg.bias_correction == "UNBIASED":
+        z = np.where(gb.valid[rows] & chosen & (out.p_hat > 0), res.M[rows], 0.0).astype(np.float32)
+        for q, ok in merged:
+            sel = np.flatnonzero(ok & chosen)
+            if sel.size == 0:
+                continue
+            sub = _SurfaceRows(gb, q[sel])
+            _p, wi, dist, cos_l, le = lights.point_towards(out.light[sel], out.b1[sel], out.b2[sel], sub.p)
+            p_hat_q, _f, _g, _pb = _target(sub, wi, le, dist, cos_l)
+            z[sel] += np.where(p_hat_q > 0, res.M[q[sel]], 0.0)
+        denom = z
+    else:
+        denom = m_total
+    ok = chosen & (out.p_hat > 0) & (denom > 0)
+    out.W = np.where(ok, stream.w_sum / np.maximum(out.p_hat * denom, 1e-30), 0.0).astype(np.float32)
+    out.light = np.where(ok, out.light, -1).astype(np.int32)
+    out.M = m_total.astype(np.float32)
+    return out

@@ -11,6 +11,8 @@ import numpy as np
 # Stream identifiers: one per use of randomness, so adding a new use never shifts another.
 STREAM_CAMERA = 1
 STREAM_PATH = 2
+STREAM_SHADE = 3
+STREAM_SPATIAL = 16  # + spatial pass index
 
 
 def rng(seed: int, frame: int, pass_index: int, stream: int, chunk: int = 0) -> np.random.Generator:

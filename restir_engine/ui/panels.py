@@ -63,9 +63,15 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
         if s.integrator == "RESTIR":
             layout.prop(s, "direct_method")
             col = layout.column(align=True)
-            col.active = s.direct_method == "RIS"
+            col.active = s.direct_method in ("RIS", "RESTIR")
             col.prop(s, "light_candidates")
             col.prop(s, "bsdf_candidates")
+            if s.direct_method == "RESTIR":
+                col = layout.column(align=True, heading="Spatial Reuse")
+                col.prop(s, "spatial_neighbors")
+                col.prop(s, "spatial_radius")
+                col.prop(s, "spatial_passes")
+                layout.prop(s, "bias_correction")
 
 
 class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):
@@ -96,7 +102,7 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl.restir, "use_pass_indirect")
         col.prop(vl.restir, "use_pass_emission")
         col = layout.column(heading="ReSTIR", align=True)
-        col.active = context.scene.restir.integrator == "RESTIR" and context.scene.restir.direct_method == "RIS"
+        col.active = context.scene.restir.integrator == "RESTIR" and context.scene.restir.direct_method != "LIGHT_SAMPLING"
         col.prop(vl.restir, "use_pass_reservoir_m")
         col.prop(vl.restir, "use_pass_reservoir_ucw")
 
