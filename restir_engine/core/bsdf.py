@@ -8,8 +8,11 @@ Model (an approximation of Principled BSDF, see docs/MATERIALS.md):
   diffuse  = base·(1-metallic)/π · (1 - F_d(cos_o))      F_d: Schlick with the dielectric f0
   specular = D·G·F / (4 cos_i cos_o)   GGX D, height-correlated Smith G, Schlick F with
              f0 = mix(f0_dielectric, base, metallic), alpha = roughness²
-The (1 - F_d) factor keeps reflectance ≤ 1 (energy-sensible). Lobes are sampled by one-sample
-MIS: cosine hemisphere for the diffuse lobe, the GGX normal distribution for the specular one.
+The (1 - F_d) factor keeps reflectance ≤ 1 (energy-sensible). The specular lobe is scaled by
+1 + f0 (1 - E(μo, α)) / E(μo, α), E the directional albedo of single-scattering GGX with F = 1
+(Turquin 2019 energy compensation), standing in for the energy Cycles' multiscatter GGX keeps at high
+roughness: a white metal then reflects all the light it receives. Lobes are sampled by one-sample MIS:
+cosine hemisphere for the diffuse lobe, the GGX normal distribution for the specular one.
 """
 from __future__ import annotations
 
@@ -73,6 +76,52 @@ def _ggx_d(alpha, cos_h):
     return a2 / (np.pi * den * den)
 
 
+_ALBEDO_TABLE = None
+_TABLE_N = 32
+
+
+def ggx_albedo_table() -> np.ndarray:
+    """E[α index, μ index]: directional albedo of single-scattering GGX (F = 1, height-correlated Smith)
+    on a 32 x 32 grid of α in [ALPHA_MIN, 1] and μo in [1/64, 1], by stratified NDF sampling
+    (64 x 64 strata per entry); computed once, in about a second."""
+    global _ALBEDO_TABLE
+    if _ALBEDO_TABLE is None:
+        n = _TABLE_N
+        alphas = np.linspace(ALPHA_MIN, 1.0, n)
+        mus = np.linspace(1.0 / 64, 1.0, n)
+        k = 64
+        u1 = ((np.arange(k) + 0.5) / k)[:, None].repeat(k, 1).ravel()
+        u2 = ((np.arange(k) + 0.5) / k)[None, :].repeat(k, 0).ravel()
+        table = np.empty((n, n))
+        for i, a in enumerate(alphas):  # loop over table rows, vectorized over μ and strata
+            tan2 = a * a * u1 / np.maximum(1 - u1, 1e-9)
+            ch = 1 / np.sqrt(1 + tan2)
+            sh = np.sqrt(np.maximum(0, 1 - ch * ch))
+            h = np.stack([sh * np.cos(2 * np.pi * u2), sh * np.sin(2 * np.pi * u2), ch], axis=1)
+            mu = mus[:, None]
+            wo = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=-1)  # (n, 1, 3)
+            odh = (wo * h[None]).sum(-1)
+            wi_z = 2 * odh * h[None, :, 2] - mu
+            g = 1 / (1 + _smith_lambda(a, np.broadcast_to(mu, wi_z.shape)) + _smith_lambda(a, np.maximum(wi_z, 1e-6)))
+            wgt = np.where((wi_z > 0) & (odh > 0), g * odh / (mu * h[None, :, 2]), 0.0)
+            table[i] = wgt.mean(axis=1)
+        _ALBEDO_TABLE = np.clip(table, 1e-3, 1.0).astype(np.float32)
+    return _ALBEDO_TABLE
+
+
+def ggx_albedo(alpha: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """Bilinear lookup of :func:`ggx_albedo_table` at (α, μo)."""
+    t = ggx_albedo_table()
+    n = _TABLE_N
+    x = np.clip((alpha - ALPHA_MIN) / (1.0 - ALPHA_MIN) * (n - 1), 0, n - 1)
+    y = np.clip((mu - 1.0 / 64) / (1.0 - 1.0 / 64) * (n - 1), 0, n - 1)
+    x0 = np.minimum(x.astype(np.int64), n - 2)
+    y0 = np.minimum(y.astype(np.int64), n - 2)
+    fx, fy = (x - x0).astype(np.float32), (y - y0).astype(np.float32)
+    return ((t[x0, y0] * (1 - fy) + t[x0, y0 + 1] * fy) * (1 - fx)
+            + (t[x0 + 1, y0] * (1 - fy) + t[x0 + 1, y0 + 1] * fy) * fx)
+
+
 def _smith_lambda(alpha, cos):
     c2 = np.clip(cos * cos, 1e-12, 1.0)
     tan2 = (1.0 - c2) / c2
@@ -96,7 +145,9 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
     d = _ggx_d(p.alpha, cos_h)
     g = 1.0 / (1.0 + _smith_lambda(p.alpha, co) + _smith_lambda(p.alpha, ci))
     fr = _schlick(p.f0, odh[:, None])
-    spec = (p.spec_on * d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr
+    e = ggx_albedo(p.alpha, np.clip(co, 0, 1))
+    compensation = 1.0 + p.f0 * ((1.0 - e) / e)[:, None]
+    spec = (p.spec_on * d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr * compensation
     f = f + spec
     pdf_s = d * cos_h / (4.0 * odh)
     pdf = (1 - p.p_spec) * pdf_d + p.p_spec * pdf_s

@@ -24,6 +24,14 @@ METHODS = [
            "C7"),
     Method("path", "Path tracer (NEE + MIS)", "RESTIR", {"integrator": "PATH"}, (1, 2, 4, 8), (1, 2, 4, 8, 16, 32, 64),
            "C0"),
+    Method("ris", "RIS (32 light + 1 BSDF candidates)", "RESTIR",
+           {"integrator": "RESTIR", "direct_method": "RIS"}, (1, 2, 4), (1, 2, 4, 8, 16, 32), "C1"),
+    Method("restir_spatial", "ReSTIR DI spatial, unbiased", "RESTIR",
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED"}, (1, 2, 4),
+           (1, 2, 4, 8, 16, 32), "C2"),
+    Method("restir_spatial_biased", "ReSTIR DI spatial, biased (1/M)", "RESTIR",
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "NONE"}, (1, 2, 4),
+           (1, 2, 4, 8, 16, 32), "C3"),
 ]
 
 
