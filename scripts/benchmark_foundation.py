@@ -88,9 +88,12 @@ def bench_rays(scene, repeat):
             "wrapper_per_thread_vs_direct": wrap_rps / thread_count() / direct_rps}
 
 
-def bench_frame(scene, samples, bounces, repeat):
-    tmin, tmed, r = best_of(lambda: render_frame(scene, RenderSettings(samples=samples, max_bounces=bounces)), repeat)
-    return {"resolution": [scene.camera.width, scene.camera.height], "samples": samples, "max_bounces": bounces,
+def bench_frame(scene, samples, bounces, repeat, **settings):
+    st = RenderSettings(samples=samples, max_bounces=bounces, **settings)
+    tmin, tmed, r = best_of(lambda: render_frame(scene, st), repeat)
+    label = settings.get("direct_method", "path") if settings.get("integrator") == "RESTIR" else "path"
+    return {"method": label, "resolution": [scene.camera.width, scene.camera.height], "samples": samples,
+            "max_bounces": bounces,
             "seconds_min": tmin, "seconds_median": tmed, "seconds_per_sample": tmin / samples,
             "triangles": len(scene.geometry)}
 
@@ -111,9 +114,10 @@ def chart(results, path):
     ax[1].set_ylabel("million primary rays / s")
     ax[1].set_title("Primary rays, demo scene 640x360")
     f = results["frames"]
-    ax[2].bar([f"{k['samples']} spp, {k['max_bounces']} bounces" for k in f], [k["seconds_min"] for k in f])
+    ax[2].bar([f"{k['method']}\n{k['samples']} spp, {k['max_bounces']} b." for k in f], [k["seconds_min"] for k in f])
+    ax[2].tick_params(axis="x", labelsize=7)
     ax[2].set_ylabel("seconds per frame")
-    ax[2].set_title("Reference path tracer, demo 640x360")
+    ax[2].set_title("Frame time, demo 640x360 (b. = bounces)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
@@ -132,7 +136,9 @@ def main():
     scene = demo_scene()
     results["rays"] = bench_rays(scene, repeat)
     results["frames"] = [bench_frame(scene, 1, 4, repeat), bench_frame(scene, 16, 4, 1 if args.quick else 2),
-                         bench_frame(scene, 16, 0, 1 if args.quick else 2)]
+                         bench_frame(scene, 16, 0, 1 if args.quick else 2),
+                         bench_frame(scene, 1, 0, repeat, integrator="RESTIR", direct_method="RIS"),
+                         bench_frame(scene, 1, 0, repeat, integrator="RESTIR", direct_method="RESTIR")]
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "foundation_benchmark.json"), "w") as f:
         json.dump(results, f, indent=2)

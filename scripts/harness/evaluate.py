@@ -30,16 +30,18 @@ class Spec:
 
     @property
     def title(self):
-        return self.name if self.variant == "default" else f"{self.name} {self.variant}"
+        base = self.name if self.variant == "default" else f"{self.name} {self.variant}"
+        return base + (" (direct light)" if self.bounces == 0 else "")
 
     @property
     def slug(self):
-        return f"{self.name}-{self.variant}".replace(".", "p")
+        return f"{self.name}-{self.variant}".replace(".", "p") + ("-direct" if self.bounces == 0 else "")
 
 
 QUICK = [Spec("cornell", "default", "tiny", 3, 1024), Spec("many_lights", "1k", "tiny", 1, 1024),
-         Spec("interior_gi", "default", "tiny", 3, 2048)]
+         Spec("many_lights", "1k", "tiny", 0, 1024), Spec("interior_gi", "default", "tiny", 3, 2048)]
 FULL = [Spec("cornell", "default", "small", 4, 4096), Spec("many_lights", "1k", "small", 1, 4096),
+        Spec("many_lights", "10k", "small", 0, 4096),
         Spec("many_lights", "10k", "small", 1, 4096), Spec("many_lights", "100k", "small", 1, 4096),
         Spec("glossy", "0.05", "small", 2, 4096), Spec("glossy", "0.2", "small", 2, 4096),
         Spec("glossy", "0.5", "small", 2, 4096), Spec("interior_gi", "default", "small", 4, 8192)]

@@ -93,10 +93,11 @@ def table_rows(result: dict, methods, budget: float, target: float) -> list[str]
             continue
         walls = [p["wall"] for p in pts]
         errs = [p["relmse"] for p in pts]
-        at_budget = metrics.interpolate_loglog(walls, errs, budget)
+        inside = min(walls) <= budget <= max(walls)  # no extrapolation: outside the measured range is "—"
+        at_budget = metrics.interpolate_loglog(walls, errs, budget) if inside else float("nan")
         reach = metrics.time_to_reach(walls, errs, target)
         best = max(pts, key=lambda p: p["spp"])
-        rows.append(f"| {result['title']} | {m.label} | {at_budget:.4g} | "
+        rows.append(f"| {result['title']} | {m.label} | {'—' if math.isnan(at_budget) else f'{at_budget:.4g}'} | "
                     f"{'—' if math.isinf(reach) else f'{reach:.2f} s'} | {best['bias'] * 100:+.2f} % ({best['spp']} spp) "
                     f"| {best['flip']:.4f} |")
     return rows
