@@ -16,6 +16,11 @@ MAX_REPORTED_WARNINGS = 12
 # benchmarks and the evaluation harness; a diagnostic, not state that rendering depends on.
 LAST_FRAME_STATS: dict = {}
 
+# ReSTIR temporal history across the frames of an animation. Engine instances are recreated per frame,
+# so it lives here, keyed by (scene, view layer): (frame number, restir_di.TemporalHistory). It is used
+# only by the next frame (a jump drops it) and only if resolution and light table still match.
+_TEMPORAL_HISTORY: dict = {}
+
 
 def settings_from_scene(scene) -> RenderSettings:
     s = scene.restir
@@ -24,6 +29,7 @@ def settings_from_scene(scene) -> RenderSettings:
                           light_candidates=int(s.light_candidates), bsdf_candidates=int(s.bsdf_candidates),
                           spatial_neighbors=int(s.spatial_neighbors), spatial_radius=float(s.spatial_radius),
                           spatial_passes=int(s.spatial_passes), bias_correction=s.bias_correction,
+                          temporal_reuse=bool(s.temporal_reuse), confidence_cap=float(s.confidence_cap),
                           film_transparent=bool(scene.render.film_transparent))
 
 
@@ -82,10 +88,16 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.update_progress(fraction)
             self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {message}")
 
+        key = (scene.name, view_layer.name)
+        prev = _TEMPORAL_HISTORY.pop(key, None)
+        history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None
         try:
-            result = render_frame(core_scene, settings, progress=progress, should_stop=self.test_break)
+            result = render_frame(core_scene, settings, progress=progress, should_stop=self.test_break,
+                                  history=history)
         except Cancelled:
             return
+        if result.history is not None and not result.cancelled:
+            _TEMPORAL_HISTORY[key] = (scene.frame_current, result.history)
         for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):
             self.report({"WARNING"}, msg)
         self._write(result.passes, core_scene.camera.window, scene, view_layer)

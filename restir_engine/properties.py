@@ -27,13 +27,18 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
         items=[("LIGHT_SAMPLING", "Light Sampling", "Baseline: one light sample and one BSDF sample combined by MIS", 0),
                ("RIS", "RIS", "Resampled importance sampling: pick one of many light and BSDF candidates by the "
                 "unshadowed contribution, then trace one shadow ray (unbiased)", 1),
-               ("RESTIR", "ReSTIR (spatial)", "RIS, then reuse of neighbouring pixels' reservoirs (spatial reuse); "
-                "temporal reuse is not available yet", 2)],
+               ("RESTIR", "ReSTIR", "RIS, then reuse of the previous sample pass's or frame's reservoirs (temporal) "
+                "and of neighbouring pixels' (spatial)", 2)],
         default="RIS", update=_update_passes)
     light_candidates: IntProperty(name="Light Candidates", description="Light samples per pixel resampled by RIS",
                                   default=32, min=0, soft_max=256)
     bsdf_candidates: IntProperty(name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",
                                  default=1, min=0, soft_max=8)
+    temporal_reuse: BoolProperty(name="Temporal Reuse", description="Reuse the reservoir the pixel's surface had "
+                                 "in the previous sample pass, and in the previous frame of an animation",
+                                 default=True)
+    confidence_cap: FloatProperty(name="Confidence Cap", description="Largest confidence M a reused reservoir keeps",
+                                  default=20.0, min=1.0, soft_max=100.0)
     spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring reservoirs merged per spatial pass",
                                    default=5, min=0, soft_max=16)
     spatial_radius: FloatProperty(name="Radius", description="Spatial reuse radius in pixels", default=30.0,

@@ -40,3 +40,16 @@ def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray):
     length = np.linalg.norm(d, axis=1)
     d = d / np.maximum(length, 1e-30)[:, None]
     return near_w.astype(np.float32), d.astype(np.float32), length.astype(np.float32)
+
+
+def project(cam: Camera, points: np.ndarray):
+    """Raster coordinates (n, 2) of world points seen by ``cam`` (x right, y up, full-resolution pixels)
+    and their planar depth along the camera axis (n,); depth <= 0 means behind the camera."""
+    w2c = np.linalg.inv(cam.cam_to_world.astype(np.float64))
+    proj = np.linalg.inv(cam.ndc_to_cam)
+    pc = points.astype(np.float64) @ w2c[:3, :3].T + w2c[:3, 3]
+    h = pc @ proj[:3, :3].T + proj[:3, 3]
+    w = pc @ proj[3, :3] + proj[3, 3]
+    ndc = h[:, :2] / np.where(np.abs(w) > 1e-12, w, 1e-12)[:, None]
+    raster = np.stack([(ndc[:, 0] + 1) * 0.5 * cam.width, (ndc[:, 1] + 1) * 0.5 * cam.height], axis=1)
+    return raster.astype(np.float32), (-pc[:, 2]).astype(np.float32)

@@ -13,7 +13,7 @@ import numpy as np
 
 from . import pathtracer, restir_di
 from .accel import pool
-from .sampling import STREAM_CAMERA, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, rng
+from .sampling import STREAM_CAMERA, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, rng
 from .scene import Scene
 
 INTEGRATORS = ("PATH", "RESTIR")
@@ -39,7 +39,9 @@ class RenderSettings:
     spatial_neighbors: int = 5
     spatial_radius: float = 30.0
     spatial_passes: int = 1
-    bias_correction: str = "UNBIASED"  # spatial reuse: "NONE" (1/M) or "UNBIASED" (1/Z)
+    bias_correction: str = "UNBIASED"  # spatial/temporal reuse: "NONE" (1/M) or "UNBIASED" (1/Z)
+    temporal_reuse: bool = True  # ReSTIR: reuse the previous sample pass's (or frame's) reservoirs
+    confidence_cap: float = 20.0
     film_transparent: bool = False
     tile_pixels: int = 16384
 
@@ -53,6 +55,7 @@ class FrameResult:
     seconds: float
     cancelled: bool = False
     stats: dict = field(default_factory=dict)
+    history: object = None  # restir_di.TemporalHistory for the next frame (ReSTIR with temporal reuse)
 
 
 def _tiles(w: int, h: int, tile_pixels: int):
@@ -68,7 +71,7 @@ class FrameRenderer:
     swaps the camera with :meth:`set_camera` (geometry and lights stay built).
     """
 
-    def __init__(self, scene: Scene, settings: RenderSettings):
+    def __init__(self, scene: Scene, settings: RenderSettings, history=None):
         if settings.integrator not in INTEGRATORS:
             raise ValueError(f"unknown integrator {settings.integrator!r}; available: {INTEGRATORS}")
         t0 = time.perf_counter()
@@ -86,7 +89,11 @@ class FrameRenderer:
                                                      max(0, settings.spatial_passes), settings.bias_correction)
         self.ctx = pathtracer.build_context(scene, settings.max_bounces, settings.film_transparent)
         self.build_seconds = time.perf_counter() - t0
+        lights = self.ctx.lights
+        self.light_signature = (lights.n_tri, lights.n_sun, hash(lights.power.tobytes()))
         self.set_camera(scene.camera)
+        if history is not None and self._history_fits(history):
+            self.history = history  # from the previous frame of an animation
 
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
@@ -98,6 +105,7 @@ class FrameRenderer:
                     "res_m": np.zeros((h, w), np.float64), "res_w": np.zeros((h, w), np.float64)}
         self.samples_done = 0
         self._data = None
+        self.history = None  # restir_di.TemporalHistory of the last sample pass
 
     def data_passes(self):
         """Depth (h, w, 1) and Normal (h, w, 3) at pixel centres (one ray per pixel: no mixing of depths
@@ -174,6 +182,11 @@ class FrameRenderer:
         self.samples_done += 1
         return True
 
+    def _history_fits(self, hist) -> bool:
+        cam = self.ctx.scene.camera
+        return (hist.light_signature == self.light_signature and hist.camera.window[2:] == cam.window[2:]
+                and (hist.camera.width, hist.camera.height) == (cam.width, cam.height))
+
     def _spatial_and_shade(self, results, s: int):
         """Spatial passes over the frame's reservoirs, then one shadow ray per pixel; adds the direct light
         and the reservoir figures into each tile's outputs."""
@@ -181,6 +194,16 @@ class FrameRenderer:
         st = self.settings
         res = self._res
         spans = [np.arange(a, min(w * h, a + st.tile_pixels)) for a in range(0, w * h, st.tile_pixels)]
+        if st.temporal_reuse and self.history is not None:
+            hist = self.history
+            parts = list(pool().map(lambda a: (a[1], restir_di.temporal_reuse(
+                self.ctx, self._gbuf, res, hist, w, a[1], st.confidence_cap, st.bias_correction,
+                rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]))), enumerate(spans)))
+            nxt = restir_di.Reservoirs.empty(w * h)
+            for rows, part in parts:
+                for name in ("light", "b1", "b2", "M", "W", "p_hat"):
+                    getattr(nxt, name)[rows] = getattr(part, name)
+            res = nxt
         for k in range(self.spatial.passes if self.spatial.neighbors else 0):
             parts = list(pool().map(lambda a: (a[1], restir_di.spatial_reuse(
                 self.ctx, self._gbuf, res, w, h, a[1], self.spatial,
@@ -202,6 +225,9 @@ class FrameRenderer:
                 direct[live] = restir_di.shade(self.ctx, sub, part, rng(st.seed, st.frame, s, STREAM_SHADE, ti))
 
         list(pool().map(shade, enumerate(spans)))
+        # history keeps confidence at most the cap, so no reservoir's M ever exceeds it when reused
+        capped = restir_di.Reservoirs(res.light, res.b1, res.b2, np.minimum(res.M, st.confidence_cap), res.W, res.p_hat)
+        self.history = restir_di.TemporalHistory(self._gbuf, capped, self.ctx.scene.camera, self.light_signature)
         for (tx, ty, tw, th), (_e, d, _i, _a, reservoir) in results:
             rows = reservoir["rows"]
             d += direct[rows]
@@ -228,14 +254,14 @@ class FrameRenderer:
         return {k: np.where(np.isfinite(v), v, 0.0).astype(np.float32) for k, v in out.items()}
 
 
-def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None) -> FrameResult:
+def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None) -> FrameResult:
     """Render one frame with the chosen integrator.
 
     progress(fraction, message) is called after every tile; should_stop() is polled after every tile,
     and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none).
     """
     t0 = time.perf_counter()
-    fr = FrameRenderer(scene, settings)
+    fr = FrameRenderer(scene, settings, history)
     cancelled = False
     for s in range(settings.samples):
         report = None
@@ -251,4 +277,4 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     ctx = fr.ctx
     return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled,
                        {"build_seconds": fr.build_seconds, "triangles": len(scene.geometry),
-                        "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun})
+                        "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun}, fr.history)

@@ -296,3 +296,70 @@ def spatial_reuse(ctx, gb: GBuffer, res: Reservoirs, width: int, height: int, ro
     out.light = np.where(ok, out.light, -1).astype(np.int32)
     out.M = m_total.astype(np.float32)
     return out
+
+
+# -- temporal reuse ------------------------------------------------------------------------------
+@dataclass
+class TemporalHistory:
+    """What the next sample pass (or frame) reuses: the previous G-buffer, its final reservoirs, its
+    camera and the light-table signature they index into."""
+
+    gbuf: GBuffer
+    res: Reservoirs
+    camera: object
+    light_signature: tuple
+
+
+def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, width: int, rows: np.ndarray,
+                   confidence_cap: float, bias_correction: str, rng: np.random.Generator) -> Reservoirs:
+    """Merge each pixel's reservoir with the reservoir its primary hit had in the previous pass/frame.
+
+    The hit is reprojected with the previous camera (static geometry; moving objects are caught by the
+    G-buffer tests: depth within 10 %, normals within 25°, same material). The previous confidence is
+    capped at ``confidence_cap`` x the current one. NONE: W = Σw / (p̂ ΣM); UNBIASED: W = Σw / (p̂ Z),
+    Z counting the previous reservoir only where its own target (at its stored surface) is non-zero."""
+    from .camera import project
+    n = len(rows)
+    me = _SurfaceRows(gb, rows)
+    x0, y0, w, h = hist.camera.window
+    raster, depth_prev_cam = project(hist.camera, gb.p[rows])
+    px = np.floor(raster[:, 0]).astype(np.int64) - x0
+    py = np.floor(raster[:, 1]).astype(np.int64) - y0
+    inside = (px >= 0) & (px < w) & (py >= 0) & (py < h) & (depth_prev_cam > 0) & gb.valid[rows]
+    q = np.where(inside, py * w + px, 0)
+    ok = inside & hist.gbuf.valid[q]
+    ok &= np.abs(hist.gbuf.depth[q] - depth_prev_cam) <= SPATIAL_DEPTH_TOLERANCE * np.maximum(depth_prev_cam, 1e-6)
+    ok &= dot(hist.gbuf.ns[q], gb.ns[rows]) >= SPATIAL_NORMAL_COS
+    ok &= hist.gbuf.material[q] == gb.material[rows]
+    stream = _Stream(n, rng)
+    local = np.arange(n)
+    m_own = np.where(gb.valid[rows], res.M[rows], 0.0).astype(np.float32)
+    stream.add(local, res.light[rows], res.b1[rows], res.b2[rows],
+               np.where(res.light[rows] >= 0, res.p_hat[rows] * res.W[rows] * res.M[rows], 0.0), res.p_hat[rows])
+    prev = hist.res
+    m_prev = np.where(ok, np.minimum(prev.M[q], confidence_cap * np.maximum(m_own, 1.0)), 0.0).astype(np.float32)
+    sel = np.flatnonzero(ok & (prev.light[q] >= 0))
+    if sel.size:
+        qs = q[sel]
+        sub = _SurfaceRows(me, sel)
+        _p, wi, dist, cos_l, le = ctx.lights.point_towards(prev.light[qs], prev.b1[qs], prev.b2[qs], sub.p)
+        p_hat, _f, _g, _pb = _target(sub, wi, le, dist, cos_l)
+        stream.add(sel, prev.light[qs], prev.b1[qs], prev.b2[qs], p_hat * prev.W[qs] * m_prev[sel], p_hat)
+    out = stream.res
+    chosen = (out.light >= 0) & (out.p_hat > 0)
+    if bias_correction == "UNBIASED":
+        z = np.where(chosen, m_own, 0.0).astype(np.float32)
+        s2 = np.flatnonzero(chosen & ok)
+        if s2.size:
+            sub = _SurfaceRows(hist.gbuf, q[s2])
+            _p, wi, dist, cos_l, le = ctx.lights.point_towards(out.light[s2], out.b1[s2], out.b2[s2], sub.p)
+            p_hat_prev, _f, _g, _pb = _target(sub, wi, le, dist, cos_l)
+            z[s2] += np.where(p_hat_prev > 0, m_prev[s2], 0.0)
+        denom = z
+    else:
+        denom = m_own + m_prev
+    good = chosen & (denom > 0)
+    out.W = np.where(good, stream.w_sum / np.maximum(out.p_hat * denom, 1e-30), 0.0).astype(np.float32)
+    out.light = np.where(good, out.light, -1).astype(np.int32)
+    out.M = (m_own + m_prev).astype(np.float32)
+    return out

@@ -12,6 +12,7 @@ import numpy as np
 STREAM_CAMERA = 1
 STREAM_PATH = 2
 STREAM_SHADE = 3
+STREAM_TEMPORAL = 4
 STREAM_SPATIAL = 16  # + spatial pass index
 
 

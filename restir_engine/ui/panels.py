@@ -67,6 +67,11 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
             col.prop(s, "light_candidates")
             col.prop(s, "bsdf_candidates")
             if s.direct_method == "RESTIR":
+                col = layout.column(align=True, heading="Temporal Reuse")
+                col.prop(s, "temporal_reuse", text="")
+                sub = col.column()
+                sub.active = s.temporal_reuse
+                sub.prop(s, "confidence_cap")
                 col = layout.column(align=True, heading="Spatial Reuse")
                 col.prop(s, "spatial_neighbors")
                 col.prop(s, "spatial_radius")
