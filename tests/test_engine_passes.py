@@ -131,3 +131,29 @@ def test_reservoir_passes_only_with_reservoirs(box):
     assert ((m >= 0) & (m <= 1)).all()
     assert np.isfinite(w).all() and (w >= 0).all() and w[inside].mean() > 0
     assert np.allclose(p["Combined"][..., :3], p["Emission"] + p["Direct"] + p["Indirect"], atol=1e-4)
+
+
+def test_animation_carries_temporal_history_between_frames(addon, tmp_path):
+    """Frames rendered in sequence reuse the previous frame's reservoirs (confidence grows up to the cap);
+    a frame rendered on its own starts fresh."""
+    from harness.render import read_exr
+    scene = cornell_box("AREA", (24, 24))
+    configure_restir(scene, 1, 0, integrator="RESTIR", direct_method="RESTIR", spatial_neighbors=0,
+                     confidence_cap=2.0)
+    scene.view_layers[0].restir.use_pass_reservoir_m = True
+    settings = scene.render.image_settings
+    if hasattr(settings, "media_type"):
+        settings.media_type = "MULTI_LAYER_IMAGE"
+    else:
+        settings.file_format = "OPEN_EXR_MULTILAYER"
+    scene.frame_start, scene.frame_end = 1, 3
+    scene.render.filepath = str(tmp_path / "f_")
+    bpy.ops.render.render(animation=True)
+    m = [read_exr(str(tmp_path / f"f_{f:04d}.exr"))["Reservoir M"][..., 0] for f in (1, 2, 3)]
+    inside = m[0] > 0.99  # pixels with a surface
+    assert m[0].max() <= 1.0                         # first frame: initial reservoirs only
+    assert m[1][inside].mean() > 1.5                 # second frame: + the previous frame's reservoir
+    assert m[2][inside].max() <= 2.0 + 1.0 + 1e-5    # cap 2 on the history, + the new initial reservoir
+    scene.frame_current = 7
+    p = render_passes(scene)                         # a jump: no history
+    assert p["Reservoir M"].max() <= 1.0
