@@ -28,12 +28,15 @@ METHODS = [
            "C0"),
     Method("ris", "RIS (32 light + 1 BSDF candidates)", "RESTIR",
            {"integrator": "RESTIR", "direct_method": "RIS"}, (1, 2, 4), (1, 2, 4, 8, 16, 32), "C1"),
-    Method("restir_spatial", "ReSTIR DI spatial, unbiased", "RESTIR",
+    Method("restir_spatial", "ReSTIR DI spatial only, unbiased", "RESTIR",
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "spatial_radius": 8.0,
+            "temporal_reuse": False}, (1, 2, 4), (1, 2, 4, 8, 16, 32), "C2"),
+    Method("restir", "ReSTIR DI temporal + spatial, unbiased", "RESTIR",
            {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "spatial_radius": 8.0},
-           (1, 2, 4), (1, 2, 4, 8, 16, 32), "C2"),
-    Method("restir_spatial_biased", "ReSTIR DI spatial, biased (1/M)", "RESTIR",
-           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "NONE", "spatial_radius": 8.0}, (1, 2, 4),
-           (1, 2, 4, 8, 16, 32), "C3"),
+           (1, 2, 4), (1, 2, 4, 8, 16, 32), "C4"),
+    Method("restir_biased", "ReSTIR DI temporal + spatial, biased (1/M)", "RESTIR",
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "NONE", "spatial_radius": 8.0},
+           (1, 2, 4), (1, 2, 4, 8, 16, 32), "C3"),
 ]
 
 
