@@ -8,7 +8,7 @@ import numpy as np
 
 from . import passes as pass_table
 from .core.renderer import Cancelled, RenderSettings, render_frame
-from .export import ExportError, export_scene
+from .export import ExportError, export_scene, neighbour_frames
 
 MAX_REPORTED_WARNINGS = 12
 
@@ -82,6 +82,11 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
             self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
         settings = settings_from_scene(scene)
+        wants_vector = view_layer.use_pass_vector
+        wants_temporal = settings.integrator == "RESTIR" and settings.direct_method == "RESTIR" and settings.temporal_reuse
+        if wants_vector or wants_temporal:
+            self.update_stats("ReSTIR", "Evaluating neighbouring frames for motion")
+            neighbour_frames(self, depsgraph, core_scene, self.camera_override, need_next=wants_vector)
         t_export = time.perf_counter() - t0
 
         def progress(fraction, message):

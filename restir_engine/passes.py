@@ -14,6 +14,7 @@ PASSES = (
     ("Combined", "RGBA", "COLOR", lambda sc, vl: True, "Combined"),
     ("Depth", "Z", "VALUE", lambda sc, vl: vl.use_pass_z, "Depth"),
     ("Normal", "XYZ", "VECTOR", lambda sc, vl: vl.use_pass_normal, "Normal"),
+    ("Vector", "XYZW", "VECTOR", lambda sc, vl: vl.use_pass_vector, "Vector"),
     ("Direct", "RGB", "COLOR", lambda sc, vl: vl.restir.use_pass_direct, "Direct"),
     ("Indirect", "RGB", "COLOR", lambda sc, vl: vl.restir.use_pass_indirect, "Indirect"),
     ("Emission", "RGB", "COLOR", lambda sc, vl: vl.restir.use_pass_emission, "Emission"),

@@ -176,7 +176,8 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
             else:  # spatial reuse follows at frame level: hand over surfaces and reservoirs
                 rows = reservoir["rows"][idx]
                 depth = dot(s.p - camera_mod.position(cam), np.broadcast_to(camera_mod.forward(cam), s.p.shape))
-                reservoir["gbuf"].store(rows, s, depth)
+                inst = ctx.scene.geometry.instance
+                reservoir["gbuf"].store(rows, s, depth, None if inst is None else inst[s.prim])
                 frame_res = reservoir["res"]
                 for name in ("light", "b1", "b2", "M", "W", "p_hat"):
                     getattr(frame_res, name)[rows] = getattr(res, name)
@@ -248,18 +249,32 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
 
 def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     """First hit at raster points (x, y): planar depth along the camera axis (n,) (1e10 = nothing,
-    as Cycles) and the world-space shading normal facing the camera (n, 3) (zero = nothing)."""
+    as Cycles), the world-space shading normal facing the camera (n, 3) (zero = nothing) and the motion
+    vector (n, 4) in Blender's convention: (prev - current, current - next) raster positions in pixels
+    (zero without neighbouring-frame data or where nothing is hit)."""
     cam = ctx.scene.camera
     o, d, tmax = camera_mod.generate_rays(cam, x, y)
     hits = ctx.geom_accel.intersect(o, d, tmax)
     depth = np.full(len(x), 1e10, np.float32)
     normal = np.zeros((len(x), 3), np.float32)
+    vector = np.zeros((len(x), 4), np.float32)
     hit = np.flatnonzero(hits.prim >= 0)
     if hit.size:
         s = Surface(ctx, hits.prim[hit], hits.u[hit], hits.v[hit], o[hit], d[hit], hits.t[hit])
         depth[hit] = np.einsum("ij,j->i", s.p - camera_mod.position(cam), camera_mod.forward(cam))
         normal[hit] = s.ns
-    return depth, normal
+        motion = ctx.scene.motion
+        inst = ctx.scene.geometry.instance
+        if motion is not None and inst is not None:
+            here = np.stack([x[hit], y[hit]], axis=1)
+            for which, cols, sign in (("prev", slice(0, 2), 1.0), ("next", slice(2, 4), -1.0)):
+                other_cam = motion.camera_prev if which == "prev" else motion.camera_next
+                if other_cam is None:
+                    continue
+                moved = motion.moved_points(s.p, inst[s.prim], which)
+                raster, _z = camera_mod.project(other_cam, moved)
+                vector[hit, cols] = sign * (raster - here)
+    return depth, normal, np.where(np.isfinite(vector), vector, 0.0).astype(np.float32)
 
 
 def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False) -> TraceContext:

@@ -108,23 +108,25 @@ class FrameRenderer:
         self.history = None  # restir_di.TemporalHistory of the last sample pass
 
     def data_passes(self):
-        """Depth (h, w, 1) and Normal (h, w, 3) at pixel centres (one ray per pixel: no mixing of depths
-        at silhouettes, as Cycles)."""
+        """Depth (h, w, 1), Normal (h, w, 3) and Vector (h, w, 4) at pixel centres (one ray per pixel: no
+        mixing of depths at silhouettes, as Cycles)."""
         if self._data is None:
             x0, y0, w, h = self.ctx.scene.camera.window
             depth = np.empty((h, w, 1), np.float32)
             normal = np.empty((h, w, 3), np.float32)
+            vector = np.empty((h, w, 4), np.float32)
 
             def gbuffer_tile(tile):
                 tx, ty, tw, th = tile
                 cy, cx = np.mgrid[0:th, 0:tw]
-                dep, nrm = pathtracer.gbuffer(self.ctx, (x0 + tx + cx.ravel() + 0.5).astype(np.float32),
-                                              (y0 + ty + cy.ravel() + 0.5).astype(np.float32))
+                dep, nrm, vec = pathtracer.gbuffer(self.ctx, (x0 + tx + cx.ravel() + 0.5).astype(np.float32),
+                                                   (y0 + ty + cy.ravel() + 0.5).astype(np.float32))
                 depth[ty:ty + th, tx:tx + tw] = dep.reshape(th, tw, 1)
                 normal[ty:ty + th, tx:tx + tw] = nrm.reshape(th, tw, 3)
+                vector[ty:ty + th, tx:tx + tw] = vec.reshape(th, tw, 4)
 
             list(pool().map(gbuffer_tile, self.tiles))
-            self._data = (depth, normal)
+            self._data = (depth, normal, vector)
         return self._data
 
     def _run_tile(self, args):
@@ -196,8 +198,10 @@ class FrameRenderer:
         spans = [np.arange(a, min(w * h, a + st.tile_pixels)) for a in range(0, w * h, st.tile_pixels)]
         if st.temporal_reuse and self.history is not None:
             hist = self.history
+            # object motion applies between frames; sample passes of one frame share the same geometry
+            motion = self.ctx.scene.motion if hist.frame == st.frame - 1 else None
             parts = list(pool().map(lambda a: (a[1], restir_di.temporal_reuse(
-                self.ctx, self._gbuf, res, hist, w, a[1], st.confidence_cap, st.bias_correction,
+                self.ctx, self._gbuf, res, hist, w, a[1], st.confidence_cap, st.bias_correction, motion,
                 rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]))), enumerate(spans)))
             nxt = restir_di.Reservoirs.empty(w * h)
             for rows, part in parts:
@@ -227,7 +231,8 @@ class FrameRenderer:
         list(pool().map(shade, enumerate(spans)))
         # history keeps confidence at most the cap, so no reservoir's M ever exceeds it when reused
         capped = restir_di.Reservoirs(res.light, res.b1, res.b2, np.minimum(res.M, st.confidence_cap), res.W, res.p_hat)
-        self.history = restir_di.TemporalHistory(self._gbuf, capped, self.ctx.scene.camera, self.light_signature)
+        self.history = restir_di.TemporalHistory(self._gbuf, capped, self.ctx.scene.camera, self.light_signature,
+                                                 st.frame)
         for (tx, ty, tw, th), (_e, d, _i, _a, reservoir) in results:
             rows = reservoir["rows"]
             d += direct[rows]
@@ -244,8 +249,8 @@ class FrameRenderer:
     def passes(self) -> dict:
         """All passes (see :class:`FrameResult`); finite everywhere."""
         inv = 1.0 / max(1, self.samples_done)
-        depth, normal = self.data_passes()
-        out = {"Combined": self.combined(), "Depth": depth, "Normal": normal,
+        depth, normal, vector = self.data_passes()
+        out = {"Combined": self.combined(), "Depth": depth, "Normal": normal, "Vector": vector,
                "Direct": self.acc["direct"] * inv, "Indirect": self.acc["indirect"] * inv,
                "Emission": self.acc["emit"] * inv}
         if self.di is not None and self.di.method in ("RIS", "RESTIR"):

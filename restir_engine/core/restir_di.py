@@ -211,16 +211,19 @@ class GBuffer:
         self.p, self.ng, self.ns, self.t, self.bt, self.wo_l = f3(), f3(), f3(), f3(), f3(), f3()
         self.depth = np.zeros(n, np.float32)
         self.material = np.zeros(n, np.int32)
+        self.instance = np.zeros(n, np.int32)
         self.valid = np.zeros(n, bool)
         self.params = material_params.take(np.zeros(n, np.int64))  # placeholder rows, overwritten per hit
 
-    def store(self, rows: np.ndarray, surf, depth: np.ndarray):
+    def store(self, rows: np.ndarray, surf, depth: np.ndarray, instance: np.ndarray | None = None):
         for name in ("p", "ng", "ns", "t", "bt", "wo_l"):
             getattr(self, name)[rows] = getattr(surf, name)
         for name in ("diffuse", "f0", "f0_dielectric", "alpha", "p_spec", "spec_on"):
             getattr(self.params, name)[rows] = getattr(surf.params, name)
         self.depth[rows] = depth
         self.material[rows] = surf.mat
+        if instance is not None:
+            self.instance[rows] = instance
         self.valid[rows] = True
 
 
@@ -308,21 +311,27 @@ class TemporalHistory:
     res: Reservoirs
     camera: object
     light_signature: tuple
+    frame: int = 0
 
 
 def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, width: int, rows: np.ndarray,
-                   confidence_cap: float, bias_correction: str, rng: np.random.Generator) -> Reservoirs:
+                   confidence_cap: float, bias_correction: str, motion, rng: np.random.Generator) -> Reservoirs:
     """Merge each pixel's reservoir with the reservoir its primary hit had in the previous pass/frame.
 
-    The hit is reprojected with the previous camera (static geometry; moving objects are caught by the
-    G-buffer tests: depth within 10 %, normals within 25°, same material). The previous confidence is
+    The hit is moved with its object's previous transform (``motion``: scene.Motion, or None between
+    sample passes of one frame) and projected with the previous camera; the match must pass the G-buffer
+    tests (depth within 10 %, normals within 25°, same material), else it is a disocclusion. The previous
+    confidence is
     capped at ``confidence_cap`` x the current one. NONE: W = Σw / (p̂ ΣM); UNBIASED: W = Σw / (p̂ Z),
     Z counting the previous reservoir only where its own target (at its stored surface) is non-zero."""
     from .camera import project
     n = len(rows)
     me = _SurfaceRows(gb, rows)
     x0, y0, w, h = hist.camera.window
-    raster, depth_prev_cam = project(hist.camera, gb.p[rows])
+    p_then = gb.p[rows]
+    if motion is not None:
+        p_then = motion.moved_points(p_then, gb.instance[rows], "prev")
+    raster, depth_prev_cam = project(hist.camera, p_then)
     px = np.floor(raster[:, 0]).astype(np.int64) - x0
     py = np.floor(raster[:, 1]).astype(np.int64) - y0
     inside = (px >= 0) & (px < w) & (py >= 0) & (py < h) & (depth_prev_cam > 0) & gb.valid[rows]

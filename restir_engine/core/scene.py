@@ -25,6 +25,7 @@ class TriangleSet:
     normals: np.ndarray
     material: np.ndarray
     uvs: np.ndarray | None = None
+    instance: np.ndarray | None = None  # (n,) int32 index into Scene.motion's instance matrices
 
     @staticmethod
     def empty() -> TriangleSet:
@@ -128,6 +129,28 @@ class Camera:
 
 
 @dataclass
+class Motion:
+    """Object and camera transforms of the neighbouring frames, for motion vectors.
+
+    current (k, 4, 4): each instance's world matrix now; prev / next (k, 4, 4): the same instances one
+    frame before / after (equal to current where an instance does not exist then: it has no motion);
+    camera_prev / camera_next: the camera then (None = unknown)."""
+
+    current: np.ndarray
+    prev: np.ndarray
+    next: np.ndarray
+    camera_prev: object = None
+    camera_next: object = None
+
+    def moved_points(self, points: np.ndarray, instance: np.ndarray, which: str) -> np.ndarray:
+        """World positions (n, 3) that surface points on ``instance`` have in the 'prev' or 'next' frame."""
+        other = self.prev if which == "prev" else self.next
+        xform = np.einsum("nij,njk->nik", other, np.linalg.inv(self.current))[instance]  # other · current⁻¹
+        p = points.astype(np.float64)
+        return (np.einsum("nij,nj->ni", xform[:, :3, :3], p) + xform[:, :3, 3]).astype(np.float32)
+
+
+@dataclass
 class Scene:
     geometry: TriangleSet
     materials: MaterialTable
@@ -135,3 +158,4 @@ class Scene:
     camera: Camera
     world_radiance: np.ndarray = field(default_factory=lambda: np.zeros(3, np.float32))
     warnings: list = field(default_factory=list)
+    motion: Motion | None = None

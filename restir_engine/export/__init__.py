@@ -6,14 +6,41 @@ from __future__ import annotations
 
 import time
 
-from ..core.scene import Scene
+import numpy as np
+
+from ..core.scene import Motion, Scene
 from .camera import ExportError, export_camera
 from .lights import export_lamps
 from .materials import MaterialRegistry
-from .meshes import export_geometry
+from .meshes import export_geometry, instance_matrices
 from .world import export_world
 
-__all__ = ["ExportError", "export_scene"]
+__all__ = ["ExportError", "export_scene", "neighbour_frames"]
+
+
+def neighbour_frames(engine, depsgraph, scene_out: Scene, camera_override=None, need_next=True):
+    """Fill ``scene_out.motion`` by evaluating the frames before and after (``engine.frame_set``) and
+    restoring the current one. Instances missing in a neighbouring frame keep their current matrix."""
+    scene = depsgraph.scene
+    frame = scene.frame_current
+    keys = scene_out.export_stats["instance_keys"]
+    current = scene_out.export_stats["instance_matrices"]
+    found = {}
+    for which, f in (("prev", frame - 1), ("next", frame + 1)):
+        if which == "next" and not need_next:
+            continue
+        engine.frame_set(f, subframe=0.0)
+        mats = instance_matrices(depsgraph)
+        arr = np.array([mats.get(k, current[i]) for i, k in enumerate(keys)]).reshape(-1, 4, 4)
+        try:
+            cam = export_camera(depsgraph, camera_override, [])
+        except ExportError:
+            cam = None
+        found[which] = (arr, cam)
+    engine.frame_set(frame, subframe=0.0)
+    prev, cam_prev = found["prev"]
+    nxt, cam_next = found.get("next", (current.copy(), None))
+    scene_out.motion = Motion(current=current, prev=prev, next=nxt, camera_prev=cam_prev, camera_next=cam_next)
 
 
 def export_scene(depsgraph, camera_override=None, camera=None) -> Scene:

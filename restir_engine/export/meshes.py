@@ -49,8 +49,25 @@ def _read_mesh(mesh, want_uv: bool) -> dict | None:
     return {"verts": co.reshape(-1, 3)[vidx].reshape(nt, 3, 3), "normals": nrm, "uvs": uvs, "slot": slot}
 
 
+def instance_key(inst) -> tuple:
+    """A key that names the same object instance in neighbouring frames (for motion vectors)."""
+    parent = inst.parent.original.name if inst.is_instance and inst.parent is not None else ""
+    return (inst.object.original.name if inst.object.original is not None else inst.object.name, parent,
+            tuple(inst.persistent_id) if inst.is_instance else ())
+
+
+def instance_matrices(depsgraph) -> dict:
+    """World matrices (4x4 float64) of every visible geometry instance, by :func:`instance_key`."""
+    out = {}
+    for inst in depsgraph.object_instances:
+        if inst.object.type in GEOMETRY_TYPES and inst.show_self:
+            out[instance_key(inst)] = np.array(inst.matrix_world, np.float64)
+    return out
+
+
 def export_geometry(depsgraph, registry, warnings: list):
-    """Returns (TriangleSet, stats dict)."""
+    """Returns (TriangleSet, stats dict); the TriangleSet's ``instance`` holds each triangle's index into
+    ``stats["instance_keys"]`` / ``stats["instance_matrices"]``."""
     blocks: list[tuple] = []  # (local arrays, matrix, material index map)
     cache: dict = {}
     slot_cache: dict = {}
@@ -82,18 +99,21 @@ def export_geometry(depsgraph, registry, warnings: list):
         arrays = cache[key]
         if arrays is None:
             continue
-        blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name))
+        blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name,
+                       instance_key(inst)))
 
     if not blocks:
-        return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0}
+        return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0, "instance_keys": [],
+                                     "instance_matrices": np.zeros((0, 4, 4))}
     total = sum(len(b[0]["verts"]) for b in blocks)
     verts = np.empty((total, 3, 3), np.float32)
     normals = np.empty((total, 3, 3), np.float32)
     material = np.empty(total, np.int32)
+    instance = np.empty(total, np.int32)
     need_uv = any(b[0]["uvs"] is not None for b in blocks)
     uvs = np.zeros((total, 3, 2), np.float32) if need_uv else None
     at = 0
-    for arrays, m, slot_map, _name in blocks:  # loop over instances, each vectorized over its triangles
+    for k, (arrays, m, slot_map, _name, _key) in enumerate(blocks):  # per instance, vectorized over triangles
         n = len(arrays["verts"])
         lin = m[:3, :3]
         verts[at:at + n] = (arrays["verts"].reshape(-1, 3) @ lin.T + m[:3, 3]).reshape(n, 3, 3)
@@ -105,6 +125,7 @@ def export_geometry(depsgraph, registry, warnings: list):
         nn /= np.maximum(np.linalg.norm(nn, axis=1), 1e-30)[:, None]
         normals[at:at + n] = nn.reshape(n, 3, 3)
         material[at:at + n] = slot_map[np.clip(arrays["slot"], 0, len(slot_map) - 1)]
+        instance[at:at + n] = k
         if uvs is not None and arrays["uvs"] is not None:
             uvs[at:at + n] = arrays["uvs"]
         at += n
@@ -121,13 +142,14 @@ def export_geometry(depsgraph, registry, warnings: list):
     if n_degenerate:
         warnings.append(f"{n_degenerate} zero-area triangles were skipped")
     if not keep.all():
-        verts, normals, material = verts[keep], normals[keep], material[keep]
+        verts, normals, material, instance = verts[keep], normals[keep], material[keep], instance[keep]
         uvs = uvs[keep] if uvs is not None else None
     bad_n = ~np.isfinite(normals).all(axis=2)
     if bad_n.any():
         normals[bad_n] = 0.0  # the shader falls back to the geometric normal
-    stats = {"triangles": len(verts), "instances": len(blocks), "dropped": int((~keep).sum())}
-    return TriangleSet(verts, normals, material, uvs), stats
+    stats = {"triangles": len(verts), "instances": len(blocks), "dropped": int((~keep).sum()),
+             "instance_keys": [b[4] for b in blocks], "instance_matrices": np.array([b[1] for b in blocks])}
+    return TriangleSet(verts, normals, material, uvs, instance), stats
 
 
 def _spans(blocks):

@@ -102,6 +102,7 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col = layout.column(heading="Data", align=True)
         col.prop(vl, "use_pass_z")
         col.prop(vl, "use_pass_normal")
+        col.prop(vl, "use_pass_vector")
         col = layout.column(heading="Light", align=True)
         col.prop(vl.restir, "use_pass_direct")
         col.prop(vl.restir, "use_pass_indirect")
