@@ -146,3 +146,27 @@ def test_temporal_reuse_over_frames_is_unbiased_and_caps_confidence():
     ma, mb = a.mean(axis=(1, 2)), b.mean(axis=(1, 2))
     se = np.sqrt(ma.var(ddof=1) / len(ma) + mb.var(ddof=1) / len(mb))
     assert abs(ma.mean() - mb.mean()) < 5 * se, (ma.mean(), mb.mean(), se)
+
+
+def test_light_switched_off_leaves_no_energy_in_the_next_frame():
+    """A light that goes out changes the light table: the history is dropped (lag 0 frames) and the next
+    frame's direct light matches the path tracer of the new scene."""
+    from scenes_core import concat, quad, tris
+    on = floor_with_emitter(width=32)
+    second = tris(quad((0.6, 0.0, 0.8), (0, 0.2, 0), (0.2, 0, 0)), 1)
+    on.geometry = concat([on.geometry, second])
+    off = floor_with_emitter(width=32)  # the second emitter is gone
+    st = dict(samples=1, max_bounces=0, integrator="RESTIR", direct_method="RESTIR", light_candidates=4,
+              spatial_radius=6)
+    finals = []
+    for rep in range(8):
+        hist = None
+        for frame in range(3):
+            hist = render_frame(on, RenderSettings(**st, seed=rep, frame=frame), history=hist).history
+        r = render_frame(off, RenderSettings(**st, seed=rep, frame=3), history=hist)
+        assert r.passes["Reservoir M"].max() <= 1.0 + 5.0  # own + at most 5 spatial neighbours: no history
+        finals.append(r.passes["Combined"][..., 0].mean())
+    ref = [render_frame(off, RenderSettings(samples=1, max_bounces=0, seed=40 + s)).passes["Combined"][..., 0].mean()
+           for s in range(8)]
+    se = np.sqrt(np.var(finals, ddof=1) / len(finals) + np.var(ref, ddof=1) / len(ref))
+    assert abs(np.mean(finals) - np.mean(ref)) < 5 * se, (np.mean(finals), np.mean(ref), se)
