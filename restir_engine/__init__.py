@@ -9,8 +9,9 @@ from __future__ import annotations
 def register():
     import bpy
 
-    from . import engine, properties, ui
+    from . import engine, presets, properties, ui
     properties.register()
+    presets.register()
     bpy.utils.register_class(engine.RestirRenderEngine)
     ui.register()
 
@@ -18,7 +19,8 @@ def register():
 def unregister():
     import bpy
 
-    from . import engine, properties, ui
+    from . import engine, presets, properties, ui
     ui.unregister()
     bpy.utils.unregister_class(engine.RestirRenderEngine)
+    presets.unregister()
     properties.unregister()

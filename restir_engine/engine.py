@@ -70,6 +70,15 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         t0 = time.perf_counter()
+        settings = settings_from_scene(scene)
+        wants_temporal = settings.integrator == "RESTIR" and settings.direct_method == "RESTIR" and settings.temporal_reuse
+        key = (scene.name, view_layer.name)
+        prev = _TEMPORAL_HISTORY.pop(key, None)
+        history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None
+        if wants_temporal and history is None and scene.restir.preroll_frames > 0:
+            history = self._preroll(depsgraph, settings, int(scene.restir.preroll_frames))
+            if history is None:  # cancelled
+                return
         self.update_stats("ReSTIR", "Exporting scene")
         try:
             core_scene = export_scene(depsgraph, self.camera_override)
@@ -81,9 +90,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, msg)
         if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
             self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
-        settings = settings_from_scene(scene)
         wants_vector = view_layer.use_pass_vector
-        wants_temporal = settings.integrator == "RESTIR" and settings.direct_method == "RESTIR" and settings.temporal_reuse
         if wants_vector or wants_temporal:
             self.update_stats("ReSTIR", "Evaluating neighbouring frames for motion")
             neighbour_frames(self, depsgraph, core_scene, self.camera_override, need_next=wants_vector)
@@ -93,9 +100,6 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.update_progress(fraction)
             self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {message}")
 
-        key = (scene.name, view_layer.name)
-        prev = _TEMPORAL_HISTORY.pop(key, None)
-        history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None
         try:
             result = render_frame(core_scene, settings, progress=progress, should_stop=self.test_break,
                                   history=history)
@@ -111,6 +115,28 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                                 frame=scene.frame_current, cancelled=result.cancelled, **result.stats)
         self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {result.samples_done} samples | "
                                     f"export {t_export:.2f}s, render {result.seconds:.2f}s")
+
+    def _preroll(self, depsgraph, settings, count: int):
+        """Render frames F-count .. F-1 (one sample each, not written) to build the temporal history a
+        sequential render would have at frame F. Returns the history, or None when cancelled."""
+        from dataclasses import replace
+        scene = depsgraph.scene
+        frame = scene.frame_current
+        history = None
+        for f in range(frame - count, frame):
+            if self.test_break():
+                self.frame_set(frame, subframe=0.0)
+                return None
+            self.update_stats("ReSTIR", f"Preroll frame {f} for frame {frame}")
+            self.frame_set(f, subframe=0.0)
+            try:
+                core = export_scene(depsgraph, self.camera_override)
+                neighbour_frames(self, depsgraph, core, self.camera_override, need_next=False)
+                history = render_frame(core, replace(settings, samples=1, frame=f), history=history).history
+            except (ExportError, Cancelled):
+                history = None
+        self.frame_set(frame, subframe=0.0)
+        return history
 
     # -- viewport (Rendered shading) ----------------------------------------------------------
     def view_update(self, context, depsgraph):

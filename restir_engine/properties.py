@@ -37,6 +37,10 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
     temporal_reuse: BoolProperty(name="Temporal Reuse", description="Reuse the reservoir the pixel's surface had "
                                  "in the previous sample pass, and in the previous frame of an animation",
                                  default=True)
+    preroll_frames: IntProperty(name="Preroll Frames", description="When a render starts without the previous "
+                                "frame's history (first frame of a farm chunk, a single frame), render this many "
+                                "frames before it first, unsaved, so it looks as in a sequential render",
+                                default=3, min=0, soft_max=16)
     confidence_cap: FloatProperty(name="Confidence Cap", description="Largest confidence M a reused reservoir keeps",
                                   default=20.0, min=1.0, soft_max=100.0)
     spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring reservoirs merged per spatial pass",

@@ -139,7 +139,7 @@ def test_animation_carries_temporal_history_between_frames(addon, tmp_path):
     from harness.render import read_exr
     scene = cornell_box("AREA", (24, 24))
     configure_restir(scene, 1, 0, integrator="RESTIR", direct_method="RESTIR", spatial_neighbors=0,
-                     confidence_cap=2.0)
+                     confidence_cap=2.0, preroll_frames=0)
     scene.view_layers[0].restir.use_pass_reservoir_m = True
     settings = scene.render.image_settings
     if hasattr(settings, "media_type"):
@@ -183,3 +183,18 @@ def test_vector_pass_matches_cycles(addon):
     v_ours, v_ref = ours["Vector"][flat], ref["Vector"][flat]
     assert np.abs(v_ref).max() > 0.5  # there is motion to compare
     assert np.allclose(v_ours, v_ref, atol=0.02), np.abs(v_ours - v_ref).max()
+
+
+def test_preroll_builds_history_for_a_chunk_start(addon):
+    """A render that starts mid-animation without history prerolls the frames before it, so its
+    reservoirs carry history (confidence above one) as in a sequential render."""
+    scene = cornell_box("AREA", (24, 24))
+    configure_restir(scene, 1, 0, integrator="RESTIR", direct_method="RESTIR", spatial_neighbors=0)
+    scene.view_layers[0].restir.use_pass_reservoir_m = True
+    scene.frame_current = 20
+    scene.restir.preroll_frames = 0
+    assert render_passes(scene)["Reservoir M"].max() <= 1.0
+    scene.frame_current = 40
+    scene.restir.preroll_frames = 3
+    m = render_passes(scene)["Reservoir M"][..., 0]
+    assert m.max() > 3.0 and m.max() <= 4.0 + 1e-5  # three preroll frames + this frame's own reservoir

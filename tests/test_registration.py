@@ -61,3 +61,13 @@ def test_unregister_and_register_again(addon):
         addon.register()
     assert hasattr(bpy.types.Scene, "restir")
     bpy.context.scene.render.engine = "RESTIR"
+
+
+def test_presets_set_the_settings(addon):
+    s = bpy.context.scene.restir
+    bpy.ops.restir.apply_preset(preset="UNBIASED")
+    assert (s.integrator, s.direct_method, s.bias_correction, s.temporal_reuse) == ("RESTIR", "RESTIR", "UNBIASED", True)
+    bpy.ops.restir.apply_preset(preset="FAST")
+    assert (s.bias_correction, s.light_candidates, s.samples) == ("NONE", 8, 4)
+    bpy.ops.restir.apply_preset(preset="REFERENCE")
+    assert (s.integrator, s.samples) == ("PATH", 256)

@@ -56,6 +56,10 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
         layout.use_property_split = True
         layout.use_property_decorate = False
         s = context.scene.restir
+        row = layout.row(align=True)
+        for key, label in (("FAST", "Fast"), ("BALANCED", "Balanced"), ("UNBIASED", "Unbiased"),
+                           ("REFERENCE", "Reference")):
+            row.operator("restir.apply_preset", text=label).preset = key
         layout.prop(s, "integrator")
         col = layout.column(align=True)
         col.prop(s, "samples")
@@ -72,6 +76,7 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
                 sub = col.column()
                 sub.active = s.temporal_reuse
                 sub.prop(s, "confidence_cap")
+                sub.prop(s, "preroll_frames")
                 col = layout.column(align=True, heading="Spatial Reuse")
                 col.prop(s, "spatial_neighbors")
                 col.prop(s, "spatial_radius")

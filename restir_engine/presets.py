@@ -1,0 +1,49 @@
+"""Render presets (Sampling panel): one click sets the ReSTIR settings to a tested combination."""
+from __future__ import annotations
+
+import bpy
+from bpy.props import EnumProperty
+
+PRESETS = {
+    "FAST": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 4, "light_candidates": 8,
+             "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 3,
+             "preroll_frames": 2, "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE"},
+    "BALANCED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
+                 "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 5,
+                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE"},
+    "UNBIASED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
+                 "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 5,
+                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "UNBIASED"},
+    "REFERENCE": {"integrator": "PATH", "samples": 256},
+}
+
+
+def apply_preset(settings, name: str) -> None:
+    for key, value in PRESETS[name].items():
+        setattr(settings, key, value)
+
+
+class RESTIR_OT_apply_preset(bpy.types.Operator):
+    """Set the ReSTIR render settings to a preset"""
+
+    bl_idname = "restir.apply_preset"
+    bl_label = "Apply ReSTIR Preset"
+    bl_options = {"REGISTER", "UNDO"}
+
+    preset: EnumProperty(items=[
+        ("FAST", "Fast", "Biased ReSTIR, 8 light candidates, 3 neighbours, 4 samples"),
+        ("BALANCED", "Balanced", "Biased ReSTIR (1/M), 32 candidates, 5 neighbours, 16 samples"),
+        ("UNBIASED", "Unbiased", "Unbiased ReSTIR (1/Z): converges to the path tracer"),
+        ("REFERENCE", "Reference", "The path tracer at 256 samples")])
+
+    def execute(self, context):
+        apply_preset(context.scene.restir, self.preset)
+        return {"FINISHED"}
+
+
+def register():
+    bpy.utils.register_class(RESTIR_OT_apply_preset)
+
+
+def unregister():
+    bpy.utils.unregister_class(RESTIR_OT_apply_preset)
