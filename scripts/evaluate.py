@@ -19,7 +19,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--mode", choices=("quick", "full"), default="quick")
     ap.add_argument("--methods", nargs="*")
-    ap.add_argument("--scenes", nargs="*")
+    ap.add_argument("--scenes", nargs="*", help="scene names (all their variants) or slugs such as many_lights-10k-direct")
     ap.add_argument("--refresh-references", action="store_true", help="re-render the cached Cycles references")
     ap.add_argument("--out")
     ap.add_argument("--no-animation", action="store_true")

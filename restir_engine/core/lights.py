@@ -68,6 +68,11 @@ class LightSample:
     pdf: np.ndarray
     delta: np.ndarray
 
+    @staticmethod
+    def zeros(n: int) -> "LightSample":
+        return LightSample(np.zeros((n, 3), np.float32), np.zeros((n, 3), np.float32), np.zeros(n, np.float32),
+                           np.zeros((n, 3), np.float32), np.zeros(n, np.float32), np.zeros(n, bool))
+
 
 class LightTable:
     def __init__(self, scene: Scene, scene_radius: float):
@@ -155,14 +160,10 @@ class LightTable:
         """Pick one light per point p (n, 3) with power-proportional probability and a point on it.
         ``u`` is (n, 4) uniforms."""
         n = len(p)
-        pos = np.zeros((n, 3), np.float32)
-        wi = np.zeros((n, 3), np.float32)
-        dist = np.zeros(n, np.float32)
-        le = np.zeros((n, 3), np.float32)
-        pdf = np.zeros(n, np.float32)
-        delta = np.zeros(n, bool)
+        out = LightSample.zeros(n)
+        pos, wi, dist, le, pdf, delta = out.pos, out.wi, out.dist, out.le, out.pdf, out.delta
         if self.alias is None or n == 0:
-            return LightSample(pos, wi, dist, le, pdf, delta)
+            return out
         light = self.alias.sample(u[:, 0], u[:, 1])
         tri = light < self.n_tri
         if tri.any():
@@ -179,21 +180,17 @@ class LightTable:
         sun = ~tri
         if sun.any():
             self._sun_sample(light[sun] - self.n_tri, self.alias.pdf[light[sun]], u[sun], sun, wi, dist, le, pdf, delta)
-        return LightSample(pos, wi, dist, le, pdf, delta)
+        return out
 
     def sample_suns(self, n: int, u: np.ndarray) -> LightSample:
         """One sun per point, chosen by power among suns only (ReSTIR's companion to resampled
         triangle lights). ``u`` is (n, 4) uniforms; all samples are flagged ``delta`` (no MIS)."""
-        pos = np.zeros((n, 3), np.float32)
-        wi = np.zeros((n, 3), np.float32)
-        dist = np.zeros(n, np.float32)
-        le = np.zeros((n, 3), np.float32)
-        pdf = np.zeros(n, np.float32)
-        delta = np.zeros(n, bool)
+        out = LightSample.zeros(n)
         if self.sun_alias is not None and n:
             s = self.sun_alias.sample(u[:, 0], u[:, 1])
-            self._sun_sample(s, self.sun_alias.pdf[s], u, np.ones(n, bool), wi, dist, le, pdf, delta)
-        return LightSample(pos, wi, dist, le, pdf, delta)
+            self._sun_sample(s, self.sun_alias.pdf[s], u, np.ones(n, bool), out.wi, out.dist, out.le, out.pdf,
+                             out.delta)
+        return out
 
     def _sun_sample(self, s, p_sel, u, sun, wi, dist, le, pdf, delta):
         """Fill rows ``sun`` of the output arrays with a direction in sun ``s``'s cone."""

@@ -178,9 +178,7 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
                 depth = dot(s.p - camera_mod.position(cam), np.broadcast_to(camera_mod.forward(cam), s.p.shape))
                 inst = ctx.scene.geometry.instance
                 reservoir["gbuf"].store(rows, s, depth, None if inst is None else inst[s.prim])
-                frame_res = reservoir["res"]
-                for name in ("light", "b1", "b2", "M", "W", "p_hat"):
-                    getattr(frame_res, name)[rows] = getattr(res, name)
+                reservoir["res"].assign(rows, res)
         # --- next-event estimation -------------------------------------------------------
         elif not ctx.lights.empty:
             ls = ctx.lights.sample(s.p, rng.random((idx.size, 4), dtype=np.float32))

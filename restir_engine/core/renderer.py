@@ -203,20 +203,12 @@ class FrameRenderer:
             parts = list(pool().map(lambda a: (a[1], restir_di.temporal_reuse(
                 self.ctx, self._gbuf, res, hist, w, a[1], st.confidence_cap, st.bias_correction, motion,
                 rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]))), enumerate(spans)))
-            nxt = restir_di.Reservoirs.empty(w * h)
-            for rows, part in parts:
-                for name in ("light", "b1", "b2", "M", "W", "p_hat"):
-                    getattr(nxt, name)[rows] = getattr(part, name)
-            res = nxt
+            res = restir_di.Reservoirs.gather(parts, w * h)
         for k in range(self.spatial.passes if self.spatial.neighbors else 0):
             parts = list(pool().map(lambda a: (a[1], restir_di.spatial_reuse(
                 self.ctx, self._gbuf, res, w, h, a[1], self.spatial,
                 rng(st.seed, st.frame, s, STREAM_SPATIAL + k, a[0]))), enumerate(spans)))
-            nxt = restir_di.Reservoirs.empty(w * h)
-            for rows, part in parts:
-                for name in ("light", "b1", "b2", "M", "W", "p_hat"):
-                    getattr(nxt, name)[rows] = getattr(part, name)
-            res = nxt
+            res = restir_di.Reservoirs.gather(parts, w * h)
         direct = np.zeros((w * h, 3), np.float32)
 
         def shade(a):

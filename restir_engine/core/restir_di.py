@@ -50,10 +50,25 @@ class Reservoirs:
     W: np.ndarray
     p_hat: np.ndarray
 
+    FIELDS = ("light", "b1", "b2", "M", "W", "p_hat")
+
     @staticmethod
     def empty(n: int) -> "Reservoirs":
         z = np.zeros(n, np.float32)
         return Reservoirs(np.full(n, -1, np.int32), z.copy(), z.copy(), z.copy(), z.copy(), z.copy())
+
+    def assign(self, rows: np.ndarray, other: "Reservoirs") -> None:
+        """self[rows] = other (all fields)."""
+        for name in Reservoirs.FIELDS:
+            getattr(self, name)[rows] = getattr(other, name)
+
+    @staticmethod
+    def gather(parts, n: int) -> "Reservoirs":
+        """A frame of n reservoirs from (rows, Reservoirs) parts."""
+        out = Reservoirs.empty(n)
+        for rows, part in parts:
+            out.assign(rows, part)
+        return out
 
 
 def _target(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l: np.ndarray):

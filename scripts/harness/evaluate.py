@@ -126,7 +126,7 @@ def run(mode: str, out_dir: str, method_keys=None, scenes=None, refresh=False, l
         animation=True, growth=True) -> dict:
     quick = mode == "quick"
     methods = by_key(method_keys)
-    specs = [s for s in (QUICK if quick else FULL) if scenes is None or s.name in scenes]
+    specs = [s for s in (QUICK if quick else FULL) if scenes is None or s.name in scenes or s.slug in scenes]
     os.makedirs(out_dir, exist_ok=True)
     summary = {"mode": mode, "scenes": [], "target_relmse": TARGET_RELMSE}
     lines = ["| scene | method | relMSE at equal time | time to relMSE %.2g | bias (highest spp) | FLIP |" % TARGET_RELMSE,

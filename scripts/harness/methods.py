@@ -37,8 +37,16 @@ METHODS = [
     Method("restir_biased", "ReSTIR DI temporal + spatial, biased (1/M)", "RESTIR",
            {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "NONE", "spatial_radius": 8.0},
            (1, 2, 4), (1, 2, 4, 8, 16, 32), "C3"),
+    # candidate-count sweep (M_light) for ReSTIR DI temporal + spatial, unbiased
+    *[Method(f"restir_m{m}", f"ReSTIR DI, M_light = {m}", "RESTIR",
+             {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "spatial_radius": 8.0,
+              "light_candidates": m}, (1, 2), (1, 2, 4, 8, 16), f"C{5 + i}") for i, m in enumerate((1, 4, 16, 64))],
 ]
+
+# the default evaluation runs these; the sweep entries are picked with --methods
+DEFAULT_KEYS = ("cycles", "path", "ris", "restir_spatial", "restir", "restir_biased")
 
 
 def by_key(keys=None):
-    return [m for m in METHODS if keys is None or m.key in keys]
+    keys = DEFAULT_KEYS if keys is None else keys
+    return [m for m in METHODS if m.key in keys]
