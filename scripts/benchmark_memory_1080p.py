@@ -1,0 +1,46 @@
+"""Peak memory and time of one 1920x1080 ReSTIR frame of the demo scene (issue target: RSS under 4 GB).
+
+Prints and writes docs/results/memory_1080p.json. Usage: python scripts/benchmark_memory_1080p.py
+"""
+from __future__ import annotations
+
+import json
+import os
+import resource
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+
+import bpy  # noqa: E402
+
+import restir_engine  # noqa: E402
+from make_demo_scene import build_demo  # noqa: E402
+from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
+from restir_engine.export import export_scene  # noqa: E402
+
+
+def peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: kilobytes
+
+
+def main():
+    if not hasattr(bpy.types.Scene, "restir"):
+        restir_engine.register()
+    build_demo(resolution=(1920, 1080))
+    scene = export_scene(bpy.context.evaluated_depsgraph_get())
+    before = peak_mb()
+    t0 = time.perf_counter()
+    render_frame(scene, RenderSettings(samples=1, max_bounces=1, integrator="RESTIR", direct_method="RESTIR"))
+    out = {"resolution": [1920, 1080], "method": "ReSTIR (RIS + spatial), 1 spp, 1 bounce",
+           "seconds": time.perf_counter() - t0, "peak_rss_mb": peak_mb(), "rss_before_render_mb": before}
+    path = os.path.join(ROOT, "docs", "results", "memory_1080p.json")
+    with open(path, "w") as f:
+        json.dump(out, f, indent=2)
+    print(json.dumps(out, indent=2))
+
+
+if __name__ == "__main__":
+    main()
