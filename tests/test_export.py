@@ -116,6 +116,19 @@ def test_unsupported_node_is_approximated_and_reported(scene):
     assert any("Glass" in w and "not supported" in w for w in s.warnings)
 
 
+def textured_plane(img, socket: str, name="Tex"):
+    """A plane whose Principled BSDF input ``socket`` is driven by an Image Texture of ``img``."""
+    bpy.ops.mesh.primitive_plane_add()
+    m = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
+    t = m.node_tree.nodes.new("ShaderNodeTexImage")
+    t.image = img
+    m.node_tree.links.new(t.outputs["Color"], m.node_tree.nodes["Principled BSDF"].inputs[socket])
+    bpy.context.active_object.data.materials.append(m)
+    return m
+
+
 def test_image_texture_feeds_base_color(scene):
     img = bpy.data.images.new("checker", 4, 2, alpha=False, float_buffer=True)
     img.colorspace_settings.name = "Linear Rec.709"
@@ -124,14 +137,7 @@ def test_image_texture_feeds_base_color(scene):
     px[:, :2, 0] = 1.0  # left half red, right half blue
     px[:, 2:, 2] = 1.0
     img.pixels.foreach_set(px.ravel())
-    bpy.ops.mesh.primitive_plane_add()
-    m = bpy.data.materials.new("Tex")
-    if bpy.app.version < (5, 0, 0):
-        m.use_nodes = True
-    t = m.node_tree.nodes.new("ShaderNodeTexImage")
-    t.image = img
-    m.node_tree.links.new(t.outputs["Color"], m.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
-    bpy.context.active_object.data.materials.append(m)
+    textured_plane(img, "Base Color")
     s = export()
     i = s.geometry.material[0]
     assert s.materials.base_tex[i] == 0 and s.geometry.uvs is not None
@@ -146,14 +152,7 @@ def test_image_texture_feeds_base_color(scene):
 def test_srgb_byte_image_is_linearized(scene):
     img = bpy.data.images.new("grey", 1, 1)
     img.pixels.foreach_set(np.array([0.5, 0.5, 0.5, 1], np.float32))
-    bpy.ops.mesh.primitive_plane_add()
-    m = bpy.data.materials.new("Tex")
-    if bpy.app.version < (5, 0, 0):
-        m.use_nodes = True
-    t = m.node_tree.nodes.new("ShaderNodeTexImage")
-    t.image = img
-    m.node_tree.links.new(t.outputs["Color"], m.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
-    bpy.context.active_object.data.materials.append(m)
+    textured_plane(img, "Base Color")
     s = export()
     assert np.allclose(s.materials.textures[0], ((0.5 + 0.055) / 1.055) ** 2.4, atol=0.01)
 
@@ -220,16 +219,9 @@ def test_metaball_and_emission_texture(scene):
     img = bpy.data.images.new("glow", 2, 2, float_buffer=True)
     img.colorspace_settings.name = "Linear Rec.709"
     img.pixels.foreach_set(np.tile(np.array([0.5, 0.25, 1.0, 1.0], np.float32), 4))
-    bpy.ops.mesh.primitive_plane_add(location=(3, 0, 0))
-    m = bpy.data.materials.new("Glow")
-    if bpy.app.version < (5, 0, 0):
-        m.use_nodes = True
-    bsdf = m.node_tree.nodes["Principled BSDF"]
-    t = m.node_tree.nodes.new("ShaderNodeTexImage")
-    t.image = img
-    m.node_tree.links.new(t.outputs["Color"], bsdf.inputs["Emission Color"])
-    bsdf.inputs["Emission Strength"].default_value = 2.0
-    bpy.context.active_object.data.materials.append(m)
+    m = textured_plane(img, "Emission Color", "Glow")
+    bpy.context.active_object.location = (3, 0, 0)
+    m.node_tree.nodes["Principled BSDF"].inputs["Emission Strength"].default_value = 2.0
     s = export()
     assert len(s.geometry) > 100  # the metaball's evaluated mesh plus the plane
     i = s.materials.names.index("Glow")
