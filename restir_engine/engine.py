@@ -143,7 +143,6 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         """Blender's thread: export the scene; the worker thread renders it."""
         from .viewport import ViewportSession, view_camera
         scene = depsgraph.scene
-        region = context.region
         if self._viewport is None:
             self._viewport = ViewportSession(self.tag_redraw)
         w, h = self._view_size(context)
@@ -159,7 +158,6 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         settings.tile_pixels = 4096  # small tiles: the view reacts quickly to navigation
         self._viewport.set_scene(core_scene, settings)
         self._viewport.set_view(cam, self._view_key(context, w, h))
-        del region
 
     def _view_size(self, context):
         pixel = max(1, int(self.get_preview_pixel_size(context.scene))) * 2  # half resolution for speed
