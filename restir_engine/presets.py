@@ -23,6 +23,13 @@ def apply_preset(settings, name: str) -> None:
         setattr(settings, key, value)
 
 
+PRESET_ITEMS = [
+    ("FAST", "Fast", "Biased ReSTIR, 8 light candidates, 3 neighbours, 4 samples"),
+    ("BALANCED", "Balanced", "Biased ReSTIR (1/M), 32 candidates, 5 neighbours, 16 samples"),
+    ("UNBIASED", "Unbiased", "Unbiased ReSTIR (1/Z): converges to the path tracer"),
+    ("REFERENCE", "Reference", "The path tracer at 256 samples")]
+
+
 class RESTIR_OT_apply_preset(bpy.types.Operator):
     """Set the ReSTIR render settings to a preset"""
 
@@ -30,11 +37,7 @@ class RESTIR_OT_apply_preset(bpy.types.Operator):
     bl_label = "Apply ReSTIR Preset"
     bl_options = {"REGISTER", "UNDO"}
 
-    preset: EnumProperty(items=[
-        ("FAST", "Fast", "Biased ReSTIR, 8 light candidates, 3 neighbours, 4 samples"),
-        ("BALANCED", "Balanced", "Biased ReSTIR (1/M), 32 candidates, 5 neighbours, 16 samples"),
-        ("UNBIASED", "Unbiased", "Unbiased ReSTIR (1/Z): converges to the path tracer"),
-        ("REFERENCE", "Reference", "The path tracer at 256 samples")])
+    preset: EnumProperty(items=PRESET_ITEMS)
 
     def execute(self, context):
         apply_preset(context.scene.restir, self.preset)

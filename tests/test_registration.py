@@ -71,3 +71,40 @@ def test_presets_set_the_settings(addon):
     assert (s.bias_correction, s.light_candidates, s.samples) == ("NONE", 8, 4)
     bpy.ops.restir.apply_preset(preset="REFERENCE")
     assert (s.integrator, s.samples) == ("PATH", 256)
+
+
+class _Layout:
+    """Stands in for a UILayout: records prop() calls and checks the properties exist."""
+
+    def __init__(self, seen):
+        object.__setattr__(self, "seen", seen)
+
+    def __setattr__(self, name, value):
+        pass
+
+    def prop(self, data, name, **_kw):
+        assert hasattr(data, name), name
+        self.seen.append(name)
+
+    def operator(self, *_a, **_kw):
+        return type("Op", (), {})()
+
+    def __getattr__(self, name):  # row(), column(), ...
+        return lambda *a, **k: _Layout(self.seen)
+
+
+def test_panels_draw_every_setting(addon):
+    from restir_engine.ui import panels
+    scene = bpy.context.scene
+    scene.restir.integrator, scene.restir.direct_method = "RESTIR", "RESTIR"
+    seen = []
+
+    class Ctx:
+        engine = "RESTIR"
+    Ctx.scene, Ctx.view_layer = scene, bpy.context.view_layer
+    for cls in panels.PANELS:
+        holder = type("Holder", (), {"layout": _Layout(seen), "split_layout": panels.RestirPanel.split_layout})()
+        cls.draw(holder, Ctx)
+    for name in ("samples", "seed", "max_bounces", "light_candidates", "temporal_reuse", "confidence_cap",
+                 "preroll_frames", "spatial_neighbors", "bias_correction", "use_pass_reservoir_m", "use_pass_vector"):
+        assert name in seen, name

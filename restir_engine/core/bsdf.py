@@ -128,8 +128,14 @@ def _smith_lambda(alpha, cos):
     return 0.5 * (np.sqrt(1.0 + alpha * alpha * tan2) - 1.0)
 
 
-def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
-    """f (n, 3) and pdf (n,) of sampling wi given wo."""
+def view_albedo(p: SurfaceParams, wo: np.ndarray) -> np.ndarray:
+    """GGX directional albedo E(μo, α) (n,) of the view directions: depends on wo only, so callers that
+    evaluate many wi for the same wo compute it once and pass it to :func:`eval_bsdf`."""
+    return ggx_albedo(p.alpha, np.clip(wo[:, 2], 0, 1))
+
+
+def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray, albedo: np.ndarray | None = None):
+    """f (n, 3) and pdf (n,) of sampling wi given wo (``albedo``: :func:`view_albedo`, if known)."""
     co = wo[:, 2]
     ci = wi[:, 2]
     valid = (co > 0) & (ci > 0)
@@ -145,7 +151,7 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
     d = _ggx_d(p.alpha, cos_h)
     g = 1.0 / (1.0 + _smith_lambda(p.alpha, co) + _smith_lambda(p.alpha, ci))
     fr = _schlick(p.f0, odh[:, None])
-    e = ggx_albedo(p.alpha, np.clip(co, 0, 1))
+    e = view_albedo(p, wo) if albedo is None else albedo
     compensation = 1.0 + p.f0 * ((1.0 - e) / e)[:, None]
     spec = (p.spec_on * d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr * compensation
     f = f + spec

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .accel import offset_origin, shadow_rays
-from .bsdf import eval_bsdf, luminance, sample_bsdf
+from .bsdf import eval_bsdf, luminance, sample_bsdf, view_albedo
 from .sampling import dot, to_local, to_world, uniform_triangle
 
 DIRECT_METHODS = ("LIGHT_SAMPLING", "RIS", "RESTIR")
@@ -75,7 +75,9 @@ def _target(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l: np.nd
     """Area-measure target p̂ (n,), f (n, 3), geometry term G (n,) and the BSDF's pdf converted to area
     measure (n,) for light points in directions wi (world) at distances dist from the surfaces."""
     wi_l = to_local(wi, surf.ns, surf.t, surf.bt)
-    f, pdf_b = eval_bsdf(surf.params, surf.wo_l, wi_l)
+    if getattr(surf, "albedo", None) is None:  # one lookup per surface, not per candidate
+        surf.albedo = view_albedo(surf.params, surf.wo_l)
+    f, pdf_b = eval_bsdf(surf.params, surf.wo_l, wi_l, surf.albedo)
     ok = (dot(wi, surf.ng) > 0) & (dist > 0)
     to_area = np.abs(cos_l) / np.maximum(dist * dist, 1e-30)
     g = np.abs(wi_l[:, 2]) * to_area

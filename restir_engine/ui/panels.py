@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import bpy
 
+from ..presets import PRESET_ITEMS
+
 ENGINE = "RESTIR"
 
 # Standard panels that work unchanged with this engine (output, format, colour management,
@@ -47,18 +49,22 @@ class RestirPanel:
     def poll(cls, context):
         return context.engine in cls.COMPAT_ENGINES
 
+    def split_layout(self):
+        """The panel layout in Blender's property-split style, without animation decorators."""
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        return layout
+
 
 class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
     bl_label = "Sampling"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = self.split_layout()
         s = context.scene.restir
         row = layout.row(align=True)
-        for key, label in (("FAST", "Fast"), ("BALANCED", "Balanced"), ("UNBIASED", "Unbiased"),
-                           ("REFERENCE", "Reference")):
+        for key, label, _description in PRESET_ITEMS:
             row.operator("restir.apply_preset", text=label).preset = key
         layout.prop(s, "integrator")
         col = layout.column(align=True)
@@ -88,9 +94,7 @@ class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):
     bl_label = "Light Paths"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = self.split_layout()
         layout.prop(context.scene.restir, "max_bounces")
         layout.prop(context.scene.render, "film_transparent")
 
@@ -100,9 +104,7 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
     bl_context = "view_layer"
 
     def draw(self, context):
-        layout = self.layout
-        layout.use_property_split = True
-        layout.use_property_decorate = False
+        layout = self.split_layout()
         vl = context.view_layer
         col = layout.column(heading="Data", align=True)
         col.prop(vl, "use_pass_z")
