@@ -142,7 +142,7 @@ class LightTable:
 
     def radiance_of(self, light: np.ndarray, b1, b2, p_receiver: np.ndarray) -> np.ndarray:
         """Radiance (n, 3) leaving triangle light ``light`` at (b1, b2) towards p_receiver,
-        before the sidedness test (spot cones included)."""
+        before the sidedness test (spot cones included unless p_receiver is None)."""
         scene = self.scene
         out = np.zeros((len(light), 3), np.float32)
         is_geom = light < self.n_geom
@@ -153,7 +153,17 @@ class LightTable:
         if lm.any():
             t = self.lamp_ids[light[lm] - self.n_geom]
             le = emitted_radiance(scene.lamps.tris, scene.materials, t, b1[lm], b2[lm])
-            out[lm] = le * spot_factor(scene.lamps, t, p_receiver[lm])[:, None]
+            out[lm] = le if p_receiver is None else le * spot_factor(scene.lamps, t, p_receiver[lm])[:, None]
+        return out
+
+    def spot_lamp_tri(self, light: np.ndarray) -> np.ndarray:
+        """Lamp triangle index (n,) int32 of lights with a spot cone, -1 for every other light."""
+        out = np.full(len(light), -1, np.int32)
+        lm = np.flatnonzero(light >= self.n_geom)
+        if lm.size:
+            t = self.lamp_ids[light[lm] - self.n_geom]
+            spot = self.scene.lamps.spot_cos[t] > -1.5
+            out[lm[spot]] = t[spot]
         return out
 
     def sample(self, p: np.ndarray, u: np.ndarray) -> LightSample:

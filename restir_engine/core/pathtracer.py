@@ -167,7 +167,9 @@ def trace(ctx: TraceContext, x: np.ndarray, y: np.ndarray, rng: np.random.Genera
         if bounce == 0:
             emitted[idx] += s.emission(ctx)
         if ris_here:
-            res = restir_di.initial_ris(ctx, s, rng, di)
+            px = np.floor(x[idx]).astype(np.int64) - cam.window[0]
+            py = np.floor(y[idx]).astype(np.int64) - cam.window[1]
+            res = restir_di.initial_ris(ctx, s, rng, di, px, py)
             if di.method == "RIS":
                 direct[idx] += restir_di.shade(ctx, s, res, rng)
                 if reservoir is not None:

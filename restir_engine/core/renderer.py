@@ -5,6 +5,7 @@ camera window (border) only.
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from concurrent.futures import FIRST_COMPLETED, wait
 from dataclasses import dataclass, field
@@ -13,8 +14,10 @@ import numpy as np
 
 from . import pathtracer, restir_di
 from .accel import pool
-from .sampling import STREAM_CAMERA, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, rng
+from .light_tiles import TILE_MODES, LightTiles, TileSettings
+from .sampling import STREAM_CAMERA, STREAM_TILES, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, rng
 from .scene import Scene
+from .target import FramePoints
 
 INTEGRATORS = ("PATH", "RESTIR")
 
@@ -42,6 +45,9 @@ class RenderSettings:
     bias_correction: str = "UNBIASED"  # spatial/temporal reuse: "NONE" (1/M) or "UNBIASED" (1/Z)
     temporal_reuse: bool = True  # ReSTIR: reuse the previous sample pass's (or frame's) reservoirs
     confidence_cap: float = 20.0
+    light_tiles: str = "AUTO"  # light candidates from presampled tiles: "AUTO" (when it pays), "ON", "OFF"
+    light_tile_count: int = 128
+    light_tile_size: int = 1024
     film_transparent: bool = False
     tile_pixels: int = 16384
 
@@ -80,8 +86,11 @@ class FrameRenderer:
         if settings.integrator == "RESTIR":
             if settings.direct_method not in restir_di.DIRECT_METHODS:
                 raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {restir_di.DIRECT_METHODS}")
+            tiles = TileSettings(settings.light_tiles, settings.light_tile_count, settings.light_tile_size)
+            if tiles.mode not in TILE_MODES:
+                raise ValueError(f"unknown light tile mode {tiles.mode!r}; available: {TILE_MODES}")
             self.di = restir_di.DISettings(settings.direct_method, max(0, settings.light_candidates),
-                                           max(0, settings.bsdf_candidates))
+                                           max(0, settings.bsdf_candidates), tiles)
             if settings.bias_correction not in restir_di.BIAS_CORRECTIONS:
                 raise ValueError(f"unknown bias correction {settings.bias_correction!r}")
             self.spatial = restir_di.SpatialSettings(max(0, settings.spatial_neighbors),
@@ -146,13 +155,22 @@ class FrameRenderer:
             w = self.ctx.scene.camera.window[2]
             ly, lx = np.mgrid[ty:ty + th, tx:tx + tw]
             reservoir = {"rows": (ly * w + lx).ravel(), "gbuf": self._gbuf, "res": self._res}
-        out = pathtracer.trace(self.ctx, x, y, path_rng, di=self.di, reservoir=reservoir)
+        out = pathtracer.trace(self.ctx, x, y, path_rng, di=self.di_pass, reservoir=reservoir)
         return (tx, ty, tw, th), (*out, reservoir)
 
     def sample_pass(self, progress=None, should_stop=None) -> bool:
         """Render the next sample pass (one path per pixel) into the accumulators. Returns False, keeping
         the accumulators unchanged, when ``should_stop`` asked to stop part-way."""
         s = self.samples_done
+        self.di_pass = self.di
+        self.used_tiles = False
+        if self.di is not None and self.di.method in ("RIS", "RESTIR") and self.ctx.lights.tri_alias is not None:
+            _x0, _y0, w, h = self.ctx.scene.camera.window
+            st = self.settings
+            if self.di.tile_settings.wanted(w * h, self.di.light_candidates):
+                tiles = LightTiles(self.ctx.lights, self.di.tile_settings, w, h, rng(st.seed, st.frame, s, STREAM_TILES))
+                self.di_pass = dataclasses.replace(self.di, tiles=tiles)
+                self.used_tiles = True
         spatial = self.di is not None and self.di.method == "RESTIR"
         if spatial:  # frame-wide primary hits and initial reservoirs, filled by the tiles
             _x0, _y0, w, h = self.ctx.scene.camera.window
@@ -205,9 +223,10 @@ class FrameRenderer:
                 rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]))), enumerate(spans)))
             res = restir_di.Reservoirs.gather(parts, w * h)
         for k in range(self.spatial.passes if self.spatial.neighbors else 0):
+            points = FramePoints(self.ctx.lights, res.light, res.b1, res.b2)
             parts = list(pool().map(lambda a: (a[1], restir_di.spatial_reuse(
                 self.ctx, self._gbuf, res, w, h, a[1], self.spatial,
-                rng(st.seed, st.frame, s, STREAM_SPATIAL + k, a[0]))), enumerate(spans)))
+                rng(st.seed, st.frame, s, STREAM_SPATIAL + k, a[0]), points)), enumerate(spans)))
             res = restir_di.Reservoirs.gather(parts, w * h)
         direct = np.zeros((w * h, 3), np.float32)
 
@@ -273,5 +292,5 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     passes = fr.passes()
     ctx = fr.ctx
     return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled,
-                       {"build_seconds": fr.build_seconds, "triangles": len(scene.geometry),
+                       {"build_seconds": fr.build_seconds, "light_tiles": fr.used_tiles, "triangles": len(scene.geometry),
                         "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun}, fr.history)

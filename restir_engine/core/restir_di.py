@@ -27,16 +27,23 @@ import numpy as np
 
 from .accel import offset_origin, shadow_rays
 from .bsdf import eval_bsdf, luminance, sample_bsdf, view_albedo
-from .sampling import dot, to_local, to_world, uniform_triangle
+from .light_tiles import TileSettings, light_points, sample_points, unpack
+from .sampling import dot, to_local, to_world
+from .target import WIDTH as TERMS_WIDTH
+from .target import FramePoints, ShadingTerms, with_spots
 
 DIRECT_METHODS = ("LIGHT_SAMPLING", "RIS", "RESTIR")
 
 
 @dataclass
 class DISettings:
+    """tiles: the sample pass's light_tiles.LightTiles (None = candidates straight from the power table)."""
+
     method: str = "RIS"
     light_candidates: int = 32
     bsdf_candidates: int = 1
+    tile_settings: TileSettings = None
+    tiles: object = None
 
 
 @dataclass
@@ -112,22 +119,57 @@ class _Stream:
         return res
 
 
-def initial_ris(ctx, surf, rng: np.random.Generator, cfg: DISettings) -> Reservoirs:
-    """One reservoir per surface point from M_l light and M_b BSDF candidates (see module docstring)."""
+def initial_ris(ctx, surf, rng: np.random.Generator, cfg: DISettings, px=None, py=None) -> Reservoirs:
+    """One reservoir per surface point from M_l light and M_b BSDF candidates (see module docstring).
+
+    Light candidates come from ``cfg.tiles`` (light_tiles.LightTiles; ``px``, ``py``: the surfaces' window
+    pixels pick the tile) or straight from the power table. All M_l candidates are weighed first and one is
+    selected per pixel in proportion to its weight (the same distribution as streaming one at a time)."""
     n = len(surf.p)
     lights = ctx.lights
     m_l = cfg.light_candidates if lights.tri_alias is not None else 0
     m_b = cfg.bsdf_candidates if lights.n_tri else 0
     stream = _Stream(n, rng)
-    rows = np.arange(n)
-    for _ in range(m_l):
-        u = rng.random((n, 4), dtype=np.float32)
-        li = lights.tri_alias.sample(u[:, 0], u[:, 1]).astype(np.int32)
-        b1, b2 = uniform_triangle(u[:, 2], u[:, 3])
-        _q, wi, dist, cos_l, le = lights.point_towards(li, b1, b2, surf.p)
-        p_l = lights.tri_only_pdf_area(li)
-        p_hat, _f, _g, p_b = _target(surf, wi, le, dist, cos_l)
-        stream.add(rows, li, b1, b2, p_hat / np.maximum(m_l * p_l + m_b * p_b, 1e-30), p_hat)
+    terms = ShadingTerms.of_surfaces(surf)
+    surf.terms = terms  # the G-buffer keeps them for reuse
+    lamps = ctx.scene.lamps
+    if m_l and n:
+        tiles = cfg.tiles if px is not None else None
+        if tiles is not None:
+            source, rows = tiles.points, tiles.rows
+            pick = np.minimum((rng.random((m_l, n), dtype=np.float32) * tiles.size).astype(np.int64), tiles.size - 1)
+            pick += tiles.tile_base(px, py)[None, :]
+        else:
+            source = sample_points(lights, rng.random((m_l * n, 4), dtype=np.float32))
+            rows, pick = None, None
+        spots = source.has_spots
+        w = np.empty((m_l, n), np.float32)
+        p_hats = np.empty((m_l, n), np.float32)
+        for k in range(m_l):
+            if spots:  # spot cones need the lamp of each candidate
+                pts = source.take(pick[k] if pick is not None else slice(k * n, (k + 1) * n))
+                pts = with_spots(pts, lamps, surf.p)
+            elif pick is not None:
+                pts = unpack(rows.take(pick[k], axis=0))
+            else:
+                pts = source.take(slice(k * n, (k + 1) * n))
+            p_hat, p_b = terms.evaluate(pts, want_pdf=m_b > 0)
+            den = m_l * pts.pdf if p_b is None else m_l * pts.pdf + m_b * p_b
+            wk = p_hat / np.maximum(den, 1e-30)
+            w[k] = np.where(np.isfinite(wk) & (wk > 0), wk, 0.0)
+            p_hats[k] = p_hat
+        cum = np.cumsum(w, axis=0, dtype=np.float64)
+        total = cum[-1]
+        k_sel = np.minimum((cum <= (rng.random(n) * total)[None, :]).sum(axis=0), m_l - 1)
+        cols = np.arange(n)
+        flat = pick[k_sel, cols] if pick is not None else k_sel * n + cols
+        take = total > 0
+        res = stream.res
+        res.light[take] = source.light[flat[take]]
+        res.b1[take] = source.b1[flat[take]]
+        res.b2[take] = source.b2[flat[take]]
+        res.p_hat[take] = p_hats[k_sel, cols][take]
+        stream.w_sum[:] = total
     for _ in range(m_b):
         u = rng.random((n, 3), dtype=np.float32)
         wi_l, _f, p_b = sample_bsdf(surf.params, surf.wo_l, u[:, 0], u[:, 1], u[:, 2])
@@ -143,7 +185,7 @@ def initial_ris(ctx, surf, rng: np.random.Generator, cfg: DISettings) -> Reservo
         hp = np.maximum(hits.prim, 0)
         geo_light = np.where(hits.prim >= 0, lights.geom_to_light[hp], -1)
         candidates.append((geo_light, hits.u, hits.v))
-        if len(ctx.scene.lamps.tris):
+        if len(lamps.tris):
             lh = ctx.lamp_accel.intersect(o, d, hits.t)
             lamp_ok = (lh.prim >= 0) & (lh.t < hits.t)
             lamp_light = np.where(lamp_ok, lights.lamp_to_light[np.maximum(lh.prim, 0)], -1)
@@ -153,13 +195,9 @@ def initial_ris(ctx, surf, rng: np.random.Generator, cfg: DISettings) -> Reservo
             if sel.size == 0:
                 continue
             r = live[sel]
-            li = light[sel].astype(np.int32)
-            b1, b2 = cu[sel].astype(np.float32), cv[sel].astype(np.float32)
-            _q, wdir, dist, cos_l, le = lights.point_towards(li, b1, b2, surf.p[r])
-            p_l = lights.tri_only_pdf_area(li)
-            sub = _SurfaceRows(surf, r)
-            p_hat, _f2, _g2, pb = _target(sub, wdir, le, dist, cos_l)
-            stream.add(r, li, b1, b2, p_hat / np.maximum(m_l * p_l + m_b * pb, 1e-30), p_hat)
+            pts = with_spots(light_points(lights, light[sel], cu[sel], cv[sel]), lamps, surf.p[r])
+            p_hat, pb = terms.take(r).evaluate(pts)
+            stream.add(r, pts.light, pts.b1, pts.b2, p_hat / np.maximum(m_l * pts.pdf + m_b * pb, 1e-30), p_hat)
     return stream.finish(1.0)
 
 
@@ -231,12 +269,19 @@ class GBuffer:
         self.instance = np.zeros(n, np.int32)
         self.valid = np.zeros(n, bool)
         self.params = material_params.take(np.zeros(n, np.int64))  # placeholder rows, overwritten per hit
+        self.terms = np.zeros((n, TERMS_WIDTH), np.float32)  # target.ShadingTerms rows
+
+    def shading_terms(self, rows=None) -> ShadingTerms:
+        """The target function's per-surface terms of all pixels, or of pixels ``rows``."""
+        return ShadingTerms(self.terms if rows is None else self.terms.take(rows, axis=0))
 
     def store(self, rows: np.ndarray, surf, depth: np.ndarray, instance: np.ndarray | None = None):
         for name in ("p", "ng", "ns", "t", "bt", "wo_l"):
             getattr(self, name)[rows] = getattr(surf, name)
         for name in ("diffuse", "f0", "f0_dielectric", "alpha", "p_spec", "spec_on"):
             getattr(self.params, name)[rows] = getattr(surf.params, name)
+        self.terms[rows] = surf.terms.packed if getattr(surf, "terms", None) is not None else \
+            ShadingTerms.of_surfaces(surf).packed
         self.depth[rows] = depth
         self.material[rows] = surf.mat
         if instance is not None:
@@ -254,20 +299,22 @@ def neighbor_offsets(k: int, radius: float, rng: np.random.Generator, n: int):
 
 
 def spatial_reuse(ctx, gb: GBuffer, res: Reservoirs, width: int, height: int, rows: np.ndarray,
-                  cfg: SpatialSettings, rng: np.random.Generator) -> Reservoirs:
+                  cfg: SpatialSettings, rng: np.random.Generator, points: FramePoints | None = None) -> Reservoirs:
     """One spatial pass for pixels ``rows``: merge ``cfg.neighbors`` similar neighbours' reservoirs
     (weights p̂_p(y_q)·W_q·M_q) into the pixel's own. NONE: W = Σw / (p̂ ΣM) (fast, darkens where
     neighbours cannot produce the sample); UNBIASED: W = Σw / (p̂ Z), Z = Σ M_q over the merged
-    reservoirs whose target is non-zero at the chosen sample (Bitterli et al. 2020, Alg. 6)."""
+    reservoirs whose target is non-zero at the chosen sample (Bitterli et al. 2020, Alg. 6).
+    ``points``: the light points of ``res`` (target.FramePoints), computed here when not given."""
     n = len(rows)
     lights = ctx.lights
-    me = _SurfaceRows(gb, rows)
+    if points is None:
+        points = FramePoints(lights, res.light, res.b1, res.b2)
+    me = gb.shading_terms(rows)
     stream = _Stream(n, rng)
     m_total = np.zeros(n, np.float32)
     local = np.arange(n)
     # the pixel's own reservoir
     own = res.light[rows] >= 0
-    stream.w_sum[:] = 0
     w_own = np.where(own, res.p_hat[rows] * res.W[rows] * res.M[rows], 0.0)
     stream.add(local, res.light[rows], res.b1[rows], res.b2[rows], w_own, res.p_hat[rows])
     m_total += np.where(gb.valid[rows], res.M[rows], 0.0)
@@ -288,26 +335,24 @@ def spatial_reuse(ctx, gb: GBuffer, res: Reservoirs, width: int, height: int, ro
         ok &= dot(gb.ns[q], gb.ns[rows]) >= SPATIAL_NORMAL_COS
         merged.append((q, ok))
         m_total += np.where(ok, res.M[q], 0.0)
-        sel = np.flatnonzero(ok & (res.light[q] >= 0))
-        if sel.size == 0:
+        use = ok & (res.light[q] >= 0)
+        if not use.any():
             continue
-        qs = q[sel]
-        sub = _SurfaceRows(me, sel)
-        _p, wi, dist, cos_l, le = lights.point_towards(res.light[qs], res.b1[qs], res.b2[qs], sub.p)
-        p_hat, _f, _g, _pb = _target(sub, wi, le, dist, cos_l)
-        stream.add(sel, res.light[qs], res.b1[qs], res.b2[qs], p_hat * res.W[qs] * res.M[qs], p_hat)
+        p_hat, _pb = me.evaluate(points.at(q, me.p), want_pdf=False)
+        stream.add(local, res.light[q], res.b1[q], res.b2[q], np.where(use, p_hat * res.W[q] * res.M[q], 0.0), p_hat)
     out = stream.res
     chosen = out.light >= 0
     if cfg.bias_correction == "UNBIASED":
         z = np.where(gb.valid[rows] & chosen & (out.p_hat > 0), res.M[rows], 0.0).astype(np.float32)
+        pts = light_points(lights, np.maximum(out.light, 0), out.b1, out.b2)
+        spots = pts.has_spots
         for q, ok in merged:
-            sel = np.flatnonzero(ok & chosen)
-            if sel.size == 0:
+            use = ok & chosen
+            if not use.any():
                 continue
-            sub = _SurfaceRows(gb, q[sel])
-            _p, wi, dist, cos_l, le = lights.point_towards(out.light[sel], out.b1[sel], out.b2[sel], sub.p)
-            p_hat_q, _f, _g, _pb = _target(sub, wi, le, dist, cos_l)
-            z[sel] += np.where(p_hat_q > 0, res.M[q[sel]], 0.0)
+            there = gb.shading_terms(q)
+            p_hat_q, _pb = there.evaluate(with_spots(pts, ctx.scene.lamps, there.p) if spots else pts, want_pdf=False)
+            z += np.where(use & (p_hat_q > 0), res.M[q], 0.0)
         denom = z
     else:
         denom = m_total
@@ -343,7 +388,7 @@ def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, wid
     Z counting the previous reservoir only where its own target (at its stored surface) is non-zero."""
     from .camera import project
     n = len(rows)
-    me = _SurfaceRows(gb, rows)
+    me = gb.shading_terms(rows)
     x0, y0, w, h = hist.camera.window
     p_then = gb.p[rows]
     if motion is not None:
@@ -364,23 +409,23 @@ def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, wid
                np.where(res.light[rows] >= 0, res.p_hat[rows] * res.W[rows] * res.M[rows], 0.0), res.p_hat[rows])
     prev = hist.res
     m_prev = np.where(ok, np.minimum(prev.M[q], confidence_cap * np.maximum(m_own, 1.0)), 0.0).astype(np.float32)
-    sel = np.flatnonzero(ok & (prev.light[q] >= 0))
-    if sel.size:
-        qs = q[sel]
-        sub = _SurfaceRows(me, sel)
-        _p, wi, dist, cos_l, le = ctx.lights.point_towards(prev.light[qs], prev.b1[qs], prev.b2[qs], sub.p)
-        p_hat, _f, _g, _pb = _target(sub, wi, le, dist, cos_l)
-        stream.add(sel, prev.light[qs], prev.b1[qs], prev.b2[qs], p_hat * prev.W[qs] * m_prev[sel], p_hat)
+    use = ok & (prev.light[q] >= 0)
+    if use.any():
+        pts = light_points(ctx.lights, np.maximum(prev.light[q], 0), prev.b1[q], prev.b2[q])
+        spots = pts.has_spots
+        p_hat, _pb = me.evaluate(with_spots(pts, ctx.scene.lamps, me.p) if spots else pts, want_pdf=False)
+        stream.add(local, pts.light, pts.b1, pts.b2, np.where(use, p_hat * prev.W[q] * m_prev, 0.0), p_hat)
     out = stream.res
     chosen = (out.light >= 0) & (out.p_hat > 0)
     if bias_correction == "UNBIASED":
         z = np.where(chosen, m_own, 0.0).astype(np.float32)
-        s2 = np.flatnonzero(chosen & ok)
-        if s2.size:
-            sub = _SurfaceRows(hist.gbuf, q[s2])
-            _p, wi, dist, cos_l, le = ctx.lights.point_towards(out.light[s2], out.b1[s2], out.b2[s2], sub.p)
-            p_hat_prev, _f, _g, _pb = _target(sub, wi, le, dist, cos_l)
-            z[s2] += np.where(p_hat_prev > 0, m_prev[s2], 0.0)
+        s2 = chosen & ok
+        if s2.any():
+            then = hist.gbuf.shading_terms(q)
+            pts = light_points(ctx.lights, np.maximum(out.light, 0), out.b1, out.b2)
+            p_hat_prev, _pb = then.evaluate(with_spots(pts, ctx.scene.lamps, then.p) if pts.has_spots else pts,
+                                            want_pdf=False)
+            z += np.where(s2 & (p_hat_prev > 0), m_prev, 0.0)
         denom = z
     else:
         denom = m_own + m_prev

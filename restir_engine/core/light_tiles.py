@@ -1,0 +1,119 @@
+"""Presampled light points and light tiles (Wyman & Panteleev 2021, "Rearchitecting spatiotemporal
+resampling for production").
+
+A :class:`LightPoints` batch holds points drawn from the triangle-light power table together with
+everything the RIS target needs about them (position, unit normal, emitted radiance, area-measure pdf),
+so a candidate costs one gather instead of an alias lookup, a barycentric interpolation and a material
+read. :class:`LightTiles` draws ``count`` tiles of ``size`` points once per sample pass; every 16 x 16
+pixel block takes its candidates from one randomly assigned tile (a cache-sized working set). Each
+candidate is still distributed as the power table says (pdf p_select / A, area measure), so RIS over
+tile candidates stays unbiased; candidates of one block are merely correlated.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .sampling import uniform_triangle
+
+TILE_MODES = ("AUTO", "ON", "OFF")
+BLOCK = 16              # pixels per side of a screen block sharing one tile
+AUTO_FACTOR = 8.0       # AUTO: use tiles when candidates per pass exceed this many times the tile points
+
+
+@dataclass
+class LightPoints:
+    """SoA light points (n,): light int32, b1, b2 float32, pos (n, 3), normal (n, 3) unit geometric
+    normal, le (n, 3) radiance leaving the front face (W·sr⁻¹·m⁻², scene-linear; spot cones not
+    applied), pdf (n,) area measure (m⁻²), two_sided bool, spot_tri int32 (lamp triangle with a
+    spot cone, else -1)."""
+
+    light: np.ndarray
+    b1: np.ndarray
+    b2: np.ndarray
+    pos: np.ndarray
+    normal: np.ndarray
+    le: np.ndarray
+    pdf: np.ndarray
+    two_sided: np.ndarray
+    spot_tri: np.ndarray
+
+    def take(self, idx) -> "LightPoints":
+        """Rows ``idx`` (an index array or a slice)."""
+        return LightPoints(*(getattr(self, f)[idx] for f in self.__dataclass_fields__))
+
+    @property
+    def has_spots(self) -> bool:
+        return bool((self.spot_tri >= 0).any())
+
+    def packed(self) -> np.ndarray:
+        """(n, 11) float32 rows [pos, normal, le, pdf, two_sided]: one gather per candidate (see :func:`unpack`)."""
+        return np.concatenate([self.pos, self.normal, self.le, self.pdf[:, None],
+                               self.two_sided[:, None].astype(np.float32)], axis=1).astype(np.float32)
+
+
+@dataclass
+class PackedPoints:
+    """Column views of :meth:`LightPoints.packed` rows: what the target function reads."""
+
+    pos: np.ndarray
+    normal: np.ndarray
+    le: np.ndarray
+    pdf: np.ndarray
+    two_sided: np.ndarray
+
+
+def unpack(rows: np.ndarray) -> PackedPoints:
+    return PackedPoints(rows[:, 0:3], rows[:, 3:6], rows[:, 6:9], rows[:, 9], rows[:, 10] > 0)
+
+
+def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> LightPoints:
+    """The points (b1, b2) of triangle lights ``light`` of a lights.LightTable."""
+    light = light.astype(np.int32)
+    w = np.stack([1 - b1 - b2, b1, b2], axis=1).astype(np.float32)
+    pos = np.einsum("ijk,ij->ik", lights.tri_verts[light], w).astype(np.float32)
+    le = lights.radiance_of(light, b1, b2, None)
+    return LightPoints(light, b1.astype(np.float32), b2.astype(np.float32), pos, lights.tri_normal[light], le,
+                       lights.tri_only_pdf_area(light), lights.tri_two_sided[light], lights.spot_lamp_tri(light))
+
+
+def sample_points(lights, u: np.ndarray) -> LightPoints:
+    """Points from the triangle-light power table (``u``: (n, 4) uniforms)."""
+    light = lights.tri_alias.sample(u[:, 0], u[:, 1]).astype(np.int32)
+    b1, b2 = uniform_triangle(u[:, 2], u[:, 3])
+    return light_points(lights, light, b1, b2)
+
+
+@dataclass
+class TileSettings:
+    """mode: 'AUTO' | 'ON' | 'OFF'; count tiles of size points each."""
+
+    mode: str = "AUTO"
+    count: int = 128
+    size: int = 1024
+
+    def wanted(self, pixels: int, candidates: int) -> bool:
+        """Whether a pass of ``pixels`` pixels drawing ``candidates`` light candidates each uses tiles."""
+        if self.mode == "ON":
+            return True
+        if self.mode == "OFF" or candidates == 0:
+            return False
+        return pixels * candidates >= AUTO_FACTOR * self.count * self.size
+
+
+class LightTiles:
+    """``count`` x ``size`` presampled points and a tile per 16 x 16 screen block, for one sample pass."""
+
+    def __init__(self, lights, cfg: TileSettings, width: int, height: int, rng: np.random.Generator):
+        self.count, self.size = max(1, cfg.count), max(1, cfg.size)
+        self.points = sample_points(lights, rng.random((self.count * self.size, 4), dtype=np.float32))
+        self.rows = self.points.packed()
+        self.blocks_x = (width + BLOCK - 1) // BLOCK
+        blocks = self.blocks_x * ((height + BLOCK - 1) // BLOCK)
+        self.tile_of_block = rng.integers(0, self.count, blocks).astype(np.int64)
+
+    def tile_base(self, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+        """First point index of the tile serving window pixels (px, py) (integers, window coordinates)."""
+        block = (py // BLOCK) * self.blocks_x + px // BLOCK
+        return self.tile_of_block[block] * self.size
