@@ -30,6 +30,8 @@ def settings_from_scene(scene) -> RenderSettings:
                           spatial_neighbors=int(s.spatial_neighbors), spatial_radius=float(s.spatial_radius),
                           spatial_passes=int(s.spatial_passes), bias_correction=s.bias_correction,
                           temporal_reuse=bool(s.temporal_reuse), confidence_cap=float(s.confidence_cap),
+                          light_tiles=s.light_tiles, light_tile_count=int(s.light_tile_count),
+                          light_tile_size=int(s.light_tile_size),
                           film_transparent=bool(scene.render.film_transparent))
 
 
@@ -67,6 +69,18 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         pass_table.register_passes(self, scene, renderlayer)
 
     def render(self, depsgraph):
+        """Render one frame; an unexpected error is reported in the UI (and printed) instead of being
+        raised into Blender, which can crash after a failed render callback."""
+        try:
+            self._render(depsgraph)
+        except Exception as exc:  # noqa: BLE001 - the last line of defence for the user's session
+            import traceback
+            traceback.print_exc()
+            message = f"ReSTIR render failed: {type(exc).__name__}: {exc}"
+            self.report({"ERROR"}, message)
+            self.error_set(message)
+
+    def _render(self, depsgraph):
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         t0 = time.perf_counter()
@@ -123,19 +137,20 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         frame = scene.frame_current
         history = None
-        for f in range(frame - count, frame):
-            if self.test_break():
-                self.frame_set(frame, subframe=0.0)
-                return None
-            self.update_stats("ReSTIR", f"Preroll frame {f} for frame {frame}")
-            self.frame_set(f, subframe=0.0)
-            try:
-                core = export_scene(depsgraph, self.camera_override)
-                neighbour_frames(self, depsgraph, core, self.camera_override, need_next=False)
-                history = render_frame(core, replace(settings, samples=1, frame=f), history=history).history
-            except (ExportError, Cancelled):
-                history = None
-        self.frame_set(frame, subframe=0.0)
+        try:  # whatever happens, the scene goes back to frame F (an unrestored frame crashes Blender)
+            for f in range(frame - count, frame):
+                if self.test_break():
+                    return None
+                self.update_stats("ReSTIR", f"Preroll frame {f} for frame {frame}")
+                self.frame_set(f, subframe=0.0)
+                try:
+                    core = export_scene(depsgraph, self.camera_override)
+                    neighbour_frames(self, depsgraph, core, self.camera_override, need_next=False)
+                    history = render_frame(core, replace(settings, samples=1, frame=f), history=history).history
+                except (ExportError, Cancelled):
+                    history = None
+        finally:
+            self.frame_set(frame, subframe=0.0)
         return history
 
     # -- viewport (Rendered shading) ----------------------------------------------------------

@@ -7,13 +7,15 @@ from bpy.props import EnumProperty
 PRESETS = {
     "FAST": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 4, "light_candidates": 8,
              "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 3,
-             "preroll_frames": 2, "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE"},
+             "preroll_frames": 2, "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE",
+             "light_tiles": "AUTO"},
     "BALANCED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
                  "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 5,
-                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE"},
+                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE", "light_tiles": "AUTO"},
     "UNBIASED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
                  "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 5,
-                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "UNBIASED"},
+                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "UNBIASED",
+                 "light_tiles": "AUTO"},
     "REFERENCE": {"integrator": "PATH", "samples": 256},
 }
 

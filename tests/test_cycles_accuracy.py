@@ -16,11 +16,14 @@ Z_MAX = 5.0
 SIZE = (48, 48)
 
 
-def renders(kind, engine, bounces, samples):
+def renders(kind, engine, bounces, samples, **settings):
     out = []
     for seed in range(REPS):
         scene = cornell_box(kind, SIZE)
-        (configure_restir if engine == "RESTIR" else configure_cycles)(scene, samples, bounces, seed)
+        if engine == "RESTIR":
+            configure_restir(scene, samples, bounces, seed, **settings)
+        else:
+            configure_cycles(scene, samples, bounces, seed)
         out.append(render_passes(scene)["Combined"][..., :3])
     return np.array(out)
 
@@ -28,11 +31,29 @@ def renders(kind, engine, bounces, samples):
 @pytest.mark.parametrize("kind,bounces", [("EMISSIVE", 0), ("AREA", 0), ("POINT", 0), ("SPOT", 0), ("SUN", 0),
                                           ("EMISSIVE", 3), ("AREA", 3)])
 def test_path_tracer_matches_cycles(addon, kind, bounces):
-    ours = renders(kind, "RESTIR", bounces, 32)
+    ours = renders(kind, "RESTIR", bounces, 32, integrator="PATH")
     ref = renders(kind, "CYCLES", bounces, 64)
     assert np.isfinite(ours).all()
     z, mean_ours, mean_ref, rel_se = compare(ours, ref, blocks=2)
     assert mean_ref[-1] > 0.01  # the scene is lit
+    assert rel_se[-1] < 0.006, f"too noisy to detect a 3% error: relative SE {rel_se[-1]:.4f}"
+    assert np.abs(z).max() < Z_MAX, f"z={np.round(z, 2)} ours={mean_ours} cycles={mean_ref}"
+    z_wrong, *_ = compare(ours * 1.03, ref, blocks=2)
+    assert abs(z_wrong[-1]) > Z_MAX, "the comparison could not detect a 3% unit error"
+
+
+@pytest.mark.parametrize("kind", ["AREA", "SPOT"])
+def test_unbiased_restir_direct_light_matches_cycles(addon, kind):
+    """The add-on's default integrator (ReSTIR DI, temporal + spatial reuse, unbiased) converges to Cycles'
+    direct light. (The emissive-quad box is left out here: its ceiling, lit by the back of a two-sided
+    lamp 2 cm away, makes ReSTIR's per-seed means so heavy-tailed (skew > 2) that a 16-seed standard error
+    is not trustworthy; 100 seeds there agree within 2 SE, see docs/RESULTS.md.)"""
+    ours = renders(kind, "RESTIR", 0, 32, integrator="RESTIR", direct_method="RESTIR", bias_correction="UNBIASED",
+                   temporal_reuse=True, spatial_neighbors=5)
+    ref = renders(kind, "CYCLES", 0, 64)
+    assert np.isfinite(ours).all()
+    z, mean_ours, mean_ref, rel_se = compare(ours, ref, blocks=2)
+    assert mean_ref[-1] > 0.01
     assert rel_se[-1] < 0.006, f"too noisy to detect a 3% error: relative SE {rel_se[-1]:.4f}"
     assert np.abs(z).max() < Z_MAX, f"z={np.round(z, 2)} ours={mean_ours} cycles={mean_ref}"
     z_wrong, *_ = compare(ours * 1.03, ref, blocks=2)

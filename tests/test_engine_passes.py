@@ -121,7 +121,7 @@ def test_camera_models_match_cycles_geometry(box, ortho):
 def test_reservoir_passes_only_with_reservoirs(box):
     vl = box.view_layers[0]
     vl.restir.use_pass_reservoir_m = vl.restir.use_pass_reservoir_ucw = True
-    configure_restir(box, 2, 1)
+    configure_restir(box, 2, 1, integrator="PATH")
     assert "Reservoir M" not in render_passes(box)  # the path tracer has no reservoirs: no placeholder pass
     configure_restir(box, 2, 1, integrator="RESTIR", direct_method="RIS", light_candidates=8)
     p = render_passes(box)

@@ -30,7 +30,7 @@ def test_quick_run_writes_charts_and_table(addon, tmp_path):
 def test_path_tracer_converges_to_cycles_reference(addon):
     blend = ensure_blend("cornell", "default", "tiny")
     ref = reference_image(blend, 3, 1024)
-    img, _wall, _core = render_blend(blend, "RESTIR", 256, 3, seed=7)
+    img, _wall, _core = render_blend(blend, "RESTIR", 256, 3, seed=7, settings={"integrator": "PATH"})
     bias = metrics.rel_bias(img, ref)
     se = metrics.bias_standard_error(img, ref)  # residual noise of both images
     assert se < 0.006, "too noisy to detect a 3% error"

@@ -71,6 +71,11 @@ def unpack(rows: np.ndarray) -> PackedPoints:
 def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> LightPoints:
     """The points (b1, b2) of triangle lights ``light`` of a lights.LightTable."""
     light = light.astype(np.int32)
+    if lights.n_tri == 0:  # no triangle lights: every point is an empty placeholder
+        n = len(light)
+        z3 = np.zeros((n, 3), np.float32)
+        return LightPoints(np.full(n, -1, np.int32), np.zeros(n, np.float32), np.zeros(n, np.float32), z3, z3.copy(),
+                           z3.copy(), np.zeros(n, np.float32), np.zeros(n, bool), np.full(n, -1, np.int32))
     w = np.stack([1 - b1 - b2, b1, b2], axis=1).astype(np.float32)
     pos = np.einsum("ijk,ij->ik", lights.tri_verts[light], w).astype(np.float32)
     le = lights.radiance_of(light, b1, b2, None)

@@ -76,6 +76,13 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
             col.active = s.direct_method in ("RIS", "RESTIR")
             col.prop(s, "light_candidates")
             col.prop(s, "bsdf_candidates")
+            col = layout.column(align=True)
+            col.active = s.direct_method in ("RIS", "RESTIR")
+            col.prop(s, "light_tiles")
+            sub = col.column(align=True)
+            sub.active = s.light_tiles != "OFF"
+            sub.prop(s, "light_tile_count")
+            sub.prop(s, "light_tile_size")
             if s.direct_method == "RESTIR":
                 col = layout.column(align=True, heading="Temporal Reuse")
                 col.prop(s, "temporal_reuse", text="")
