@@ -31,7 +31,8 @@ def settings_from_scene(scene) -> RenderSettings:
                           spatial_passes=int(s.spatial_passes), bias_correction=s.bias_correction,
                           temporal_reuse=bool(s.temporal_reuse), confidence_cap=float(s.confidence_cap),
                           light_tiles=s.light_tiles, light_tile_count=int(s.light_tile_count),
-                          light_tile_size=int(s.light_tile_size),
+                          light_tile_size=int(s.light_tile_size), boiling_filter=bool(s.boiling_filter),
+                          boiling_threshold=float(s.boiling_threshold),
                           film_transparent=bool(scene.render.film_transparent))
 
 

@@ -8,14 +8,15 @@ PRESETS = {
     "FAST": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 4, "light_candidates": 8,
              "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 3,
              "preroll_frames": 2, "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE",
-             "light_tiles": "AUTO"},
+             "light_tiles": "AUTO", "boiling_filter": True},
     "BALANCED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
                  "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 5,
-                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE", "light_tiles": "AUTO"},
+                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE", "light_tiles": "AUTO",
+                 "boiling_filter": False},
     "UNBIASED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
                  "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 5,
                  "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "UNBIASED",
-                 "light_tiles": "AUTO"},
+                 "light_tiles": "AUTO", "boiling_filter": False},
     "REFERENCE": {"integrator": "PATH", "samples": 256},
 }
 
@@ -26,7 +27,7 @@ def apply_preset(settings, name: str) -> None:
 
 
 PRESET_ITEMS = [
-    ("FAST", "Fast", "Biased ReSTIR, 8 light candidates, 3 neighbours, 4 samples"),
+    ("FAST", "Fast", "Biased ReSTIR, 8 light candidates, 3 neighbours, boiling filter, 4 samples"),
     ("BALANCED", "Balanced", "Biased ReSTIR (1/M), 32 candidates, 5 neighbours, 16 samples"),
     ("UNBIASED", "Unbiased", "Unbiased ReSTIR (1/Z): converges to the path tracer"),
     ("REFERENCE", "Reference", "The path tracer at 256 samples")]

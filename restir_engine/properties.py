@@ -70,6 +70,13 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                ("UNBIASED", "Unbiased (1/Z)", "Counts only neighbours whose target is non-zero at the chosen sample "
                 "(converges to the path tracer)", 1)],
         default="UNBIASED")
+    boiling_filter: BoolProperty(
+        name="Boiling Filter", description="With bias correction None: empty reservoirs whose contribution is "
+        "far above their 16x16 pixel block's mean, so a rare bright sample does not spread into blotches over "
+        "neighbours and frames. Biased (darker); never used by the unbiased mode", default=False)
+    boiling_threshold: FloatProperty(
+        name="Threshold", description="A reservoir is emptied when its contribution exceeds this many times its "
+        "block's mean (lower filters more)", default=20.0, min=1.5, soft_max=100.0)
     samples: IntProperty(name="Samples", description="Iterations averaged per frame", default=16, min=1,
                          soft_max=4096)
     seed: IntProperty(name="Seed", description="Noise pattern; different seeds give independent noise", default=0,

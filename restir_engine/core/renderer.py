@@ -14,6 +14,7 @@ import numpy as np
 
 from . import pathtracer, restir_di
 from .accel import pool
+from .boiling import boiling_filter
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
 from .sampling import STREAM_CAMERA, STREAM_TILES, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, rng
 from .scene import Scene
@@ -45,6 +46,8 @@ class RenderSettings:
     bias_correction: str = "UNBIASED"  # spatial/temporal reuse: "NONE" (1/M) or "UNBIASED" (1/Z)
     temporal_reuse: bool = True  # ReSTIR: reuse the previous sample pass's (or frame's) reservoirs
     confidence_cap: float = 20.0
+    boiling_filter: bool = False  # bias_correction NONE only: drop reservoirs far above their block's mean
+    boiling_threshold: float = 20.0  # x the 16x16 block's mean p̂·W (core.boiling)
     light_tiles: str = "AUTO"  # light candidates from presampled tiles: "AUTO" (when it pays), "ON", "OFF"
     light_tile_count: int = 128
     light_tile_size: int = 1024
@@ -113,6 +116,7 @@ class FrameRenderer:
                     "indirect": np.zeros((h, w, 3), np.float64), "alpha": np.zeros((h, w), np.float64),
                     "res_m": np.zeros((h, w), np.float64), "res_w": np.zeros((h, w), np.float64)}
         self.samples_done = 0
+        self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
         self._data = None
         self.history = None  # restir_di.TemporalHistory of the last sample pass
 
@@ -222,6 +226,8 @@ class FrameRenderer:
                 self.ctx, self._gbuf, res, hist, w, a[1], st.confidence_cap, st.bias_correction, motion,
                 rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]))), enumerate(spans)))
             res = restir_di.Reservoirs.gather(parts, w * h)
+        if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode
+            self.boiling_dropped += int(boiling_filter(res, self._gbuf.valid, w, h, st.boiling_threshold).sum())
         for k in range(self.spatial.passes if self.spatial.neighbors else 0):
             points = FramePoints(self.ctx.lights, res.light, res.b1, res.b2)
             parts = list(pool().map(lambda a: (a[1], restir_di.spatial_reuse(
@@ -293,4 +299,5 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     ctx = fr.ctx
     return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled,
                        {"build_seconds": fr.build_seconds, "light_tiles": fr.used_tiles, "triangles": len(scene.geometry),
-                        "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun}, fr.history)
+                        "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun,
+                        "boiling_dropped": fr.boiling_dropped}, fr.history)

@@ -95,6 +95,13 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
                 col.prop(s, "spatial_radius")
                 col.prop(s, "spatial_passes")
                 layout.prop(s, "bias_correction")
+                col = layout.column(align=True, heading="Boiling Filter")
+                col.active = s.bias_correction == "NONE"  # biased: the unbiased mode never applies it
+                row = col.row(align=True)
+                row.prop(s, "boiling_filter", text="")
+                sub = row.row(align=True)
+                sub.active = s.boiling_filter
+                sub.prop(s, "boiling_threshold")
 
 
 class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):

@@ -9,15 +9,15 @@ from __future__ import annotations
 import json
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from . import metrics, report
-from .methods import by_key
+from .methods import by_key, settings_for
 from .reference import reference_image
 from .render import render_blend
-from .scenes import ANIM_FRAMES, LIGHT_OFF_FRAME, ensure_blend
+from .scenes import ANIM_FRAMES, LIGHT_OFF_FRAME, SIZES, ensure_blend
 
 
 @dataclass(frozen=True)
@@ -55,9 +55,10 @@ def evaluate_scene(spec: Spec, methods, quick: bool, refresh: bool = False, log=
     log(f"[{spec.title}] reference ready ({time.perf_counter() - t0:.1f}s)")
     points, images = [], {}
     for m in methods:
-        render_blend(blend, m.engine, 1, spec.bounces, settings=m.settings)  # warm-up, not timed
+        settings = settings_for(m, SIZES[spec.size][0])
+        render_blend(blend, m.engine, 1, spec.bounces, settings=settings)  # warm-up, not timed
         for spp in (m.ladder_quick if quick else m.ladder_full):
-            img, wall, core = render_blend(blend, m.engine, spp, spec.bounces, seed=1, settings=m.settings)
+            img, wall, core = render_blend(blend, m.engine, spp, spec.bounces, seed=1, settings=settings)
             p = {"method": m.key, "spp": spp, "wall": wall, "core": core, "relmse": metrics.rel_mse(img, ref),
                  "bias": metrics.rel_bias(img, ref), "flip": metrics.flip(img, ref)}
             points.append(p)
@@ -82,7 +83,8 @@ def evaluate_animation(size: str, spp: int, ref_spp: int, methods, quick: bool, 
     for m in methods:
         imgs, walls = [], []
         for f in frames:
-            img, wall, _core = render_blend(blend, m.engine, spp, 2, seed=f, frame=f, settings=m.settings)
+            img, wall, _core = render_blend(blend, m.engine, spp, 2, seed=f, frame=f,
+                                            settings=settings_for(m, SIZES[size][0]))
             imgs.append(img)
             walls.append(wall)
         out["per_method"][m.key] = {
@@ -123,10 +125,13 @@ def evaluate_growth(quick: bool, log=print):
 
 
 def run(mode: str, out_dir: str, method_keys=None, scenes=None, refresh=False, log=print,
-        animation=True, growth=True) -> dict:
+        animation=True, growth=True, size: str | None = None, reference_spp: int | None = None) -> dict:
+    """``size`` / ``reference_spp``: override every scene's image size (a key of scenes.SIZES) and the
+    Cycles reference's samples."""
     quick = mode == "quick"
     methods = by_key(method_keys)
     specs = [s for s in (QUICK if quick else FULL) if scenes is None or s.name in scenes or s.slug in scenes]
+    specs = [replace(s, size=size or s.size, reference_spp=reference_spp or s.reference_spp) for s in specs]
     os.makedirs(out_dir, exist_ok=True)
     summary = {"mode": mode, "scenes": [], "target_relmse": TARGET_RELMSE}
     lines = ["| scene | method | relMSE at equal time | time to relMSE %.2g | bias (highest spp) | FLIP |" % TARGET_RELMSE,

@@ -19,8 +19,8 @@ class Method:
     color: str = "C0"
 
 
-# Spatial radius 8 px: the harness renders 64x48 to 320x180 images, where the 30 px default mostly lands
-# outside the window or on other surfaces.
+# The spatial radius is not set here: ``settings_for`` scales the 30 px default (meant for 640x360 and
+# up) with the image width, as on 64x48 to 320x180 images 30 px mostly lands outside the window.
 METHODS = [
     Method("cycles", "Cycles (CPU, outside reference)", "CYCLES", {}, (1, 2, 4, 8, 16), (1, 2, 4, 8, 16, 32, 64, 128),
            "C7"),
@@ -29,17 +29,17 @@ METHODS = [
     Method("ris", "RIS (32 light + 1 BSDF candidates)", "RESTIR",
            {"integrator": "RESTIR", "direct_method": "RIS"}, (1, 2, 4), (1, 2, 4, 8, 16, 32), "C1"),
     Method("restir_spatial", "ReSTIR DI spatial only, unbiased", "RESTIR",
-           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "spatial_radius": 8.0,
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED",
             "temporal_reuse": False}, (1, 2, 4), (1, 2, 4, 8, 16, 32), "C2"),
     Method("restir", "ReSTIR DI temporal + spatial, unbiased", "RESTIR",
-           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "spatial_radius": 8.0},
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED"},
            (1, 2, 4), (1, 2, 4, 8, 16, 32), "C4"),
     Method("restir_biased", "ReSTIR DI temporal + spatial, biased (1/M)", "RESTIR",
-           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "NONE", "spatial_radius": 8.0},
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "NONE"},
            (1, 2, 4), (1, 2, 4, 8, 16, 32), "C3"),
     # candidate-count sweep (M_light) for ReSTIR DI temporal + spatial, unbiased
     *[Method(f"restir_m{m}", f"ReSTIR DI, M_light = {m}", "RESTIR",
-             {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "spatial_radius": 8.0,
+             {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED",
               "light_candidates": m}, (1, 2), (1, 2, 4, 8, 16), f"C{5 + i}") for i, m in enumerate((1, 4, 16, 64))],
 ]
 
@@ -50,3 +50,12 @@ DEFAULT_KEYS = ("cycles", "path", "ris", "restir_spatial", "restir", "restir_bia
 def by_key(keys=None):
     keys = DEFAULT_KEYS if keys is None else keys
     return [m for m in METHODS if m.key in keys]
+
+
+def settings_for(method: Method, width: int) -> dict:
+    """The scene.restir settings of ``method`` for an image ``width`` pixels wide: ReSTIR's spatial radius
+    is the 30 px default at 640 px and above, scaled down with the width (at least 6 px) below."""
+    out = dict(method.settings)
+    if out.get("direct_method") == "RESTIR" and "spatial_radius" not in out:
+        out["spatial_radius"] = float(max(6.0, min(30.0, 30.0 * width / 640)))
+    return out
