@@ -132,8 +132,9 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                                     f"export {t_export:.2f}s, render {result.seconds:.2f}s")
 
     def _preroll(self, depsgraph, settings, count: int):
-        """Render frames F-count .. F-1 (one sample each, not written) to build the temporal history a
-        sequential render would have at frame F. Returns the history, or None when cancelled."""
+        """Render frames F-count .. F-1 (with the frame's own samples, not written) to build the temporal
+        history a sequential render would have at frame F: the same sample passes with the same seeds, so
+        a chunk's frames match a sequential render's. Returns the history, or None when cancelled."""
         from dataclasses import replace
         scene = depsgraph.scene
         frame = scene.frame_current
@@ -147,7 +148,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                 try:
                     core = export_scene(depsgraph, self.camera_override)
                     neighbour_frames(self, depsgraph, core, self.camera_override, need_next=False)
-                    history = render_frame(core, replace(settings, samples=1, frame=f), history=history).history
+                    history = render_frame(core, replace(settings, frame=f), history=history).history
                 except (ExportError, Cancelled):
                     history = None
         finally:

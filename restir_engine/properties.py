@@ -53,7 +53,9 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                                  default=True)
     preroll_frames: IntProperty(name="Preroll Frames", description="When a render starts without the previous "
                                 "frame's history (first frame of a farm chunk, a single frame), render this many "
-                                "frames before it first, unsaved, so it looks as in a sequential render",
+                                "frames before it first, unsaved and with the same samples, so it looks as in a "
+                                "sequential render once frames x samples reach the Confidence Cap (costs as many frames' "
+                                "render time, once per chunk)",
                                 default=3, min=0, soft_max=16)
     confidence_cap: FloatProperty(name="Confidence Cap", description="Largest confidence M a reused reservoir keeps",
                                   default=20.0, min=1.0, soft_max=100.0)
