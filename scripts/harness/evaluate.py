@@ -15,8 +15,8 @@ import numpy as np
 
 from . import metrics, report
 from .methods import by_key, settings_for
-from .reference import reference_image
-from .render import render_blend
+from .reference import reference_image, reference_lit
+from .render import render_blend, render_blend_passes
 from .scenes import ANIM_FRAMES, LIGHT_OFF_FRAME, SIZES, ensure_blend
 
 
@@ -51,6 +51,10 @@ TARGET_RELMSE = 0.02
 def evaluate_scene(spec: Spec, methods, quick: bool, refresh: bool = False, log=print):
     blend = ensure_blend(spec.name, spec.variant, spec.size)
     t0 = time.perf_counter()
+    # direct-light scenes also score the light reflected by surfaces alone (Combined - Emission): emitters
+    # seen directly add pixel-coverage noise that no direct-light method changes
+    lit = spec.bounces == 0
+    ref_lit = reference_lit(blend, spec.bounces, spec.reference_spp, refresh=refresh) if lit else None
     ref = reference_image(blend, spec.bounces, spec.reference_spp, refresh=refresh)
     log(f"[{spec.title}] reference ready ({time.perf_counter() - t0:.1f}s)")
     points, images = [], {}
@@ -58,13 +62,17 @@ def evaluate_scene(spec: Spec, methods, quick: bool, refresh: bool = False, log=
         settings = settings_for(m, SIZES[spec.size][0])
         render_blend(blend, m.engine, 1, spec.bounces, settings=settings)  # warm-up, not timed
         for spp in (m.ladder_quick if quick else m.ladder_full):
-            img, wall, core = render_blend(blend, m.engine, spp, spec.bounces, seed=1, settings=settings)
+            passes, wall, core = render_blend_passes(blend, m.engine, spp, spec.bounces, seed=1, settings=settings,
+                                                     emission=lit)
+            img = passes["Combined"][..., :3]
             p = {"method": m.key, "spp": spp, "wall": wall, "core": core, "relmse": metrics.rel_mse(img, ref),
                  "bias": metrics.rel_bias(img, ref), "flip": metrics.flip(img, ref)}
+            if lit:
+                p["relmse_lit"] = metrics.rel_mse(img - passes["Emission"][..., :3], ref_lit)
             points.append(p)
             images[(m.key, spp)] = img
             log(f"[{spec.title}] {m.key:8s} {spp:4d} spp  wall {wall:6.2f}s  relMSE {p['relmse']:.4g}  "
-                f"bias {p['bias'] * 100:+.2f}%")
+                f"bias {p['bias'] * 100:+.2f}%" + (f"  relMSE lit {p['relmse_lit']:.4g}" if lit else ""))
     h, w = ref.shape[:2]
     result = {"title": spec.title, "scene": spec.name, "variant": spec.variant, "size": [w, h],
               "bounces": spec.bounces, "reference_spp": spec.reference_spp, "points": points}
@@ -134,8 +142,8 @@ def run(mode: str, out_dir: str, method_keys=None, scenes=None, refresh=False, l
     specs = [replace(s, size=size or s.size, reference_spp=reference_spp or s.reference_spp) for s in specs]
     os.makedirs(out_dir, exist_ok=True)
     summary = {"mode": mode, "scenes": [], "target_relmse": TARGET_RELMSE}
-    lines = ["| scene | method | relMSE at equal time | time to relMSE %.2g | bias (highest spp) | FLIP |" % TARGET_RELMSE,
-             "|---|---|---|---|---|---|"]
+    lines = ["| scene | method | relMSE at equal time | surfaces only (Combined - Emission) at equal time | "
+             "time to relMSE %.2g | bias (highest spp) | FLIP |" % TARGET_RELMSE, "|---|---|---|---|---|---|---|"]
     for spec in specs:
         result, images, ref = evaluate_scene(spec, methods, quick, refresh, log)
         path_pts = [p for p in result["points"] if p["method"] == "path"] or result["points"]

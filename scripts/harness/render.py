@@ -77,9 +77,10 @@ def render_scene(scene) -> tuple[dict, float]:
         return read_exr(path), wall
 
 
-def render_blend(path: str, engine: str, samples: int, bounces: int, seed: int = 0, frame: int | None = None,
-                 settings: dict | None = None):
-    """Open ``path`` and render one frame. Returns (Combined RGB (h, w, 3), wall s, core s or None)."""
+def render_blend_passes(path: str, engine: str, samples: int, bounces: int, seed: int = 0, frame: int | None = None,
+                        settings: dict | None = None, emission: bool = False):
+    """Open ``path`` and render one frame. Returns (passes {name: (h, w, c)}, wall s, core s or None); with
+    ``emission`` the passes include "Emission" (RGB), emitters seen directly (Cycles: its Emit pass)."""
     bpy.ops.wm.open_mainfile(filepath=path)
     scene = bpy.context.scene
     if frame is not None:
@@ -88,9 +89,24 @@ def render_blend(path: str, engine: str, samples: int, bounces: int, seed: int =
         configure_cycles(scene, samples, bounces, seed)
     else:
         configure_restir(scene, samples, bounces, seed, **(settings or {}))
+    if emission:
+        vl = scene.view_layers[0]
+        if engine == "CYCLES":
+            vl.use_pass_emit = True
+        else:
+            vl.restir.use_pass_emission = True
     passes, wall = render_scene(scene)
+    if emission and "Emit" in passes:
+        passes["Emission"] = passes.pop("Emit")
     core = None
     if engine != "CYCLES":
         from restir_engine.engine import LAST_FRAME_STATS
         core = LAST_FRAME_STATS.get("core_seconds")
+    return passes, wall, core
+
+
+def render_blend(path: str, engine: str, samples: int, bounces: int, seed: int = 0, frame: int | None = None,
+                 settings: dict | None = None):
+    """Open ``path`` and render one frame. Returns (Combined RGB (h, w, 3), wall s, core s or None)."""
+    passes, wall, core = render_blend_passes(path, engine, samples, bounces, seed, frame, settings)
     return passes["Combined"][..., :3], wall, core

@@ -32,13 +32,22 @@ def chart_scene(result: dict, methods, path: str):
         for p in pts:
             axes[0].annotate(str(p["spp"]), (p["wall"], p["relmse"]), fontsize=7, textcoords="offset points",
                              xytext=(3, 3))
+        lit = [p for p in pts if "relmse_lit" in p]
         core = [p for p in pts if p.get("core")]
-        if core:
+        if lit:  # direct-light scene: the right panel scores surfaces only (Combined - Emission)
+            axes[1].loglog([p["wall"] for p in lit], [p["relmse_lit"] for p in lit], "o-", color=m.color,
+                           label=m.label)
+        elif core:
             axes[1].loglog([p["core"] for p in core], [p["relmse"] for p in core], "o-", color=m.color, label=m.label)
+    has_lit = any("relmse_lit" in p for p in result["points"])
     axes[0].set_xlabel("wall-clock seconds per frame (Blender render incl. export)")
-    axes[1].set_xlabel("core seconds per frame (renderer only, our methods)")
+    axes[1].set_xlabel("wall-clock seconds per frame" if has_lit else "core seconds per frame (renderer only, our methods)")
     for ax in axes:
         ax.set_ylabel("relMSE")
+    if has_lit:
+        axes[0].set_title("Combined", fontsize=8)
+        axes[1].set_title("surfaces only: Combined - Emission (emitters seen directly removed)", fontsize=8)
+        axes[1].set_ylabel("relMSE (Combined - Emission)")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle(f"{result['title']}  ({result['size'][0]}x{result['size'][1]}, {result['bounces']} bounces, "
@@ -95,9 +104,13 @@ def table_rows(result: dict, methods, budget: float, target: float) -> list[str]
         errs = [p["relmse"] for p in pts]
         inside = min(walls) <= budget <= max(walls)  # no extrapolation: outside the measured range is "—"
         at_budget = metrics.interpolate_loglog(walls, errs, budget) if inside else float("nan")
+        lit = float("nan")
+        if inside and all("relmse_lit" in p for p in pts):
+            lit = metrics.interpolate_loglog(walls, [p["relmse_lit"] for p in pts], budget)
         reach = metrics.time_to_reach(walls, errs, target)
         best = max(pts, key=lambda p: p["spp"])
         rows.append(f"| {result['title']} | {m.label} | {'—' if math.isnan(at_budget) else f'{at_budget:.4g}'} | "
+                    f"{'—' if math.isnan(lit) else f'{lit:.4g}'} | "
                     f"{'—' if math.isinf(reach) else f'{reach:.2f} s'} | {best['bias'] * 100:+.2f} % ({best['spp']} spp) "
                     f"| {best['flip']:.4f} |")
     return rows
