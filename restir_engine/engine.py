@@ -90,7 +90,9 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         key = (scene.name, view_layer.name)
         prev = _TEMPORAL_HISTORY.pop(key, None)
         history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None
-        if wants_temporal and history is None and scene.restir.preroll_frames > 0:
+        # a chunk of an animation render that starts without history prerolls; a still does not (its
+        # sample passes reuse each other, and a preroll would multiply its cost)
+        if wants_temporal and history is None and self.is_animation and scene.restir.preroll_frames > 0:
             history = self._preroll(depsgraph, settings, int(scene.restir.preroll_frames))
             if history is None:  # cancelled
                 return
@@ -132,9 +134,9 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                                     f"export {t_export:.2f}s, render {result.seconds:.2f}s")
 
     def _preroll(self, depsgraph, settings, count: int):
-        """Render frames F-count .. F-1 (with the frame's own samples, not written) to build the temporal
-        history a sequential render would have at frame F: the same sample passes with the same seeds, so
-        a chunk's frames match a sequential render's. Returns the history, or None when cancelled."""
+        """Render the first sample pass of frames F-count .. F-1 (not written): the history travels through
+        each frame's first pass, so this builds exactly the history a sequential render has at frame F (same
+        seeds) at one pass per frame. Returns the history, or None when cancelled."""
         from dataclasses import replace
         scene = depsgraph.scene
         frame = scene.frame_current
@@ -148,7 +150,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                 try:
                     core = export_scene(depsgraph, self.camera_override)
                     neighbour_frames(self, depsgraph, core, self.camera_override, need_next=False)
-                    history = render_frame(core, replace(settings, frame=f), history=history).history
+                    history = render_frame(core, replace(settings, samples=1, frame=f), history=history).history
                 except (ExportError, Cancelled):
                     history = None
         finally:

@@ -49,14 +49,13 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
     light_tile_size: IntProperty(name="Tile Size", description="Light points per tile", default=1024, min=1,
                                  soft_max=8192)
     temporal_reuse: BoolProperty(name="Temporal Reuse", description="Reuse the reservoir the pixel's surface had "
-                                 "in the previous sample pass, and in the previous frame of an animation",
+                                 "in the previous frame of an animation (through each frame's first sample pass; "
+                                 "the other passes stay independent, so a frame's average is not correlated)",
                                  default=True)
-    preroll_frames: IntProperty(name="Preroll Frames", description="When a render starts without the previous "
-                                "frame's history (first frame of a farm chunk, a single frame), render this many "
-                                "frames before it first, unsaved and with the same samples, so it looks as in a "
-                                "sequential render once frames x samples reach the Confidence Cap (costs as many frames' "
-                                "render time, once per chunk)",
-                                default=3, min=0, soft_max=16)
+    preroll_frames: IntProperty(name="Preroll Frames", description="When an animation job starts without the "
+                                "previous frame's history (the first frame of a farm chunk), first render the first "
+                                "sample pass of this many frames before it, unsaved: the chunk then matches a "
+                                "sequential render exactly", default=3, min=0, soft_max=16)
     confidence_cap: FloatProperty(name="Confidence Cap", description="Largest confidence M a reused reservoir keeps",
                                   default=20.0, min=1.0, soft_max=100.0)
     spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring reservoirs merged per spatial pass",

@@ -31,6 +31,9 @@ METHODS = [
     Method("restir_spatial", "ReSTIR DI spatial only, unbiased", "RESTIR",
            {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED",
             "temporal_reuse": False}, (1, 2, 4), (1, 2, 4, 8, 16, 32), "C2"),
+    Method("restir_temporal", "ReSTIR DI temporal only, unbiased", "RESTIR",
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED",
+            "spatial_neighbors": 0}, (1, 2, 4), (1, 2, 4, 8, 16, 32), "C9"),
     Method("restir", "ReSTIR DI temporal + spatial, unbiased", "RESTIR",
            {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED"},
            (1, 2, 4), (1, 2, 4, 8, 16, 32), "C4"),
@@ -44,7 +47,7 @@ METHODS = [
 ]
 
 # the default evaluation runs these; the sweep entries are picked with --methods
-DEFAULT_KEYS = ("cycles", "path", "ris", "restir_spatial", "restir", "restir_biased")
+DEFAULT_KEYS = ("cycles", "path", "ris", "restir_spatial", "restir_temporal", "restir", "restir_biased")
 
 
 def by_key(keys=None):
