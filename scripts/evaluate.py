@@ -2,7 +2,7 @@
 
 Usage: python scripts/evaluate.py [--mode quick|full] [--methods path cycles] [--scenes cornell ...]
                                   [--refresh-references] [--out docs/results/quick] [--no-animation] [--no-growth]
-                                  [--size tiny|small|medium|large] [--reference-spp N]
+                                  [--size tiny|small|medium|large] [--reference-spp N] [--anim-spp N]
 quick: tiny scenes, short sample ladders (a few minutes on 2 cores); full: the published charts.
 """
 from __future__ import annotations
@@ -27,6 +27,7 @@ def main():
     ap.add_argument("--no-growth", action="store_true")
     ap.add_argument("--size", choices=("tiny", "small", "medium", "large"), help="override every scene's size")
     ap.add_argument("--reference-spp", type=int, help="override the Cycles references' samples")
+    ap.add_argument("--anim-spp", type=int, default=4, help="samples per frame of the animated scene")
     args = ap.parse_args()
     import bpy
 
@@ -37,7 +38,7 @@ def main():
     out = args.out or os.path.join(ROOT, "docs", "results", args.mode)
     run(args.mode, out, args.methods, args.scenes, args.refresh_references,
         animation=not args.no_animation, growth=not args.no_growth, size=args.size,
-        reference_spp=args.reference_spp)
+        reference_spp=args.reference_spp, anim_spp=args.anim_spp)
     print(f"Wrote {out}/summary.md and charts")
 
 

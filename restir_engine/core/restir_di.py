@@ -300,10 +300,12 @@ def neighbor_offsets(k: int, radius: float, rng: np.random.Generator, n: int):
 
 def spatial_reuse(ctx, gb: GBuffer, res: Reservoirs, width: int, height: int, rows: np.ndarray,
                   cfg: SpatialSettings, rng: np.random.Generator, points: FramePoints | None = None) -> Reservoirs:
-    """One spatial pass for pixels ``rows``: merge ``cfg.neighbors`` similar neighbours' reservoirs
-    (weights p̂_p(y_q)·W_q·M_q) into the pixel's own. NONE: W = Σw / (p̂ ΣM) (fast, darkens where
-    neighbours cannot produce the sample); UNBIASED: W = Σw / (p̂ Z), Z = Σ M_q over the merged
-    reservoirs whose target is non-zero at the chosen sample (Bitterli et al. 2020, Alg. 6).
+    """One spatial pass for pixels ``rows``: merge up to ``cfg.neighbors`` similar neighbours' reservoirs
+    into the pixel's own (the canonical one).
+
+    NONE: weights p̂_c(y_q)·W_q·M_q, W = Σw / (p̂ ΣM) (fast; darkens where neighbours cannot produce the
+    sample). UNBIASED: pairwise MIS with confidence weights (see :func:`pairwise_weights`): two target
+    evaluations per neighbour, no Z count, robust where a neighbour's target is far below the pixel's.
     ``points``: the light points of ``res`` (target.FramePoints), computed here when not given."""
     n = len(rows)
     lights = ctx.lights
@@ -311,16 +313,16 @@ def spatial_reuse(ctx, gb: GBuffer, res: Reservoirs, width: int, height: int, ro
         points = FramePoints(lights, res.light, res.b1, res.b2)
     me = gb.shading_terms(rows)
     stream = _Stream(n, rng)
-    m_total = np.zeros(n, np.float32)
     local = np.arange(n)
-    # the pixel's own reservoir
+    valid = gb.valid[rows]
+    m_c = np.where(valid, res.M[rows], 0.0).astype(np.float32)
     own = res.light[rows] >= 0
-    w_own = np.where(own, res.p_hat[rows] * res.W[rows] * res.M[rows], 0.0)
-    stream.add(local, res.light[rows], res.b1[rows], res.b2[rows], w_own, res.p_hat[rows])
-    m_total += np.where(gb.valid[rows], res.M[rows], 0.0)
     offs = neighbor_offsets(cfg.neighbors, cfg.radius, rng, n)
     px, py = rows % width, rows // width
-    merged = []
+    unbiased = cfg.bias_correction == "UNBIASED"
+    # per accepted neighbour: its pixel, mask, M, p̂_c(y_q), and (unbiased) p̂_q(y_c)
+    qs, oks, m_q, pc_at_q, pq_at_c = [], [], [], [], []
+    own_pts = points.at(rows, me.p) if unbiased else None
     for k in range(cfg.neighbors):
         qx = np.round(px + offs[:, k, 0]).astype(np.int64)
         qy = np.round(py + offs[:, k, 1]).astype(np.int64)
@@ -328,39 +330,72 @@ def spatial_reuse(ctx, gb: GBuffer, res: Reservoirs, width: int, height: int, ro
         q = np.where(inside, qy * width + qx, rows)
         # a neighbour outside the window, the pixel itself or one already merged would be a correlated
         # duplicate (biased): skip it
-        ok = inside & gb.valid[q] & (q != rows) & gb.valid[rows]
-        for q_prev, _ok_prev in merged:
+        ok = inside & gb.valid[q] & (q != rows) & valid
+        for q_prev in qs:
             ok &= q != q_prev
         ok &= np.abs(gb.depth[q] - gb.depth[rows]) <= SPATIAL_DEPTH_TOLERANCE * np.maximum(gb.depth[rows], 1e-6)
         ok &= dot(gb.ns[q], gb.ns[rows]) >= SPATIAL_NORMAL_COS
-        merged.append((q, ok))
-        m_total += np.where(ok, res.M[q], 0.0)
-        use = ok & (res.light[q] >= 0)
-        if not use.any():
+        qs.append(q)
+        oks.append(ok)
+        m_q.append(np.where(ok, res.M[q], 0.0).astype(np.float32))
+        if not ok.any():
+            pc_at_q.append(np.zeros(n, np.float32))
+            pq_at_c.append(np.zeros(n, np.float32))
             continue
         p_hat, _pb = me.evaluate(points.at(q, me.p), want_pdf=False)
-        stream.add(local, res.light[q], res.b1[q], res.b2[q], np.where(use, p_hat * res.W[q] * res.M[q], 0.0), p_hat)
-    out = stream.res
-    chosen = out.light >= 0
-    if cfg.bias_correction == "UNBIASED":
-        z = np.where(gb.valid[rows] & chosen & (out.p_hat > 0), res.M[rows], 0.0).astype(np.float32)
-        pts = light_points(lights, np.maximum(out.light, 0), out.b1, out.b2)
-        spots = pts.has_spots
-        for q, ok in merged:
-            use = ok & chosen
-            if not use.any():
-                continue
+        pc_at_q.append(np.where(ok & (res.light[q] >= 0), p_hat, 0.0).astype(np.float32))
+        if unbiased:
             there = gb.shading_terms(q)
-            p_hat_q, _pb = there.evaluate(with_spots(pts, ctx.scene.lamps, there.p) if spots else pts, want_pdf=False)
-            z += np.where(use & (p_hat_q > 0), res.M[q], 0.0)
-        denom = z
+            pts = own_pts if points.spot_tri is None else points.at(rows, there.p)  # spot cones: per receiver
+            p_there, _pb = there.evaluate(pts, want_pdf=False)
+            pq_at_c.append(np.where(ok & own, p_there, 0.0).astype(np.float32))
+    m_total = m_c + (np.sum(m_q, axis=0) if m_q else 0.0)
+    if unbiased:
+        p_own = np.where(own & valid, res.p_hat[rows], 0.0)
+        m_c_w, m_q_w = pairwise_weights(m_c, p_own, m_q, [res.p_hat[q] for q in qs], pc_at_q, pq_at_c, oks)
+        stream.add(local, res.light[rows], res.b1[rows], res.b2[rows], m_c_w * p_own * res.W[rows], res.p_hat[rows])
+        for q, ok, w_mis, pc in zip(qs, oks, m_q_w, pc_at_q):
+            stream.add(local, res.light[q], res.b1[q], res.b2[q], np.where(ok, w_mis * pc * res.W[q], 0.0), pc)
+        denom = np.ones(n, np.float32)
     else:
+        stream.add(local, res.light[rows], res.b1[rows], res.b2[rows],
+                   np.where(own, res.p_hat[rows] * res.W[rows] * res.M[rows], 0.0), res.p_hat[rows])
+        for q, mq, pc in zip(qs, m_q, pc_at_q):
+            stream.add(local, res.light[q], res.b1[q], res.b2[q], pc * res.W[q] * mq, pc)
         denom = m_total
-    ok = chosen & (out.p_hat > 0) & (denom > 0)
+    out = stream.res
+    ok = (out.light >= 0) & (out.p_hat > 0) & (denom > 0)
     out.W = np.where(ok, stream.w_sum / np.maximum(out.p_hat * denom, 1e-30), 0.0).astype(np.float32)
     out.light = np.where(ok, out.light, -1).astype(np.int32)
     out.M = m_total.astype(np.float32)
     return out
+
+
+def pairwise_weights(m_c, p_c, m_q, p_q, pc_at_q, pq_at_c, oks):
+    """Pairwise MIS weights with confidences for one canonical reservoir c and neighbours q = 1..k.
+
+    Each neighbour forms a pair with c, in which c takes a 1/k share of its confidence; pair q holds the
+    share π_q = (M_q + M_c/k) / M_total of the estimate and splits it by the balance heuristic:
+      m_q(y_q) = π_q · M_q p̂_q(y_q) / (M_q p̂_q(y_q) + M_c/k · p̂_c(y_q))
+      m_c(y_c) = Σ_q π_q · M_c/k · p̂_c(y_c) / (M_q p̂_q(y_c) + M_c/k · p̂_c(y_c))      (1 when k = 0)
+    For every sample the weights of all techniques sum to one, and a technique whose target is zero gets
+    weight zero, so the merged reservoir stays unbiased; where all targets agree the weights are the
+    confidence shares M/M_total (the generalized balance heuristic). Arguments are per-slot lists of (n,)
+    arrays; ``p_c`` = p̂_c(y_c), ``p_q`` = p̂_q(y_q) (the targets cached in the reservoirs).
+    Returns (m_c (n,), [m_q (n,)])."""
+    k = np.sum(oks, axis=0).astype(np.float32) if oks else np.zeros_like(m_c)
+    m_total = m_c + (np.sum(m_q, axis=0) if m_q else 0.0)
+    share_c = np.where(k > 0, m_c / np.maximum(k, 1.0), 0.0)
+    inv_total = 1.0 / np.maximum(m_total, 1e-30)
+    w_c = np.where(k > 0, 0.0, 1.0)
+    w_q = []
+    for mq, pq, pcq, pqc, ok in zip(m_q, p_q, pc_at_q, pq_at_c, oks):
+        pi = (mq + share_c) * inv_total
+        a = mq * pq
+        w_q.append(np.where(ok, pi * a / np.maximum(a + share_c * pcq, 1e-30), 0.0))
+        b = share_c * p_c
+        w_c = w_c + np.where(ok, pi * b / np.maximum(mq * pqc + b, 1e-30), 0.0)
+    return w_c.astype(np.float32), [w.astype(np.float32) for w in w_q]
 
 
 # -- temporal reuse ------------------------------------------------------------------------------
@@ -384,8 +419,9 @@ def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, wid
     sample passes of one frame) and projected with the previous camera; the match must pass the G-buffer
     tests (depth within 10 %, normals within 25°, same material), else it is a disocclusion. The previous
     confidence is
-    capped at ``confidence_cap`` x the current one. NONE: W = Σw / (p̂ ΣM); UNBIASED: W = Σw / (p̂ Z),
-    Z counting the previous reservoir only where its own target (at its stored surface) is non-zero."""
+    capped at ``confidence_cap`` x the current one. NONE: W = Σw / (p̂ ΣM); UNBIASED: pairwise MIS with
+    the previous reservoir as the one neighbour (:func:`pairwise_weights`; its target evaluated at its
+    stored surface)."""
     from .camera import project
     n = len(rows)
     me = gb.shading_terms(rows)
@@ -405,31 +441,41 @@ def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, wid
     stream = _Stream(n, rng)
     local = np.arange(n)
     m_own = np.where(gb.valid[rows], res.M[rows], 0.0).astype(np.float32)
-    stream.add(local, res.light[rows], res.b1[rows], res.b2[rows],
-               np.where(res.light[rows] >= 0, res.p_hat[rows] * res.W[rows] * res.M[rows], 0.0), res.p_hat[rows])
+    own = (res.light[rows] >= 0) & gb.valid[rows]
     prev = hist.res
     m_prev = np.where(ok, np.minimum(prev.M[q], confidence_cap * np.maximum(m_own, 1.0)), 0.0).astype(np.float32)
     use = ok & (prev.light[q] >= 0)
+    p_hat = np.zeros(n, np.float32)  # p̂ here of the previous sample
+    pts = None
     if use.any():
         pts = light_points(ctx.lights, np.maximum(prev.light[q], 0), prev.b1[q], prev.b2[q])
-        spots = pts.has_spots
-        p_hat, _pb = me.evaluate(with_spots(pts, ctx.scene.lamps, me.p) if spots else pts, want_pdf=False)
-        stream.add(local, pts.light, pts.b1, pts.b2, np.where(use, p_hat * prev.W[q] * m_prev, 0.0), p_hat)
-    out = stream.res
-    chosen = (out.light >= 0) & (out.p_hat > 0)
+        p_hat, _pb = me.evaluate(with_spots(pts, ctx.scene.lamps, me.p) if pts.has_spots else pts, want_pdf=False)
+        p_hat = np.where(use, p_hat, 0.0).astype(np.float32)
     if bias_correction == "UNBIASED":
-        z = np.where(chosen, m_own, 0.0).astype(np.float32)
-        s2 = chosen & ok
-        if s2.any():
+        # pairwise MIS with one neighbour (the previous reservoir): the balance heuristic with confidences
+        p_prev_at_own = np.zeros(n, np.float32)  # p̂ at the previous surface of the current sample
+        both = ok & own
+        if both.any():
             then = hist.gbuf.shading_terms(q)
-            pts = light_points(ctx.lights, np.maximum(out.light, 0), out.b1, out.b2)
-            p_hat_prev, _pb = then.evaluate(with_spots(pts, ctx.scene.lamps, then.p) if pts.has_spots else pts,
-                                            want_pdf=False)
-            z += np.where(s2 & (p_hat_prev > 0), m_prev, 0.0)
-        denom = z
+            cur = light_points(ctx.lights, np.maximum(res.light[rows], 0), res.b1[rows], res.b2[rows])
+            p_then, _pb = then.evaluate(with_spots(cur, ctx.scene.lamps, then.p) if cur.has_spots else cur,
+                                        want_pdf=False)
+            p_prev_at_own = np.where(both, p_then, 0.0).astype(np.float32)
+        p_own = np.where(own, res.p_hat[rows], 0.0)
+        w_c, (w_p,) = pairwise_weights(m_own, p_own, [m_prev], [np.where(use, prev.p_hat[q], 0.0)], [p_hat],
+                                       [p_prev_at_own], [ok])
+        stream.add(local, res.light[rows], res.b1[rows], res.b2[rows], w_c * p_own * res.W[rows], res.p_hat[rows])
+        if pts is not None:
+            stream.add(local, pts.light, pts.b1, pts.b2, np.where(use, w_p * p_hat * prev.W[q], 0.0), p_hat)
+        denom = np.ones(n, np.float32)
     else:
+        stream.add(local, res.light[rows], res.b1[rows], res.b2[rows],
+                   np.where(own, res.p_hat[rows] * res.W[rows] * res.M[rows], 0.0), res.p_hat[rows])
+        if pts is not None:
+            stream.add(local, pts.light, pts.b1, pts.b2, np.where(use, p_hat * prev.W[q] * m_prev, 0.0), p_hat)
         denom = m_own + m_prev
-    good = chosen & (denom > 0)
+    out = stream.res
+    good = (out.light >= 0) & (out.p_hat > 0) & (denom > 0)
     out.W = np.where(good, stream.w_sum / np.maximum(out.p_hat * denom, 1e-30), 0.0).astype(np.float32)
     out.light = np.where(good, out.light, -1).astype(np.int32)
     out.M = (m_own + m_prev).astype(np.float32)

@@ -133,9 +133,10 @@ def evaluate_growth(quick: bool, log=print):
 
 
 def run(mode: str, out_dir: str, method_keys=None, scenes=None, refresh=False, log=print,
-        animation=True, growth=True, size: str | None = None, reference_spp: int | None = None) -> dict:
+        animation=True, growth=True, size: str | None = None, reference_spp: int | None = None,
+        anim_spp: int = 4) -> dict:
     """``size`` / ``reference_spp``: override every scene's image size (a key of scenes.SIZES) and the
-    Cycles reference's samples."""
+    Cycles reference's samples; ``anim_spp``: samples per frame of the animated scene."""
     quick = mode == "quick"
     methods = by_key(method_keys)
     specs = [s for s in (QUICK if quick else FULL) if scenes is None or s.name in scenes or s.slug in scenes]
@@ -155,7 +156,7 @@ def run(mode: str, out_dir: str, method_keys=None, scenes=None, refresh=False, l
         summary["scenes"].append(result)
     if animation:
         size = "tiny" if quick else "small"
-        anim = evaluate_animation(size, 4, 512 if quick else 2048, methods, quick, refresh, log)
+        anim = evaluate_animation(size, anim_spp, 512 if quick else 2048, methods, quick, refresh, log)
         report.chart_animation(anim, methods, os.path.join(out_dir, "animated.png"))
         summary["animation"] = anim
     if growth:

@@ -37,13 +37,17 @@ METHODS = [
     Method("restir", "ReSTIR DI temporal + spatial, unbiased", "RESTIR",
            {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED"},
            (1, 2, 4), (1, 2, 4, 8, 16, 32), "C4"),
+    Method("restir_tuned", "ReSTIR DI unbiased, radius 10 px, 2 spatial passes", "RESTIR",
+           {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "spatial_radius": 10.0,
+            "spatial_passes": 2}, (1, 2, 4), (1, 2, 4, 8, 16, 32), "C6"),
     Method("restir_biased", "ReSTIR DI temporal + spatial, biased (1/M)", "RESTIR",
            {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "NONE"},
            (1, 2, 4), (1, 2, 4, 8, 16, 32), "C3"),
     # candidate-count sweep (M_light) for ReSTIR DI temporal + spatial, unbiased
     *[Method(f"restir_m{m}", f"ReSTIR DI, M_light = {m}", "RESTIR",
              {"integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED",
-              "light_candidates": m}, (1, 2), (1, 2, 4, 8, 16), f"C{5 + i}") for i, m in enumerate((1, 4, 16, 64))],
+              "light_candidates": m}, (1, 2), (1, 2, 4, 8, 16), colour)
+      for m, colour in zip((1, 4, 16, 64), ("C5", "m", "C8", "k"))],
 ]
 
 # the default evaluation runs these; the sweep entries are picked with --methods
