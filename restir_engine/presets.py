@@ -29,7 +29,7 @@ def apply_preset(settings, name: str) -> None:
 PRESET_ITEMS = [
     ("FAST", "Fast", "Biased ReSTIR, 8 light candidates, 3 neighbours, boiling filter, 4 samples"),
     ("BALANCED", "Balanced", "Biased ReSTIR (1/M), 32 candidates, 5 neighbours, 16 samples"),
-    ("UNBIASED", "Unbiased", "Unbiased ReSTIR (1/Z): converges to the path tracer"),
+    ("UNBIASED", "Unbiased", "Unbiased ReSTIR (pairwise MIS): converges to the path tracer"),
     ("REFERENCE", "Reference", "The path tracer at 256 samples")]
 
 

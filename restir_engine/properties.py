@@ -68,8 +68,8 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
         name="Bias Correction",
         description="How merged reservoirs are normalized",
         items=[("NONE", "None (1/M)", "Fastest; darkens where neighbours could not have produced the sample", 0),
-               ("UNBIASED", "Unbiased (1/Z)", "Counts only neighbours whose target is non-zero at the chosen sample "
-                "(converges to the path tracer)", 1)],
+               ("UNBIASED", "Unbiased (pairwise MIS)", "Pairwise MIS weights with confidences: converges to the "
+                "path tracer and Cycles, robust where neighbours' targets differ; two target evaluations per neighbour", 1)],
         default="UNBIASED")
     boiling_filter: BoolProperty(
         name="Boiling Filter", description="With bias correction None: empty reservoirs whose contribution is "

@@ -43,7 +43,7 @@ class RenderSettings:
     spatial_neighbors: int = 5
     spatial_radius: float = 30.0
     spatial_passes: int = 1
-    bias_correction: str = "UNBIASED"  # spatial/temporal reuse: "NONE" (1/M) or "UNBIASED" (1/Z)
+    bias_correction: str = "UNBIASED"  # spatial/temporal reuse: "NONE" (1/M) or "UNBIASED" (pairwise MIS)
     temporal_reuse: bool = True  # ReSTIR: reuse the previous sample pass's (or frame's) reservoirs
     confidence_cap: float = 20.0
     boiling_filter: bool = False  # bias_correction NONE only: drop reservoirs far above their block's mean

@@ -305,7 +305,7 @@ def spatial_reuse(ctx, gb: GBuffer, res: Reservoirs, width: int, height: int, ro
 
     NONE: weights p̂_c(y_q)·W_q·M_q, W = Σw / (p̂ ΣM) (fast; darkens where neighbours cannot produce the
     sample). UNBIASED: pairwise MIS with confidence weights (see :func:`pairwise_weights`): two target
-    evaluations per neighbour, no Z count, robust where a neighbour's target is far below the pixel's.
+    evaluations per neighbour, robust where a neighbour's target is far below the pixel's.
     ``points``: the light points of ``res`` (target.FramePoints), computed here when not given."""
     n = len(rows)
     lights = ctx.lights
