@@ -15,6 +15,7 @@ import numpy as np
 from . import pathtracer, restir_di
 from .accel import pool
 from .boiling import boiling_filter
+from .context_cache import context_for
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
 from .sampling import STREAM_CAMERA, STREAM_TILES, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, rng
 from .scene import Scene
@@ -99,7 +100,8 @@ class FrameRenderer:
             self.spatial = restir_di.SpatialSettings(max(0, settings.spatial_neighbors),
                                                      max(1.0, float(settings.spatial_radius)),
                                                      max(0, settings.spatial_passes), settings.bias_correction)
-        self.ctx = pathtracer.build_context(scene, settings.max_bounces, settings.film_transparent)
+        self.ctx, self.context_reused = context_for(scene, settings.max_bounces, settings.film_transparent,
+                                                    pathtracer.build_context)
         self.build_seconds = time.perf_counter() - t0
         lights = self.ctx.lights
         self.light_signature = (lights.n_tri, lights.n_sun, hash(lights.power.tobytes()))
@@ -306,4 +308,4 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled,
                        {"build_seconds": fr.build_seconds, "light_tiles": fr.used_tiles, "triangles": len(scene.geometry),
                         "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun,
-                        "boiling_dropped": fr.boiling_dropped}, fr.history)
+                        "boiling_dropped": fr.boiling_dropped, "context_reused": fr.context_reused}, fr.history)
