@@ -108,6 +108,10 @@ class LightTable:
         self.tri_alias = AliasTable(power[:self.n_tri]) if (power[:self.n_tri] > 0).any() else None
         self.sun_alias = AliasTable(power[self.n_tri:]) if (power[self.n_tri:] > 0).any() else None
         self.scene = scene
+        # stable ids across frames: scene triangle index, or len(scene triangles) + lamp triangle index
+        self.light_uid = np.concatenate([g_idx, len(geom) + l_idx]).astype(np.int64)
+        self.uid_space = (len(geom), len(lamps.tris))
+        self.signature = (self.n_tri, self.n_sun, hash(power.tobytes()))
 
     @property
     def empty(self) -> bool:

@@ -104,10 +104,10 @@ class FrameRenderer:
                                                     pathtracer.build_context)
         self.build_seconds = time.perf_counter() - t0
         lights = self.ctx.lights
-        self.light_signature = (lights.n_tri, lights.n_sun, hash(lights.power.tobytes()))
+        self.light_signature = lights.signature
         self.set_camera(scene.camera)
         if history is not None and self._history_fits(history):
-            self.prev_history = history  # from the previous frame of an animation
+            self.prev_history = history.remapped(lights)  # from the previous frame (None: lights cannot map)
 
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
@@ -215,7 +215,7 @@ class FrameRenderer:
 
     def _history_fits(self, hist) -> bool:
         cam = self.ctx.scene.camera
-        return (hist.light_signature == self.light_signature and hist.camera.window[2:] == cam.window[2:]
+        return (hist.camera.window[2:] == cam.window[2:]
                 and (hist.camera.width, hist.camera.height) == (cam.width, cam.height))
 
     def _spatial_and_shade(self, results, s: int):
@@ -256,8 +256,9 @@ class FrameRenderer:
         if s == 0:  # the next frame's history; confidence at most the cap, so no reused M ever exceeds it
             capped = restir_di.Reservoirs(res.light, res.b1, res.b2, np.minimum(res.M, st.confidence_cap), res.W,
                                           res.p_hat)
+            lights = self.ctx.lights
             self.history = restir_di.TemporalHistory(self._gbuf, capped, self.ctx.scene.camera, self.light_signature,
-                                                     st.frame)
+                                                     st.frame, lights.light_uid, lights.uid_space)
         for (tx, ty, tw, th), (_e, d, _i, _a, reservoir) in results:
             rows = reservoir["rows"]
             d += direct[rows]

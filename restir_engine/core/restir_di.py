@@ -21,6 +21,7 @@ Reservoir memory per pixel: light index (int32), barycentrics b1, b2, confidence
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -409,6 +410,31 @@ class TemporalHistory:
     camera: object
     light_signature: tuple
     frame: int = 0
+    light_uid: np.ndarray | None = None  # (n_tri,) stable id of each light (lights.LightTable.light_uid)
+    uid_space: tuple = ()                # (scene triangles, lamp triangles) the ids index into
+    had_light: np.ndarray | None = None  # after remapping to a new light table: (n_tri,) bool, lights of the
+    #                                      current table that were lights in this history's frame
+
+    def remapped(self, lights) -> "TemporalHistory | None":
+        """This history for the light table ``lights`` of the next frame: identical tables keep it as it is;
+        tables over the same triangles (lights switched on/off or re-powered) get the reservoirs' light
+        indices remapped through the stable ids (a light that went out leaves an empty reservoir) and
+        ``had_light`` set; anything else cannot be mapped (None)."""
+        if self.light_signature == lights.signature:
+            return self
+        if self.light_uid is None or self.uid_space != lights.uid_space:
+            return None
+        uid_to_light = np.full(int(sum(self.uid_space)), -1, np.int64)
+        uid_to_light[lights.light_uid] = np.arange(lights.n_tri)
+        old = self.res.light
+        light = np.where(old >= 0, uid_to_light[self.light_uid[np.maximum(old, 0)]], -1).astype(np.int32)
+        gone = (old >= 0) & (light < 0)
+        res = Reservoirs(light, self.res.b1, self.res.b2, self.res.M, np.where(gone, 0.0, self.res.W).astype(np.float32),
+                         np.where(gone, 0.0, self.res.p_hat).astype(np.float32))
+        had = np.zeros(int(sum(self.uid_space)), bool)
+        had[self.light_uid] = True
+        return dataclasses.replace(self, res=res, light_signature=lights.signature, light_uid=lights.light_uid,
+                                   had_light=had[lights.light_uid])
 
 
 def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, width: int, rows: np.ndarray,
@@ -460,6 +486,8 @@ def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, wid
             cur = light_points(ctx.lights, np.maximum(res.light[rows], 0), res.b1[rows], res.b2[rows])
             p_then, _pb = then.evaluate(with_spots(cur, ctx.scene.lamps, then.p) if cur.has_spots else cur,
                                         want_pdf=False)
+            if hist.had_light is not None:  # the previous frame could not have produced lights that were off
+                p_then = np.where(hist.had_light[np.maximum(res.light[rows], 0)], p_then, 0.0)
             p_prev_at_own = np.where(both, p_then, 0.0).astype(np.float32)
         p_own = np.where(own, res.p_hat[rows], 0.0)
         w_c, (w_p,) = pairwise_weights(m_own, p_own, [m_prev], [np.where(use, prev.p_hat[q], 0.0)], [p_hat],
