@@ -36,6 +36,7 @@ VARIANTS = [
     ("spatial", "spatial only", {**BASE, "temporal_reuse": False}),
     ("temporal", "temporal only", {**BASE, "spatial_neighbors": 0}),
     ("both", "temporal + spatial (defaults)", BASE),
+    ("both_r10", "temporal + spatial, 10 px", {**BASE, "spatial_radius": 10.0}),
     ("both_tuned", "temporal + spatial, 10 px, 2 passes", {**BASE, "spatial_radius": 10.0, "spatial_passes": 2}),
     ("biased", "temporal + spatial, biased (1/M)", {**BASE, "bias_correction": "NONE"}),
 ]
@@ -64,6 +65,13 @@ def main():
         out["variants"][key] = {"label": label, "settings": st, "relmse": errs, "seconds": secs}
         print(f"{label:40s} relMSE per frame {' '.join(f'{e:.3f}' for e in errs)}  "
               f"mean time {np.mean(secs[1:]):.2f}s", flush=True)
+    path = out["variants"]["path"]
+    base = np.mean(path["relmse"]) * np.mean(path["seconds"][1:])  # relMSE x seconds: the path tracer's efficiency
+    for v in out["variants"].values():
+        v["steady_relmse"] = float(np.mean(v["relmse"][-3:]))
+        v["efficiency_vs_path"] = float(base / (v["steady_relmse"] * np.mean(v["seconds"][1:])))
+        print(f"{v['label']:40s} steady relMSE {v['steady_relmse']:.3f}  "
+              f"x{v['efficiency_vs_path']:.1f} vs path at equal time")
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "ablation.json"), "w") as fh:
         json.dump(out, fh, indent=1)
