@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import bpy
 import numpy as np
@@ -34,6 +35,12 @@ def settings_from_scene(scene) -> RenderSettings:
                           light_tile_size=int(s.light_tile_size), boiling_filter=bool(s.boiling_filter),
                           boiling_threshold=float(s.boiling_threshold),
                           film_transparent=bool(scene.render.film_transparent))
+
+
+def with_data_passes(settings: RenderSettings, view_layer) -> RenderSettings:
+    """``settings`` computing Depth/Normal/Vector only when the view layer writes one of them."""
+    wanted = bool(view_layer.use_pass_z or view_layer.use_pass_normal or view_layer.use_pass_vector)
+    return replace(settings, data_passes=wanted)
 
 
 def scene_problems(core_scene, light_count: int) -> list[str]:
@@ -85,7 +92,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         t0 = time.perf_counter()
-        settings = settings_from_scene(scene)
+        settings = with_data_passes(settings_from_scene(scene), view_layer)
         wants_temporal = settings.integrator == "RESTIR" and settings.direct_method == "RESTIR" and settings.temporal_reuse
         key = (scene.name, view_layer.name)
         prev = _TEMPORAL_HISTORY.pop(key, None)
@@ -137,7 +144,6 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         """Render the first sample pass of frames F-count .. F-1 (not written): the history travels through
         each frame's first pass, so this builds exactly the history a sequential render has at frame F (same
         seeds) at one pass per frame. Returns the history, or None when cancelled."""
-        from dataclasses import replace
         scene = depsgraph.scene
         frame = scene.frame_current
         history = None
@@ -150,7 +156,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                 try:
                     core = export_scene(depsgraph, self.camera_override)
                     neighbour_frames(self, depsgraph, core, self.camera_override, need_next=False)
-                    history = render_frame(core, replace(settings, samples=1, frame=f), history=history).history
+                    history = render_frame(core, replace(settings, samples=1, frame=f, data_passes=False),
+                                           history=history).history
                 except (ExportError, Cancelled):
                     history = None
         finally:
@@ -174,6 +181,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             return
         settings = settings_from_scene(scene)
         settings.samples = 1
+        settings.data_passes = False  # the viewport shows Combined only
         settings.tile_pixels = 4096  # small tiles: the view reacts quickly to navigation
         self._viewport.set_scene(core_scene, settings)
         self._viewport.set_view(cam, self._view_key(context, w, h))

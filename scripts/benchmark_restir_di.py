@@ -34,7 +34,7 @@ from restir_engine.export import export_scene  # noqa: E402
 
 RESTIR_DEFAULTS = dict(integrator="RESTIR", direct_method="RESTIR", bias_correction="UNBIASED", temporal_reuse=True,
                        spatial_neighbors=5, spatial_radius=30.0, light_candidates=32, bsdf_candidates=1,
-                       max_bounces=0, samples=1)
+                       max_bounces=0, samples=1, data_passes=False)  # Combined only, as a render without Z/Normal/Vector
 LIGHT_COUNTS = {"100": 100, "1k": 1000, "10k": 10000, "100k": 100000, "1m": 1000000}
 
 

@@ -266,3 +266,22 @@ def test_chunked_render_matches_sequential(addon):
     se = np.sqrt(a.var(ddof=1) / len(a) + b.var(ddof=1) / len(b))
     assert abs(a.mean() - b.mean()) < 5 * se, (a.mean(), b.mean(), se)
     assert abs(np.mean(ms[True]) / np.mean(ms[False]) - 1) < 0.05, (np.mean(ms[True]), np.mean(ms[False]))
+
+
+def test_data_passes_only_when_written(addon):
+    """Depth, Normal and Vector cost a ray per pixel: the engine asks the core for them only when the view
+    layer writes one, and the core then skips them."""
+    from restir_engine.core.renderer import RenderSettings, render_frame
+    from restir_engine.engine import settings_from_scene, with_data_passes
+    from scenes_core import floor_with_emitter
+    scene = cornell_box("AREA", (16, 16))
+    configure_restir(scene, 1, 0)
+    vl = scene.view_layers[0]
+    vl.use_pass_z = vl.use_pass_normal = vl.use_pass_vector = False
+    assert not with_data_passes(settings_from_scene(scene), vl).data_passes
+    vl.use_pass_vector = True
+    assert with_data_passes(settings_from_scene(scene), vl).data_passes
+    core = floor_with_emitter(width=8)
+    assert not {"Depth", "Normal", "Vector"} & set(render_frame(core, RenderSettings(samples=1,
+                                                                                   data_passes=False)).passes)
+    assert {"Depth", "Normal", "Vector"} <= set(render_frame(core, RenderSettings(samples=1)).passes)

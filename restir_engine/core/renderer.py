@@ -53,6 +53,7 @@ class RenderSettings:
     light_tile_count: int = 128
     light_tile_size: int = 1024
     film_transparent: bool = False
+    data_passes: bool = True  # Depth, Normal and Vector (one more ray per pixel and frame); off when not written
     tile_pixels: int = 16384
 
 
@@ -275,10 +276,10 @@ class FrameRenderer:
     def passes(self) -> dict:
         """All passes (see :class:`FrameResult`); finite everywhere."""
         inv = 1.0 / max(1, self.samples_done)
-        depth, normal, vector = self.data_passes()
-        out = {"Combined": self.combined(), "Depth": depth, "Normal": normal, "Vector": vector,
-               "Direct": self.acc["direct"] * inv, "Indirect": self.acc["indirect"] * inv,
+        out = {"Combined": self.combined(), "Direct": self.acc["direct"] * inv, "Indirect": self.acc["indirect"] * inv,
                "Emission": self.acc["emit"] * inv}
+        if self.settings.data_passes:
+            out["Depth"], out["Normal"], out["Vector"] = self.data_passes()
         if self.di is not None and self.di.method in ("RIS", "RESTIR"):
             out["Reservoir M"] = (self.acc["res_m"] * inv)[..., None]
             out["Reservoir UCW"] = (self.acc["res_w"] * inv)[..., None]
