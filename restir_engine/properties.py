@@ -27,7 +27,7 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
         items=[("LIGHT_SAMPLING", "Light Sampling", "Baseline: one light sample and one BSDF sample combined by MIS", 0),
                ("RIS", "RIS", "Resampled importance sampling: pick one of many light and BSDF candidates by the "
                 "unshadowed contribution, then trace one shadow ray (unbiased)", 1),
-               ("RESTIR", "ReSTIR", "RIS, then reuse of the previous sample pass's or frame's reservoirs (temporal) "
+               ("RESTIR", "ReSTIR", "RIS, then reuse of the previous frame's reservoirs (temporal) "
                 "and of neighbouring pixels' (spatial)", 2)],
         default="RESTIR", update=_update_passes)
     light_candidates: IntProperty(name="Light Candidates", description="Light samples per pixel resampled by RIS",

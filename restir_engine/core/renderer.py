@@ -45,7 +45,7 @@ class RenderSettings:
     spatial_radius: float = 30.0
     spatial_passes: int = 1
     bias_correction: str = "UNBIASED"  # spatial/temporal reuse: "NONE" (1/M) or "UNBIASED" (pairwise MIS)
-    temporal_reuse: bool = True  # ReSTIR: reuse the previous sample pass's (or frame's) reservoirs
+    temporal_reuse: bool = True  # ReSTIR: pass 0 of a frame reuses pass 0 of the previous frame (history)
     confidence_cap: float = 20.0
     boiling_filter: bool = False  # bias_correction NONE only: drop reservoirs far above their block's mean
     boiling_threshold: float = 20.0  # x the 16x16 block's mean p̂·W (core.boiling)

@@ -439,7 +439,7 @@ class TemporalHistory:
 
 def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, width: int, rows: np.ndarray,
                    confidence_cap: float, bias_correction: str, motion, rng: np.random.Generator) -> Reservoirs:
-    """Merge each pixel's reservoir with the reservoir its primary hit had in the previous pass/frame.
+    """Merge each pixel's reservoir with the reservoir its primary hit had in the previous frame.
 
     The hit is moved with its object's previous transform (``motion``: scene.Motion, or None between
     sample passes of one frame) and projected with the previous camera; the match must pass the G-buffer
