@@ -54,6 +54,18 @@ def floor_with_emitter(albedo=0.5, le=4.0, height=1.0, half=0.5, width=32, two_s
     return Scene(concat([floor, light]), mats, Lamps.empty(), top_down_camera(width, width, height_above=0.5 * height))
 
 
+def add_emitters(scene: Scene, emissions) -> list[int]:
+    """Append black emissive materials of RGB radiance ``emissions`` (W·sr⁻¹·m⁻², two-sided) to the scene's
+    table (kept: base colour, f0, emission, two-sidedness of the existing ones); returns their indices."""
+    mats = scene.materials
+    rows = [{"base_color": tuple(mats.base_color[i]), "f0": float(mats.f0[i]), "emission": tuple(mats.emission[i]),
+             "two_sided_emission": bool(mats.two_sided_emission[i])} for i in range(len(mats.names))]
+    first = len(rows)
+    rows += [{"base_color": (0, 0, 0), "f0": 0.0, "emission": tuple(e)} for e in emissions]
+    scene.materials = MaterialTable.build(rows)
+    return list(range(first, len(rows)))
+
+
 def irradiance_square(h: float, a: float) -> float:
     """Irradiance / radiance at the point under the centre of a 2a x 2a square at height h:
     E = L * 4 * (a/√(a²+h²)) * atan(a/√(a²+h²)) (unit-radiance square, standard form factor)."""

@@ -4,8 +4,7 @@ import numpy as np
 from restir_engine.core.boiling import boiling_filter
 from restir_engine.core.renderer import RenderSettings, render_frame
 from restir_engine.core.restir_di import Reservoirs
-from restir_engine.core.scene import MaterialTable
-from scenes_core import concat, floor_with_emitter, quad, tris
+from scenes_core import add_emitters, concat, floor_with_emitter, quad, tris
 from test_restir_stability import RESTIR, with_tiny_bright_light
 
 
@@ -45,12 +44,8 @@ def light_near_the_floor(width=32):
     """A large emitter 1 m above a floor and a 4 cm one 3 cm above it: the small light has 0.2 % of the
     power, so the floor under it rarely draws it and then gets a huge weight (the outliers boiling spreads)."""
     scene = floor_with_emitter(width=width, le=2.0)
-    mats = scene.materials
-    rows = [{"base_color": tuple(mats.base_color[i]), "f0": float(mats.f0[i]), "emission": tuple(mats.emission[i])}
-            for i in range(len(mats.names))]
-    rows.append({"base_color": (0, 0, 0), "f0": 0.0, "emission": (100.0,) * 3})
-    scene.materials = MaterialTable.build(rows)
-    scene.geometry = concat([scene.geometry, tris(quad((0.3, -0.2, 0.03), (0, 0.02, 0), (0.02, 0, 0)), len(rows) - 1)])
+    (lamp,) = add_emitters(scene, [(100.0,) * 3])
+    scene.geometry = concat([scene.geometry, tris(quad((0.3, -0.2, 0.03), (0, 0.02, 0), (0.02, 0, 0)), lamp)])
     return scene
 
 

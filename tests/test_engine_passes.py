@@ -136,16 +136,12 @@ def test_reservoir_passes_only_with_reservoirs(box):
 def test_animation_carries_temporal_history_between_frames(addon, tmp_path):
     """Frames rendered in sequence reuse the previous frame's reservoirs (confidence grows up to the cap);
     a frame rendered on its own starts fresh."""
-    from harness.render import read_exr
+    from harness.render import read_exr, use_multilayer_exr
     scene = cornell_box("AREA", (24, 24))
     configure_restir(scene, 1, 0, integrator="RESTIR", direct_method="RESTIR", spatial_neighbors=0,
                      confidence_cap=2.0, preroll_frames=0)
     scene.view_layers[0].restir.use_pass_reservoir_m = True
-    settings = scene.render.image_settings
-    if hasattr(settings, "media_type"):
-        settings.media_type = "MULTI_LAYER_IMAGE"
-    else:
-        settings.file_format = "OPEN_EXR_MULTILAYER"
+    use_multilayer_exr(scene)
     scene.frame_start, scene.frame_end = 1, 3
     scene.render.filepath = str(tmp_path / "f_")
     bpy.ops.render.render(animation=True)
@@ -189,13 +185,8 @@ def render_chunk(scene, first: int, last: int) -> dict:
     """Render frames first..last as an animation job (a farm chunk); passes of the last frame."""
     import tempfile
 
-    from harness.render import read_exr
-    settings = scene.render.image_settings
-    if hasattr(settings, "media_type"):
-        settings.media_type = "MULTI_LAYER_IMAGE"
-    else:
-        settings.file_format = "OPEN_EXR_MULTILAYER"
-    settings.color_depth = "32"
+    from harness.render import read_exr, use_multilayer_exr
+    use_multilayer_exr(scene)
     scene.frame_start, scene.frame_end = first, last
     with tempfile.TemporaryDirectory() as tmp:
         scene.render.filepath = tmp + "/f_"

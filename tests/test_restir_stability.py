@@ -4,8 +4,7 @@ with the path tracer within 5 standard errors."""
 import numpy as np
 
 from restir_engine.core.renderer import RenderSettings, render_frame
-from scenes_core import concat, floor_with_emitter, quad, tris
-from restir_engine.core.scene import MaterialTable
+from scenes_core import add_emitters, concat, floor_with_emitter, quad, tris
 
 RESTIR = dict(max_bounces=0, integrator="RESTIR", direct_method="RESTIR", light_candidates=4, spatial_radius=6)
 
@@ -32,12 +31,8 @@ def test_lights_behind_the_surface_give_nothing():
 def with_tiny_bright_light(width=32):
     """A dim emitter over a floor plus a 1 cm light 40000x brighter."""
     scene = floor_with_emitter(width=width, le=0.5)
-    mats = scene.materials
-    rows = [{"base_color": tuple(mats.base_color[i]), "f0": float(mats.f0[i]), "emission": tuple(mats.emission[i])}
-            for i in range(len(mats.names))]
-    rows.append({"base_color": (0, 0, 0), "f0": 0.0, "emission": (20000.0,) * 3})
-    scene.materials = MaterialTable.build(rows)
-    tiny = tris(quad((0.3, -0.2, 0.6), (0, 0.005, 0), (0.005, 0, 0)), len(rows) - 1)
+    (bright,) = add_emitters(scene, [(20000.0,) * 3])
+    tiny = tris(quad((0.3, -0.2, 0.6), (0, 0.005, 0), (0.005, 0, 0)), bright)
     scene.geometry = concat([scene.geometry, tiny])
     return scene
 
@@ -97,11 +92,8 @@ def _occluder_scene(x: float, prev_x: float):
     20 cm beside it, which the floor sees and the board's top never can."""
     from restir_engine.core.scene import Motion
     scene = floor_with_emitter(width=32)
-    mats = scene.materials
-    rows = [{"base_color": tuple(mats.base_color[i]), "f0": float(mats.f0[i]), "emission": tuple(mats.emission[i])}
-            for i in range(len(mats.names))]
-    scene.materials = MaterialTable.build(rows + [{"base_color": (0, 0, 0), "f0": 0.0, "emission": (40.0,) * 3}])
-    low_lamp = tris(quad((0.0, 0.4, 0.15), (0, 0.1, 0), (0.1, 0, 0)), len(rows))
+    (lamp,) = add_emitters(scene, [(40.0,) * 3])
+    low_lamp = tris(quad((0.0, 0.4, 0.15), (0, 0.1, 0), (0.1, 0, 0)), lamp)
     board = tris(quad((x, 0.0, 0.45), (0.25, 0, 0), (0, 0.25, 0)), 0)
     scene.geometry = concat([scene.geometry, low_lamp, board])
     scene.geometry.instance = np.array([0, 0, 1, 1, 1, 1, 2, 2], np.int32)
@@ -150,13 +142,8 @@ def _thousands_of_tiny_lights(n=5000, width=32):
     corners = np.array([[-h, -h, 0], [h, -h, 0], [h, h, 0], [-h, h, 0]], np.float32)
     p = c[:, None, :] + corners[None]                                   # (n, 4, 3), wound for normal +z
     verts = np.concatenate([p[:, [0, 2, 1]], p[:, [0, 3, 2]]])          # reversed: normal -z (facing down)
-    mats = scene.materials
-    rows = [{"base_color": tuple(mats.base_color[i]), "f0": float(mats.f0[i]), "emission": tuple(mats.emission[i])}
-            for i in range(len(mats.names))]
-    strengths = [2000.0, 20000.0, 200000.0]
-    rows += [{"base_color": (0, 0, 0), "f0": 0.0, "emission": (s,) * 3} for s in strengths]
-    scene.materials = MaterialTable.build(rows)
-    material = np.tile(len(rows) - 3 + g.integers(0, 3, n), 2).astype(np.int32)
+    first = add_emitters(scene, [(s,) * 3 for s in (2000.0, 20000.0, 200000.0)])[0]
+    material = np.tile(first + g.integers(0, 3, n), 2).astype(np.int32)
     normals = np.zeros_like(verts)
     normals[..., 2] = -1
     floor = scene.geometry
@@ -201,12 +188,8 @@ def _two_lamps(second_on: bool, width=24):
     """Floor, the big emitter and a second one beside it with its own material, switched on or off by its
     emission (the triangles stay, as when a lamp's strength is animated in Blender)."""
     scene = floor_with_emitter(width=width)
-    mats = scene.materials
-    rows = [{"base_color": tuple(mats.base_color[i]), "f0": float(mats.f0[i]), "emission": tuple(mats.emission[i])}
-            for i in range(len(mats.names))]
-    rows.append({"base_color": (0, 0, 0), "f0": 0.0, "emission": (12.0, 6.0, 2.0) if second_on else (0.0,) * 3})
-    scene.materials = MaterialTable.build(rows)
-    scene.geometry = concat([scene.geometry, tris(quad((0.6, 0.3, 0.5), (0, 0.15, 0), (0.15, 0, 0)), len(rows) - 1)])
+    (lamp,) = add_emitters(scene, [(12.0, 6.0, 2.0) if second_on else (0.0,) * 3])
+    scene.geometry = concat([scene.geometry, tris(quad((0.6, 0.3, 0.5), (0, 0.15, 0), (0.15, 0, 0)), lamp)])
     return scene
 
 

@@ -60,14 +60,19 @@ def read_exr(path: str) -> dict:
     return {k: np.concatenate([p for _n, p in sorted(v)], axis=2) if len(v) > 1 else v[0][1] for k, v in out.items()}
 
 
-def render_scene(scene) -> tuple[dict, float]:
-    """Render the current frame of ``scene``: (passes, wall seconds of the whole render incl. export)."""
+def use_multilayer_exr(scene) -> None:
+    """Write renders of ``scene`` as 32-bit multilayer EXR (every pass; Blender 4.x and 5.x settings)."""
     settings = scene.render.image_settings
     if hasattr(settings, "media_type"):
         settings.media_type = "MULTI_LAYER_IMAGE"
     else:
         settings.file_format = "OPEN_EXR_MULTILAYER"
     settings.color_depth = "32"
+
+
+def render_scene(scene) -> tuple[dict, float]:
+    """Render the current frame of ``scene``: (passes, wall seconds of the whole render incl. export)."""
+    use_multilayer_exr(scene)
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "render.exr")
         scene.render.filepath = path
