@@ -98,7 +98,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         prev = _TEMPORAL_HISTORY.pop(key, None)
         history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None
         # a chunk of an animation render that starts without history prerolls; a still does not (its
-        # sample passes reuse each other, and a preroll would multiply its cost)
+        # sample passes are independent, and only animations carry history from frame to frame)
         if wants_temporal and history is None and self.is_animation and scene.restir.preroll_frames > 0:
             history = self._preroll(depsgraph, settings, int(scene.restir.preroll_frames))
             if history is None:  # cancelled

@@ -104,11 +104,9 @@ class FrameRenderer:
         self.ctx, self.context_reused = context_for(scene, settings.max_bounces, settings.film_transparent,
                                                     pathtracer.build_context)
         self.build_seconds = time.perf_counter() - t0
-        lights = self.ctx.lights
-        self.light_signature = lights.signature
         self.set_camera(scene.camera)
         if history is not None and self._history_fits(history):
-            self.prev_history = history.remapped(lights)  # from the previous frame (None: lights cannot map)
+            self.prev_history = history.remapped(self.ctx.lights)  # from the previous frame (None: lights cannot map)
 
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
@@ -228,7 +226,7 @@ class FrameRenderer:
         spans = [np.arange(a, min(w * h, a + st.tile_pixels)) for a in range(0, w * h, st.tile_pixels)]
         if st.temporal_reuse and s == 0 and self.prev_history is not None:
             hist = self.prev_history
-            # object motion applies between frames; sample passes of one frame share the same geometry
+            # object motion is known for the previous frame only; a history from another frame gets none
             motion = self.ctx.scene.motion if hist.frame == st.frame - 1 else None
             parts = list(pool().map(lambda a: (a[1], restir_di.temporal_reuse(
                 self.ctx, self._gbuf, res, hist, w, a[1], st.confidence_cap, st.bias_correction, motion,
@@ -258,7 +256,7 @@ class FrameRenderer:
             capped = restir_di.Reservoirs(res.light, res.b1, res.b2, np.minimum(res.M, st.confidence_cap), res.W,
                                           res.p_hat)
             lights = self.ctx.lights
-            self.history = restir_di.TemporalHistory(self._gbuf, capped, self.ctx.scene.camera, self.light_signature,
+            self.history = restir_di.TemporalHistory(self._gbuf, capped, self.ctx.scene.camera, lights.signature,
                                                      st.frame, lights.light_uid, lights.uid_space)
         for (tx, ty, tw, th), (_e, d, _i, _a, reservoir) in results:
             rows = reservoir["rows"]

@@ -441,8 +441,8 @@ def temporal_reuse(ctx, gb: GBuffer, res: Reservoirs, hist: TemporalHistory, wid
                    confidence_cap: float, bias_correction: str, motion, rng: np.random.Generator) -> Reservoirs:
     """Merge each pixel's reservoir with the reservoir its primary hit had in the previous frame.
 
-    The hit is moved with its object's previous transform (``motion``: scene.Motion, or None between
-    sample passes of one frame) and projected with the previous camera; the match must pass the G-buffer
+    The hit is moved with its object's previous transform (``motion``: scene.Motion, or None when the
+    history is not from the previous frame) and projected with the previous camera; the match must pass the G-buffer
     tests (depth within 10 %, normals within 25°, same material), else it is a disocclusion. The previous
     confidence is
     capped at ``confidence_cap`` x the current one. NONE: W = Σw / (p̂ ΣM); UNBIASED: pairwise MIS with
