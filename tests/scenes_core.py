@@ -84,3 +84,48 @@ def emissive_furnace(albedo=0.5, le=1.0, width=24) -> Scene:
     cam = top_down_camera(width, width, height_above=0.5, half_extent=0.9)
     cam.clip_start = 0.01
     return Scene(box, mats, Lamps.empty(), cam)
+
+
+def perspective_camera(eye, target, width=48, height=36, fov_y_deg=50.0, near=0.05, far=100.0) -> Camera:
+    """Pinhole camera at ``eye`` looking at ``target`` (+Z up), OpenGL-style projection as Blender's."""
+    eye, target = np.asarray(eye, np.float64), np.asarray(target, np.float64)
+    fwd = target - eye
+    fwd /= np.linalg.norm(fwd)
+    right = np.cross(fwd, (0.0, 0.0, 1.0))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    c2w = np.eye(4)
+    c2w[:3, 0], c2w[:3, 1], c2w[:3, 2], c2w[:3, 3] = right, up, -fwd, eye
+    f = 1.0 / np.tan(np.radians(fov_y_deg) / 2)
+    proj = np.array([[f * height / width, 0, 0, 0], [0, f, 0, 0],
+                     [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1, 0]])
+    return Camera(c2w, np.linalg.inv(proj), width, height, (0, 0, width, height), clip_start=near, clip_end=far)
+
+
+def regression_room(width=48, height=36) -> Scene:
+    """A small room with every feature the integrators branch on: a glossy Principled-like floor, a metal
+    block, diffuse walls (one open side to a grey world), an occluder, three coloured emitters (one tiny and
+    bright) and a sun. Used for fixed-seed before/after image comparisons."""
+    mats = MaterialTable.build([
+        {"base_color": (0.6, 0.6, 0.55), "roughness": 0.3, "f0": 0.04},               # 0 glossy floor
+        {"base_color": (0.7, 0.3, 0.2), "roughness": 1.0, "f0": 0.0},                 # 1 diffuse wall
+        {"base_color": (0.9, 0.8, 0.5), "roughness": 0.2, "metallic": 1.0},            # 2 metal block
+        {"base_color": (0, 0, 0), "f0": 0.0, "emission": (6.0, 5.0, 4.0)},             # 3 warm panel
+        {"base_color": (0, 0, 0), "f0": 0.0, "emission": (1.0, 2.0, 6.0)},             # 4 blue strip
+        {"base_color": (0, 0, 0), "f0": 0.0, "emission": (3000.0, 3000.0, 3000.0)},    # 5 tiny bright
+    ])
+    parts = [tris(quad((0, 0, 0), (2, 0, 0), (0, 2, 0)), 0),
+             tris(quad((0, 2, 1), (2, 0, 0), (0, 0, 1)), 1),
+             tris(quad((-2, 0, 1), (0, 0, 1), (0, 2, 0)), 1),
+             tris(quad((0.5, 0.6, 0.4), (0.3, 0, 0), (0, 0, 0.4)), 2),   # block front face (normal -y)
+             tris(quad((0.5, 0.6, 0.8), (0.3, 0, 0), (0, 0.3, 0)), 2),   # block top
+             tris(quad((0, 0.5, 1.9), (0, 0.5, 0), (0.5, 0, 0)), 3),     # ceiling panel facing down
+             tris(quad((-1.95, 1.0, 1.0), (0, 0.6, 0), (0, 0, 0.05)), 4),  # strip on the left wall
+             tris(quad((-0.6, -0.3, 0.5), (0, 0.01, 0), (0.01, 0, 0)), 5)]  # tiny light facing down
+    lamps = Lamps.empty()
+    d = np.array([[0.4, -0.3, 0.86]], np.float32)
+    lamps.sun_dir = d / np.linalg.norm(d)
+    lamps.sun_cos = np.array([np.cos(0.02)], np.float32)
+    lamps.sun_irradiance = np.array([[1.5, 1.4, 1.2]], np.float32)
+    cam = perspective_camera((0.3, -2.6, 1.3), (0.0, 0.6, 0.5), width, height)
+    return Scene(concat(parts), mats, lamps, cam, world_radiance=np.full(3, 0.2, np.float32))
