@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import os
 import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from .profile import add_embree_seconds
 from .sampling import dot, norm
 
 CHUNK_RAYS = 32768  # rays per Embree call: large enough to amortize the call, small for load balance
@@ -113,7 +115,9 @@ class Accel:
 
         def work(span):
             s, e = span
+            t0 = time.perf_counter()
             r = self._scene.run(o[s:e], d[s:e], dists=None if far is None else far[s:e].copy(), output=1)
+            add_embree_seconds(time.perf_counter() - t0)
             prim = r["primID"]
             hits.prim[s:e] = prim
             hit = prim >= 0
@@ -136,7 +140,9 @@ class Accel:
 
         def work(span):
             s, e = span
+            t0 = time.perf_counter()
             out[s:e] = self._scene.run(o[s:e], d[s:e], dists=far[s:e].copy(), query="OCCLUDED") >= 0
+            add_embree_seconds(time.perf_counter() - t0)
 
         run_chunks(work, self._chunks(n))
         return out
