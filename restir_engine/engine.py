@@ -18,7 +18,7 @@ MAX_REPORTED_WARNINGS = 12
 LAST_FRAME_STATS: dict = {}
 
 # ReSTIR temporal history across the frames of an animation. Engine instances are recreated per frame,
-# so it lives here, keyed by (scene, view layer): (frame number, restir_di.TemporalHistory). It is used
+# so it lives here, keyed by (scene, view layer): (frame number, restir.history.TemporalHistory). It is used
 # only by the next frame (a jump drops it) and only if resolution and light table still match.
 _TEMPORAL_HISTORY: dict = {}
 

@@ -3,13 +3,13 @@ import numpy as np
 
 from restir_engine.core.boiling import boiling_filter
 from restir_engine.core.renderer import RenderSettings, render_frame
-from restir_engine.core.restir_di import Reservoirs
+from restir_engine.core.restir.di import DIReservoirs
 from scenes_core import add_emitters, concat, floor_with_emitter, quad, tris
 from test_restir_stability import RESTIR, with_tiny_bright_light
 
 
 def frame(width, height, weight):
-    res = Reservoirs.empty(width * height)
+    res = DIReservoirs.empty(width * height)
     res.light[:] = 0
     res.p_hat[:] = 1.0
     res.W[:] = weight
@@ -22,13 +22,13 @@ def test_only_reservoirs_far_above_their_block_mean_are_dropped():
     res = frame(w, h, 1.0)
     res.W[5 * w + 7] = 100.0    # an outlier in block (0, 0)
     res.W[18 * w + 35] = 10.0   # 10x, but the partial block (2, 1) has only 5x4 pixels: its mean is 1.45
-    valid = np.ones(w * h, bool)
-    drop = boiling_filter(res, valid, w, h, threshold=20.0)
+    pixels = np.arange(w * h)
+    drop = boiling_filter(res, pixels, w, h, threshold=20.0)
     assert np.flatnonzero(drop).tolist() == [5 * w + 7]
     assert res.light[5 * w + 7] == -1 and res.W[5 * w + 7] == 0 and res.M[5 * w + 7] == 3.0  # M is kept
     assert (res.light[~drop] == 0).all()
     uniform = frame(w, h, 2.0)
-    assert not boiling_filter(uniform, valid, w, h, threshold=1.5).any()
+    assert not boiling_filter(uniform, pixels, w, h, threshold=1.5).any()
 
 
 def test_unbiased_mode_never_filters():

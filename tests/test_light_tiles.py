@@ -4,10 +4,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from restir_engine.core import light_tiles, restir_di
+from restir_engine.core import light_tiles
 from restir_engine.core.bsdf import SurfaceParams
 from restir_engine.core.light_tiles import TileSettings
 from restir_engine.core.renderer import RenderSettings, render_frame
+from restir_engine.core.restir.di import shading_value
 from restir_engine.core.sampling import orthonormal_basis, to_local
 from restir_engine.core.target import ShadingTerms
 
@@ -47,13 +48,13 @@ def test_packed_target_matches_the_bsdf_model():
                                   g.random(n) < 0.5, np.full(n, -1, np.int32))
     nl = g.normal(size=(n, 3))
     pts.normal[:] = nl / np.linalg.norm(nl, axis=1)[:, None]
-    p_hat, pdf = ShadingTerms.of_surfaces(surf).evaluate(pts)
+    p_hat, pdf = ShadingTerms.of_surfaces(surf).evaluate(light_tiles.PackedPoints.of(pts.packed()))
     d = pts.pos - surf.p
     dist = np.linalg.norm(d, axis=1)
     wi = (d / dist[:, None]).astype(np.float32)
     cos_l = -np.einsum("ij,ij->i", wi, pts.normal)
     le = np.where(((cos_l > 0) | pts.two_sided)[:, None], pts.le, 0.0).astype(np.float32)
-    ref_p, _f, _g, ref_pdf = restir_di._target(surf, wi, le, dist.astype(np.float32), cos_l.astype(np.float32))
+    ref_p, _f, _g, ref_pdf = shading_value(surf, wi, le, dist.astype(np.float32), cos_l.astype(np.float32))
     assert (ref_p > 0).mean() > 0.2 and (ref_p == 0).mean() > 0.2  # both cases exercised
     np.testing.assert_allclose(p_hat, ref_p, rtol=2e-3, atol=1e-6 * ref_p.max())
     live = ref_p > 0  # where p̂ = 0 the pdf never matters (the candidate's weight is 0 either way)

@@ -85,6 +85,11 @@ class Hits:
         self.u = np.zeros(n, dtype=np.float32)
         self.v = np.zeros(n, dtype=np.float32)
 
+    def take(self, rows) -> "Hits":
+        out = Hits.__new__(Hits)
+        out.prim, out.t, out.u, out.v = self.prim[rows], self.t[rows], self.u[rows], self.v[rows]
+        return out
+
 
 class Accel:
     """A static triangle scene. ``triangles`` is (n, 3, 3) float32 world-space vertices."""

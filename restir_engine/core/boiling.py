@@ -16,22 +16,19 @@ import numpy as np
 BLOCK = 16  # pixels: the neighbourhood whose mean weight an outlier is compared with
 
 
-def boiling_filter(res, valid: np.ndarray, width: int, height: int, threshold: float) -> np.ndarray:
-    """Empty (in place) the reservoirs of ``res`` (restir_di.Reservoirs over a width x height window,
-    row-major) whose p̂·W exceeds ``threshold`` x the mean over their block's valid pixels.
-    Returns the boolean mask of dropped reservoirs."""
-    n = width * height
-    weight = np.where(valid & (res.light >= 0), res.p_hat.astype(np.float64) * res.W, 0.0)
-    pix = np.arange(n)
+def boiling_filter(res, pixels: np.ndarray, width: int, height: int, threshold: float) -> np.ndarray:
+    """Empty (in place) the reservoirs of ``res`` (restir.reservoir.Reservoirs; reservoir i belongs to pixel
+    ``pixels[i]`` of a width x height window, row-major) whose p̂·W exceeds ``threshold`` x the mean over the
+    reservoirs of their block. Returns the boolean mask of dropped reservoirs."""
+    weight = np.where(res.has_sample(), res.p_hat.astype(np.float64) * res.W, 0.0)
+    pix = pixels
     bx, by = (pix % width) // BLOCK, (pix // width) // BLOCK
     blocks_x = (width + BLOCK - 1) // BLOCK
     block = by * blocks_x + bx
     n_blocks = blocks_x * ((height + BLOCK - 1) // BLOCK)
     total = np.bincount(block, weights=weight, minlength=n_blocks)
-    count = np.bincount(block, weights=valid.astype(np.float64), minlength=n_blocks)
+    count = np.bincount(block, minlength=n_blocks)
     mean = total / np.maximum(count, 1.0)
     drop = (weight > threshold * mean[block]) & (weight > 0)
-    res.light[drop] = -1
-    res.W[drop] = 0.0
-    res.p_hat[drop] = 0.0
+    res.clear(drop)
     return drop

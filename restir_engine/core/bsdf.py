@@ -4,7 +4,7 @@ All directions are in the local shading frame (z = shading normal), unit length,
 ``wo`` towards the viewer, ``wi`` towards the light. ``eval`` returns f (n, 3) without the
 cosine, pdfs are in solid-angle measure.
 
-Model (an approximation of Principled BSDF, see docs/MATERIALS.md):
+Model (an approximation of the Principled BSDF):
   diffuse  = base·(1-metallic)/π · (1 - F_d(cos_o))      F_d: Schlick with the dielectric f0
   specular = D·G·F / (4 cos_i cos_o)   GGX D, height-correlated Smith G, Schlick F with
              f0 = mix(f0_dielectric, base, metallic), alpha = roughness²
@@ -63,7 +63,7 @@ class SurfaceParams:
         return SurfaceParams(diffuse, f0, f0_d.astype(np.float32), alpha, p, spec_on)
 
 
-def _schlick(f0, cos):
+def schlick(f0, cos):
     c = np.clip(1.0 - cos, 0.0, 1.0)
     c5 = (c * c) * (c * c) * c
     return f0 + (1.0 - f0) * c5
@@ -102,7 +102,7 @@ def ggx_albedo_table() -> np.ndarray:
             wo = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=-1)  # (n, 1, 3)
             odh = (wo * h[None]).sum(-1)
             wi_z = 2 * odh * h[None, :, 2] - mu
-            g = 1 / (1 + _smith_lambda(a, np.broadcast_to(mu, wi_z.shape)) + _smith_lambda(a, np.maximum(wi_z, 1e-6)))
+            g = 1 / (1 + smith_lambda(a, np.broadcast_to(mu, wi_z.shape)) + smith_lambda(a, np.maximum(wi_z, 1e-6)))
             wgt = np.where((wi_z > 0) & (odh > 0), g * odh / (mu * h[None, :, 2]), 0.0)
             table[i] = wgt.mean(axis=1)
         _ALBEDO_TABLE = np.clip(table, 1e-3, 1.0).astype(np.float32)
@@ -122,7 +122,7 @@ def ggx_albedo(alpha: np.ndarray, mu: np.ndarray) -> np.ndarray:
             + (t[x0 + 1, y0] * (1 - fy) + t[x0 + 1, y0 + 1] * fy) * fx)
 
 
-def _smith_lambda(alpha, cos):
+def smith_lambda(alpha, cos):
     c2 = np.clip(cos * cos, 1e-12, 1.0)
     tan2 = (1.0 - c2) / c2
     return 0.5 * (np.sqrt(1.0 + alpha * alpha * tan2) - 1.0)
@@ -140,7 +140,7 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray, albedo: np.ndarr
     ci = wi[:, 2]
     valid = (co > 0) & (ci > 0)
     # a lobe with f0 = 0 does not exist (Diffuse BSDF): no Fresnel split, no grazing specular
-    fd = np.where(p.f0_dielectric > 0, 1.0 - _schlick(p.f0_dielectric, co), 1.0)
+    fd = np.where(p.f0_dielectric > 0, 1.0 - schlick(p.f0_dielectric, co), 1.0)
     f = p.diffuse * (fd * INV_PI)[:, None]
     pdf_d = np.maximum(ci, 0) * INV_PI
     h = wo + wi
@@ -149,8 +149,8 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray, albedo: np.ndarr
     cos_h = np.clip(h[:, 2], 0, 1)
     odh = np.clip(dot(wo, h), 1e-6, 1.0)
     d = _ggx_d(p.alpha, cos_h)
-    g = 1.0 / (1.0 + _smith_lambda(p.alpha, co) + _smith_lambda(p.alpha, ci))
-    fr = _schlick(p.f0, odh[:, None])
+    g = 1.0 / (1.0 + smith_lambda(p.alpha, co) + smith_lambda(p.alpha, ci))
+    fr = schlick(p.f0, odh[:, None])
     e = view_albedo(p, wo) if albedo is None else albedo
     compensation = 1.0 + p.f0 * ((1.0 - e) / e)[:, None]
     spec = (p.spec_on * d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr * compensation

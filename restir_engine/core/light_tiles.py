@@ -48,14 +48,21 @@ class LightPoints:
         return bool((self.spot_tri >= 0).any())
 
     def packed(self) -> np.ndarray:
-        """(n, 11) float32 rows [pos, normal, le, pdf, two_sided]: one gather per candidate (see :func:`unpack`)."""
-        return np.concatenate([self.pos, self.normal, self.le, self.pdf[:, None],
-                               self.two_sided[:, None].astype(np.float32)], axis=1).astype(np.float32)
+        """(11, n) float32 block [pos, normal, le, pdf, two_sided] (rows): one column gather per candidate
+        (see :class:`PackedPoints`)."""
+        out = np.empty((11, len(self.light)), np.float32)
+        out[0:3] = self.pos.T
+        out[3:6] = self.normal.T
+        out[6:9] = self.le.T
+        out[9] = self.pdf
+        out[10] = self.two_sided
+        return out
 
 
 @dataclass
 class PackedPoints:
-    """Column views of :meth:`LightPoints.packed` rows: what the target function reads."""
+    """Row views of a :meth:`LightPoints.packed` block (or of a gather from it, shape (11, ...)): what the
+    target function reads. pos, normal, le are (3, ...), pdf (...) area measure, two_sided (...) bool."""
 
     pos: np.ndarray
     normal: np.ndarray
@@ -63,9 +70,9 @@ class PackedPoints:
     pdf: np.ndarray
     two_sided: np.ndarray
 
-
-def unpack(rows: np.ndarray) -> PackedPoints:
-    return PackedPoints(rows[:, 0:3], rows[:, 3:6], rows[:, 6:9], rows[:, 9], rows[:, 10] > 0)
+    @staticmethod
+    def of(block: np.ndarray) -> "PackedPoints":
+        return PackedPoints(block[0:3], block[3:6], block[6:9], block[9], block[10] > 0)
 
 
 def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> LightPoints:

@@ -1,7 +1,17 @@
-"""Per-frame orchestration: tiles on the thread pool, sample passes, accumulation, passes out.
+"""Per-frame orchestration: a sample pass as named stages over the whole window, chunks on the thread pool.
 
-Images are (h, w, c) float32 with row 0 at the *bottom* (Blender's pass order), covering the
-camera window (border) only.
+Stages of a sample pass (each timed by a profile.StageClock when one is given):
+  primary   camera rays, emission seen directly, the G-buffer (every integrator)
+  initial   ReSTIR/RIS: target terms and initial resampling (light + BSDF candidates)
+  temporal  ReSTIR, first pass of a frame: merge with the previous frame's reservoirs
+  boiling   ReSTIR biased mode with the boiling filter
+  spatial   ReSTIR: spatial reuse passes
+  shade     direct light: the reservoirs' samples with shadow rays (ReSTIR/RIS), or next-event estimation
+  paths     the first vertex's BSDF ray and bounces 1..max_bounces (pathtracer.continue_paths)
+  passes    accumulation into the running means
+Images are (h, w, c) float32 with row 0 at the *bottom* (Blender's pass order), covering the camera window
+(border) only. Pixels are row-major over the window; a chunk is a span of CHUNK_PIXELS pixels and its
+random streams are keyed by (seed, frame, pass, stream, chunk), so images do not depend on scheduling.
 """
 from __future__ import annotations
 
@@ -12,16 +22,23 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import pathtracer, restir_di
+from . import camera as camera_mod
+from . import pathtracer
 from .accel import pool
 from .boiling import boiling_filter
 from .context_cache import context_for
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
-from .sampling import STREAM_CAMERA, STREAM_TILES, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, rng
+from .profile import NullClock
+from .restir import di, reuse
+from .restir.gbuffer import GBuffer
+from .restir.history import TemporalHistory
+from .sampling import (STREAM_CAMERA, STREAM_INITIAL, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL,
+                       STREAM_TILES, rng)
 from .scene import Scene
-from .target import FramePoints
+from .target import ShadingTerms
 
 INTEGRATORS = ("PATH", "RESTIR")
+CHUNK_PIXELS = 16384  # pixels per chunk of work (its working set stays in the 4 MB L2 of a core)
 
 
 class Cancelled(Exception):
@@ -31,48 +48,66 @@ class Cancelled(Exception):
 @dataclass
 class RenderSettings:
     """samples: sample passes averaged per frame; seed: noise seed; max_bounces: 0 = direct only;
-    frame: frame number (keys the random streams)."""
+    frame: frame number (keys the random streams). Stage defaults come from the stages' own settings
+    (di.CandidateSettings, reuse.SpatialSettings, TileSettings)."""
 
     samples: int = 16
     seed: int = 0
     max_bounces: int = 4
     frame: int = 0
     integrator: str = "PATH"
-    direct_method: str = "RIS"  # with integrator RESTIR: "LIGHT_SAMPLING" (NEE + MIS) or "RIS"
-    light_candidates: int = 32
-    bsdf_candidates: int = 1
-    spatial_neighbors: int = 5
-    spatial_radius: float = 30.0
-    spatial_passes: int = 1
-    bias_correction: str = "UNBIASED"  # spatial/temporal reuse: "NONE" (1/M) or "UNBIASED" (pairwise MIS)
+    direct_method: str = "RIS"  # with integrator RESTIR: "LIGHT_SAMPLING" (NEE + MIS), "RIS" or "RESTIR"
+    light_candidates: int = di.CandidateSettings.light_candidates
+    bsdf_candidates: int = di.CandidateSettings.bsdf_candidates
+    spatial_neighbors: int = reuse.SpatialSettings.neighbors
+    spatial_radius: float = reuse.SpatialSettings.radius
+    spatial_passes: int = reuse.SpatialSettings.passes
+    bias_correction: str = reuse.SpatialSettings.bias_correction  # "NONE" (1/M) or "UNBIASED" (pairwise MIS)
     temporal_reuse: bool = True  # ReSTIR: pass 0 of a frame reuses pass 0 of the previous frame (history)
     confidence_cap: float = 20.0
     boiling_filter: bool = False  # bias_correction NONE only: drop reservoirs far above their block's mean
     boiling_threshold: float = 20.0  # x the 16x16 block's mean p̂·W (core.boiling)
-    light_tiles: str = "AUTO"  # light candidates from presampled tiles: "AUTO" (when it pays), "ON", "OFF"
-    light_tile_count: int = 128
-    light_tile_size: int = 1024
+    light_tiles: str = TileSettings.mode  # light candidates from presampled tiles: "AUTO", "ON", "OFF"
+    light_tile_count: int = TileSettings.count
+    light_tile_size: int = TileSettings.size
     film_transparent: bool = False
     data_passes: bool = True  # Depth, Normal and Vector (one more ray per pixel and frame); off when not written
-    tile_pixels: int = 16384
+    tile_pixels: int = CHUNK_PIXELS  # pixels per chunk of work (smaller: finer progress and cancellation)
 
 
 @dataclass
 class FrameResult:
-    """passes: name -> (h, w, c) float32 (bottom row first); samples_done; seconds; cancelled."""
+    """passes: name -> (h, w, c) float32 (bottom row first); samples_done; seconds; cancelled; stats (with
+    "stages" when a clock timed the frame); history for the next frame (ReSTIR with temporal reuse)."""
 
     passes: dict
     samples_done: int
     seconds: float
     cancelled: bool = False
     stats: dict = field(default_factory=dict)
-    history: object = None  # restir_di.TemporalHistory for the next frame (ReSTIR with temporal reuse)
+    history: object = None
 
 
-def _tiles(w: int, h: int, tile_pixels: int):
-    """Square-ish tiles (x, y, tw, th) covering a w x h window."""
-    side = max(8, int(np.sqrt(max(tile_pixels, 64))))
-    return [(x, y, min(side, w - x), min(side, h - y)) for y in range(0, h, side) for x in range(0, w, side)]
+class _Stopped(Exception):
+    pass
+
+
+@dataclass
+class _Chunk:
+    """One span of window pixels through a sample pass: its primary hits and per-surface results."""
+
+    index: int
+    pixels: np.ndarray     # window pixel indices (row-major)
+    hits: object = None    # pathtracer.PrimaryHits (rows index ``pixels``)
+    first: int = 0         # index of its first surface in the frame's G-buffer
+    res: object = None     # di.DIReservoirs of its surfaces after initial resampling
+    bsdf_ray: object = None
+    direct: np.ndarray = None
+    indirect: np.ndarray = None
+
+    @property
+    def surfaces(self) -> slice:
+        return slice(self.first, self.first + len(self.hits.rows))
 
 
 class FrameRenderer:
@@ -82,42 +117,47 @@ class FrameRenderer:
     swaps the camera with :meth:`set_camera` (geometry and lights stay built).
     """
 
-    def __init__(self, scene: Scene, settings: RenderSettings, history=None):
+    def __init__(self, scene: Scene, settings: RenderSettings, history=None, clock=None):
         if settings.integrator not in INTEGRATORS:
             raise ValueError(f"unknown integrator {settings.integrator!r}; available: {INTEGRATORS}")
         t0 = time.perf_counter()
         self.settings = settings
-        self.di = None
+        self.clock = clock or NullClock()
+        self.candidates = None  # di.CandidateSettings when the direct light is resampled
+        self.method = "PATH"
         if settings.integrator == "RESTIR":
-            if settings.direct_method not in restir_di.DIRECT_METHODS:
-                raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {restir_di.DIRECT_METHODS}")
+            if settings.direct_method not in di.DIRECT_METHODS:
+                raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {di.DIRECT_METHODS}")
+            self.method = settings.direct_method
             tiles = TileSettings(settings.light_tiles, settings.light_tile_count, settings.light_tile_size)
             if tiles.mode not in TILE_MODES:
                 raise ValueError(f"unknown light tile mode {tiles.mode!r}; available: {TILE_MODES}")
-            self.di = restir_di.DISettings(settings.direct_method, max(0, settings.light_candidates),
-                                           max(0, settings.bsdf_candidates), tiles)
-            if settings.bias_correction not in restir_di.BIAS_CORRECTIONS:
+            if settings.bias_correction not in reuse.BIAS_CORRECTIONS:
                 raise ValueError(f"unknown bias correction {settings.bias_correction!r}")
-            self.spatial = restir_di.SpatialSettings(max(0, settings.spatial_neighbors),
-                                                     max(1.0, float(settings.spatial_radius)),
-                                                     max(0, settings.spatial_passes), settings.bias_correction)
+            if self.method in ("RIS", "RESTIR"):
+                self.candidates = di.CandidateSettings(self.method, max(0, settings.light_candidates),
+                                                       max(0, settings.bsdf_candidates), tiles)
+            self.spatial = reuse.SpatialSettings(max(0, settings.spatial_neighbors),
+                                                 max(1.0, float(settings.spatial_radius)),
+                                                 max(0, settings.spatial_passes), settings.bias_correction)
         self.ctx, self.context_reused = context_for(scene, settings.max_bounces, settings.film_transparent,
                                                     pathtracer.build_context)
+        self.space = di.LightSpace(self.ctx.lights)
         self.build_seconds = time.perf_counter() - t0
         self.set_camera(scene.camera)
-        if history is not None and self._history_fits(history):
+        if history is not None and history.fits(scene.camera):
             self.prev_history = history.remapped(self.ctx.lights)  # from the previous frame (None: lights cannot map)
 
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
         self.ctx.scene.camera = camera
         _x0, _y0, w, h = camera.window
-        self.tiles = _tiles(w, h, self.settings.tile_pixels)
         self.acc = {"emit": np.zeros((h, w, 3), np.float64), "direct": np.zeros((h, w, 3), np.float64),
                     "indirect": np.zeros((h, w, 3), np.float64), "alpha": np.zeros((h, w), np.float64),
                     "res_m": np.zeros((h, w), np.float64), "res_w": np.zeros((h, w), np.float64)}
         self.samples_done = 0
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
+        self.used_tiles = False
         self._data = None
         # temporal reuse runs through the first sample pass of each frame: pass 0 reuses the previous
         # frame's pass 0 (prev_history) and becomes the next frame's (history); the other passes of a frame
@@ -144,125 +184,205 @@ class FrameRenderer:
                 normal[ty:ty + th, tx:tx + tw] = nrm.reshape(th, tw, 3)
                 vector[ty:ty + th, tx:tx + tw] = vec.reshape(th, tw, 4)
 
-            list(pool().map(gbuffer_tile, self.tiles))
+            list(pool().map(gbuffer_tile, _tiles(w, h, self.settings.tile_pixels)))
             self._data = (depth, normal, vector)
         return self._data
 
-    def _run_tile(self, args):
-        s, ti, (tx, ty, tw, th) = args
-        st = self.settings
-        x0, y0 = self.ctx.scene.camera.window[:2]
-        cam_rng = rng(st.seed, st.frame, s, STREAM_CAMERA, ti)
-        path_rng = rng(st.seed, st.frame, s, STREAM_PATH, ti)
-        jy, jx = np.mgrid[0:th, 0:tw]
-        j = cam_rng.random((th * tw, 2), dtype=np.float32)
-        x = x0 + tx + jx.ravel().astype(np.float32) + j[:, 0]
-        y = y0 + ty + jy.ravel().astype(np.float32) + j[:, 1]
-        reservoir = None
-        if self.di is not None and self.di.method == "RIS":
-            reservoir = {"M": np.zeros(th * tw, np.float32), "W": np.zeros(th * tw, np.float32)}
-        elif self.di is not None and self.di.method == "RESTIR":
-            w = self.ctx.scene.camera.window[2]
-            ly, lx = np.mgrid[ty:ty + th, tx:tx + tw]
-            reservoir = {"rows": (ly * w + lx).ravel(), "gbuf": self._gbuf, "res": self._res}
-        out = pathtracer.trace(self.ctx, x, y, path_rng, di=self.di_pass, reservoir=reservoir)
-        return (tx, ty, tw, th), (*out, reservoir)
+    # -- one sample pass ------------------------------------------------------------------------
+    def _map(self, fn, items, stop):
+        """fn(item) for every item on the pool; raises _Stopped when ``stop`` asks to stop part-way."""
+        if len(items) <= 1:
+            out = [fn(it) for it in items]
+        else:
+            futures = {pool().submit(fn, it): i for i, it in enumerate(items)}
+            out = [None] * len(items)
+            pending = set(futures)
+            while pending:
+                done, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
+                for f in done:
+                    out[futures[f]] = f.result()
+                if stop.should_stop and stop.should_stop():
+                    for f in pending:
+                        f.cancel()
+                    wait(pending)
+                    raise _Stopped
+                stop.advance(len(done))
+        if len(items) <= 1:
+            stop.advance(len(items))
+        return out
 
     def sample_pass(self, progress=None, should_stop=None) -> bool:
         """Render the next sample pass (one path per pixel) into the accumulators. Returns False, keeping
         the accumulators unchanged, when ``should_stop`` asked to stop part-way."""
-        s = self.samples_done
-        self.di_pass = self.di
-        self.used_tiles = False
-        if self.di is not None and self.di.method in ("RIS", "RESTIR") and self.ctx.lights.tri_alias is not None:
-            _x0, _y0, w, h = self.ctx.scene.camera.window
-            st = self.settings
-            if self.di.tile_settings.wanted(w * h, self.di.light_candidates):
-                tiles = LightTiles(self.ctx.lights, self.di.tile_settings, w, h, rng(st.seed, st.frame, s, STREAM_TILES))
-                self.di_pass = dataclasses.replace(self.di, tiles=tiles)
-                self.used_tiles = True
-        spatial = self.di is not None and self.di.method == "RESTIR"
-        if spatial:  # frame-wide primary hits and initial reservoirs, filled by the tiles
-            _x0, _y0, w, h = self.ctx.scene.camera.window
-            self._gbuf = restir_di.GBuffer(w * h, self.ctx.material_params)
-            self._res = restir_di.Reservoirs.empty(w * h)
-        futures = {pool().submit(self._run_tile, (s, ti, t)) for ti, t in enumerate(self.tiles)}
-        results = []
-        while futures:
-            finished, futures = wait(futures, timeout=0.25, return_when=FIRST_COMPLETED)
-            results.extend(f.result() for f in finished)
-            if progress:
-                progress(len(results) / len(self.tiles))
-            if should_stop and should_stop():
-                for f in futures:
-                    f.cancel()
-                wait(futures)
-                return False
-        if spatial:
-            self._spatial_and_shade(results, s)
-        for (tx, ty, tw, th), (emit, direct, indirect, alpha, reservoir) in results:
-            sl = (slice(ty, ty + th), slice(tx, tx + tw))
-            self.acc["emit"][sl] += emit.reshape(th, tw, 3)
-            self.acc["direct"][sl] += direct.reshape(th, tw, 3)
-            self.acc["indirect"][sl] += indirect.reshape(th, tw, 3)
-            self.acc["alpha"][sl] += alpha.reshape(th, tw)
-            if reservoir is not None and "M" in reservoir:
-                self.acc["res_m"][sl] += reservoir["M"].reshape(th, tw)
-                self.acc["res_w"][sl] += reservoir["W"].reshape(th, tw)
+        try:
+            self._sample_pass(progress, should_stop)
+        except _Stopped:
+            return False
         self.samples_done += 1
         return True
 
-    def _history_fits(self, hist) -> bool:
-        cam = self.ctx.scene.camera
-        return (hist.camera.window[2:] == cam.window[2:]
-                and (hist.camera.width, hist.camera.height) == (cam.width, cam.height))
-
-    def _spatial_and_shade(self, results, s: int):
-        """Spatial passes over the frame's reservoirs, then one shadow ray per pixel; adds the direct light
-        and the reservoir figures into each tile's outputs."""
-        _x0, _y0, w, h = self.ctx.scene.camera.window
+    def _sample_pass(self, progress, should_stop):
         st = self.settings
-        res = self._res
-        spans = [np.arange(a, min(w * h, a + st.tile_pixels)) for a in range(0, w * h, st.tile_pixels)]
+        s = self.samples_done
+        clock = self.clock
+        x0, y0, w, h = self.ctx.scene.camera.window
+        npix = w * h
+        step = max(64, int(st.tile_pixels))
+        chunks = [_Chunk(i, np.arange(a, min(npix, a + step))) for i, a in enumerate(range(0, npix, step))]
+        resampled = self.candidates is not None
+        reusing = self.method == "RESTIR"
+        chunk_stages = 3 + int(resampled)
+        stop = _Progress(progress, should_stop, len(chunks) * chunk_stages)
+        ctx = self.ctx
+
+        def primary(c: _Chunk):
+            j = rng(st.seed, st.frame, s, STREAM_CAMERA, c.index).random((len(c.pixels), 2), dtype=np.float32)
+            x = (x0 + c.pixels % w).astype(np.float32) + j[:, 0]
+            y = (y0 + c.pixels // w).astype(np.float32) + j[:, 1]
+            c.hits = pathtracer.primary(ctx, x, y)
+
+        with clock.stage("primary"):
+            self._map(primary, chunks, stop)
+            first = 0
+            for c in chunks:
+                c.first = first
+                first += len(c.hits.rows)
+        candidates = self.candidates
+        if resampled and ctx.lights.tri_alias is not None and candidates.tile_settings.wanted(npix, candidates.light_candidates):
+            tiles = LightTiles(ctx.lights, candidates.tile_settings, w, h, rng(st.seed, st.frame, s, STREAM_TILES))
+            candidates = dataclasses.replace(candidates, tiles=tiles)
+            self.used_tiles = True
+        continuing = pathtracer.needs_continuation(ctx, resampled)
+        terms = [None] * len(chunks)
+
+        def initial(c: _Chunk):
+            surf = c.hits.surf
+            terms[c.index] = t = ShadingTerms.of_surfaces(surf)
+            pix = c.pixels[c.hits.rows]
+            c.res, c.bsdf_ray = di.initial_ris(ctx, surf, t, rng(st.seed, st.frame, s, STREAM_INITIAL, c.index),
+                                               candidates, pix % w, pix // w, keep_bsdf_ray=continuing)
+
+        if resampled:
+            with clock.stage("initial"):
+                self._map(initial, chunks, stop)
+        res = gb = None
+        if reusing:
+            gb = self._gbuffer(chunks, terms)
+            res = di.DIReservoirs.empty(len(gb))
+            for c in chunks:
+                res.assign(c.surfaces, c.res)
+            res = self._reuse(gb, res, s)
+            for c in chunks:
+                c.res = res.take(c.surfaces)
+
+        def shade(c: _Chunk):
+            r = rng(st.seed, st.frame, s, STREAM_SHADE, c.index)
+            if resampled:
+                c.direct = di.shade(ctx, c.hits.surf, c.res, r)
+            else:
+                c.direct = pathtracer.next_event(ctx, c.hits.surf, r)
+
+        with clock.stage("shade"):
+            self._map(shade, chunks, stop)
+
+        def paths(c: _Chunk):
+            if not continuing:
+                c.indirect = None
+                return
+            d, c.indirect = pathtracer.continue_paths(ctx, c.hits.surf, rng(st.seed, st.frame, s, STREAM_PATH, c.index),
+                                                      direct_resampled=resampled, first_ray=c.bsdf_ray)
+            c.direct += d
+
+        with clock.stage("paths"):
+            self._map(paths, chunks, stop)
+        with clock.stage("passes"):
+            self._accumulate(chunks, resampled)
+
+    def _gbuffer(self, chunks, terms) -> GBuffer:
+        """The frame's G-buffer from the chunks' primary hits (surfaces in chunk order)."""
+        cam = self.ctx.scene.camera
+        _x0, _y0, w, h = cam.window
+        surfs = [c.hits.surf for c in chunks]
+        p = np.concatenate([sf.p for sf in surfs])
+        depth = (p - camera_mod.position(cam)) @ camera_mod.forward(cam)
+        inst = self.ctx.scene.geometry.instance
+        prim = np.concatenate([sf.prim for sf in surfs])
+        gb = GBuffer(None, np.concatenate([c.pixels[c.hits.rows] for c in chunks]), w, h, depth.astype(np.float32),
+                     inst[prim] if inst is not None else np.zeros(len(prim), np.int32),
+                     ShadingTerms(np.concatenate([t.packed for t in terms], axis=1)))
+        gb.material = np.concatenate([sf.mat for sf in surfs])
+        gb.ns = np.concatenate([sf.ns for sf in surfs])
+        return gb
+
+    def _spans(self, n: int):
+        step = max(64, int(self.settings.tile_pixels))
+        return [np.arange(a, min(n, a + step)) for a in range(0, n, step)]
+
+    def _reuse(self, gb: GBuffer, res, s: int):
+        """Temporal (first pass of a frame, with a history), boiling filter, spatial passes; makes the next
+        frame's history. Returns the frame's final reservoirs."""
+        st = self.settings
+        clock = self.clock
+        spans = self._spans(len(gb))
+        space = self.space
+        ctx = self.ctx
         if st.temporal_reuse and s == 0 and self.prev_history is not None:
-            hist = self.prev_history
-            # object motion is known for the previous frame only; a history from another frame gets none
-            motion = self.ctx.scene.motion if hist.frame == st.frame - 1 else None
-            parts = list(pool().map(lambda a: (a[1], restir_di.temporal_reuse(
-                self.ctx, self._gbuf, res, hist, w, a[1], st.confidence_cap, st.bias_correction, motion,
-                rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]))), enumerate(spans)))
-            res = restir_di.Reservoirs.gather(parts, w * h)
+            with clock.stage("temporal"):
+                hist = self.prev_history
+                # object motion is known for the previous frame only; a history from another frame gets none
+                motion = ctx.scene.motion if hist.frame == st.frame - 1 else None
+                prepared = space.prepare(hist.res)
+                had = hist.had_light
+                possible = None if had is None else (lambda rows: had[np.maximum(res.light[rows], 0)])
+                parts = list(pool().map(lambda a: (a[1], reuse.temporal_reuse(
+                    space, gb, res, hist, prepared, a[1], st.confidence_cap, st.bias_correction, motion,
+                    rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]), possible)), enumerate(spans)))
+                res = _gather(space.kind, parts, len(gb))
         if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode
-            self.boiling_dropped += int(boiling_filter(res, self._gbuf.valid, w, h, st.boiling_threshold).sum())
+            with clock.stage("boiling"):
+                self.boiling_dropped += int(boiling_filter(res, gb.pix, gb.width, gb.height,
+                                                           st.boiling_threshold).sum())
         for k in range(self.spatial.passes if self.spatial.neighbors else 0):
-            points = FramePoints(self.ctx.lights, res.light, res.b1, res.b2)
-            parts = list(pool().map(lambda a: (a[1], restir_di.spatial_reuse(
-                self.ctx, self._gbuf, res, w, h, a[1], self.spatial,
-                rng(st.seed, st.frame, s, STREAM_SPATIAL + k, a[0]), points)), enumerate(spans)))
-            res = restir_di.Reservoirs.gather(parts, w * h)
-        direct = np.zeros((w * h, 3), np.float32)
-
-        def shade(a):
-            ti, rows = a
-            live = rows[self._gbuf.valid[rows]]
-            if live.size:
-                sub = restir_di._SurfaceRows(self._gbuf, live)
-                part = restir_di.Reservoirs(res.light[live], res.b1[live], res.b2[live], res.M[live], res.W[live],
-                                            res.p_hat[live])
-                direct[live] = restir_di.shade(self.ctx, sub, part, rng(st.seed, st.frame, s, STREAM_SHADE, ti))
-
-        list(pool().map(shade, enumerate(spans)))
+            with clock.stage("spatial"):
+                prepared = space.prepare(res)
+                parts = list(pool().map(lambda a: (a[1], reuse.spatial_reuse(
+                    space, gb, res, prepared, a[1], self.spatial, rng(st.seed, st.frame, s, STREAM_SPATIAL + k, a[0]))),
+                    enumerate(spans)))
+                res = _gather(space.kind, parts, len(gb))
         if s == 0:  # the next frame's history; confidence at most the cap, so no reused M ever exceeds it
-            capped = restir_di.Reservoirs(res.light, res.b1, res.b2, np.minimum(res.M, st.confidence_cap), res.W,
-                                          res.p_hat)
-            lights = self.ctx.lights
-            self.history = restir_di.TemporalHistory(self._gbuf, capped, self.ctx.scene.camera, lights.signature,
-                                                     st.frame, lights.light_uid, lights.uid_space)
-        for (tx, ty, tw, th), (_e, d, _i, _a, reservoir) in results:
-            rows = reservoir["rows"]
-            d += direct[rows]
-            reservoir["M"] = res.M[rows]
-            reservoir["W"] = res.W[rows]
+            lights = ctx.lights
+            self.history = TemporalHistory(gb.for_history(), res.replace(M=np.minimum(res.M, st.confidence_cap)),
+                                           ctx.scene.camera, lights.signature, st.frame, lights.light_uid,
+                                           lights.uid_space)
+        return res
+
+    def _accumulate(self, chunks, resampled: bool) -> None:
+        _x0, _y0, w, h = self.ctx.scene.camera.window
+        npix = w * h
+        emit = np.zeros((npix, 3), np.float32)
+        direct = np.zeros((npix, 3), np.float32)
+        indirect = np.zeros((npix, 3), np.float32)
+        alpha = np.zeros(npix, np.float32)
+        res_m = np.zeros(npix, np.float32)
+        res_w = np.zeros(npix, np.float32)
+        for c in chunks:
+            emit[c.pixels] = c.hits.emitted
+            alpha[c.pixels] = c.hits.alpha
+            pix = c.pixels[c.hits.rows]
+            direct[pix] = c.direct
+            if c.indirect is not None:
+                indirect[pix] = c.indirect
+            if resampled:
+                res_m[pix] = c.res.M
+                res_w[pix] = c.res.W
+        self.acc["emit"] += emit.reshape(h, w, 3)
+        self.acc["direct"] += direct.reshape(h, w, 3)
+        self.acc["indirect"] += indirect.reshape(h, w, 3)
+        self.acc["alpha"] += alpha.reshape(h, w)
+        if resampled:
+            self.acc["res_m"] += res_m.reshape(h, w)
+            self.acc["res_w"] += res_w.reshape(h, w)
+
 
     def combined(self) -> np.ndarray:
         """The running mean of Combined (h, w, 4) float32."""
@@ -278,20 +398,41 @@ class FrameRenderer:
                "Emission": self.acc["emit"] * inv}
         if self.settings.data_passes:
             out["Depth"], out["Normal"], out["Vector"] = self.data_passes()
-        if self.di is not None and self.di.method in ("RIS", "RESTIR"):
+        if self.candidates is not None:
             out["Reservoir M"] = (self.acc["res_m"] * inv)[..., None]
             out["Reservoir UCW"] = (self.acc["res_w"] * inv)[..., None]
         return {k: np.where(np.isfinite(v), v, 0.0).astype(np.float32) for k, v in out.items()}
 
 
-def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None) -> FrameResult:
+def _gather(kind, parts, n: int):
+    """A frame of n reservoirs of type ``kind`` from (rows, Reservoirs) parts."""
+    out = kind.empty(n)
+    for rows, part in parts:
+        out.assign(rows, part)
+    return out
+
+
+class _Progress:
+    """Progress over the chunk tasks of a sample pass, and the stop request."""
+
+    def __init__(self, progress, should_stop, total: int):
+        self.progress, self.should_stop, self.total, self.done = progress, should_stop, max(1, total), 0
+
+    def advance(self, k: int) -> None:
+        self.done += k
+        if self.progress:
+            self.progress(min(1.0, self.done / self.total))
+
+
+def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
+                 clock=None) -> FrameResult:
     """Render one frame with the chosen integrator.
 
-    progress(fraction, message) is called after every tile; should_stop() is polled after every tile,
+    progress(fraction, message) is called as chunks finish; should_stop() is polled while they run,
     and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none).
     """
     t0 = time.perf_counter()
-    fr = FrameRenderer(scene, settings, history)
+    fr = FrameRenderer(scene, settings, history, clock)
     cancelled = False
     for s in range(settings.samples):
         report = None
@@ -303,9 +444,18 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
             break
     if fr.samples_done == 0:
         raise Cancelled("render cancelled before the first sample pass finished")
-    passes = fr.passes()
+    with fr.clock.stage("passes"):
+        passes = fr.passes()
     ctx = fr.ctx
-    return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled,
-                       {"build_seconds": fr.build_seconds, "light_tiles": fr.used_tiles, "triangles": len(scene.geometry),
-                        "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun,
-                        "boiling_dropped": fr.boiling_dropped, "context_reused": fr.context_reused}, fr.history)
+    stats = {"build_seconds": fr.build_seconds, "light_tiles": fr.used_tiles, "triangles": len(scene.geometry),
+             "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun, "boiling_dropped": fr.boiling_dropped,
+             "context_reused": fr.context_reused}
+    if clock is not None:
+        stats["stages"] = clock.stages
+    return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled, stats, fr.history)
+
+
+def _tiles(w: int, h: int, tile_pixels: int = CHUNK_PIXELS):
+    """Square-ish tiles (x, y, tw, th) covering a w x h window (data passes)."""
+    side = max(8, int(np.sqrt(max(tile_pixels, 64))))
+    return [(x, y, min(side, w - x), min(side, h - y)) for y in range(0, h, side) for x in range(0, w, side)]

@@ -8,27 +8,24 @@ light point y (position, unit normal n_l, radiance Le), in area measure on the l
 with f the Lambert + GGX model of bsdf.py. Because luminance is linear, luminance(f · Le) splits into
   Le · k_d  +  S(ωi) · (Le · A + (1 - ωo·h)⁵ · Le · B)
 where k_d, A and B are per-surface RGB vectors (luminance weights folded in) and S is the scalar
-D·G/(4 cos θ_o cos θ_i) of the GGX lobe; only S and the Fresnel power depend on the candidate.
-Agrees with bsdf.eval_bsdf to float32 rounding (tested).
+D·G/(4 cos θ_o cos θ_i) of the GGX lobe; only S and the Fresnel power depend on the candidate. The half
+vector is never formed: with unit ωo, ωi, |ωo + ωi|² = 2 + 2 ωo·ωi, cos θ_h = (cos θ_o + cos θ_i)/|ωo + ωi|
+and ωo·h = (1 + ωo·ωi)/|ωo + ωi|. Agrees with bsdf.eval_bsdf to float32 rounding (tested).
+
+Layout: structure of arrays. Terms are a (27, n) float32 block (:data:`LAYOUT` rows), light points a
+(11, ...) block (light_tiles.PackedPoints); the candidate axis broadcasts, so p̂ of m candidates at n
+surfaces is one pass over (m, n) arrays.
 """
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 
-from .bsdf import _smith_lambda, _schlick, view_albedo
-from .light_tiles import light_points, unpack
+from .bsdf import schlick, smith_lambda, view_albedo
+from .light_tiles import PackedPoints, light_points
 from .lights import spot_factor
-from .sampling import to_world
 
 LUM = np.array([0.2126, 0.7152, 0.0722], np.float32)
 INV_PI = np.float32(1.0 / np.pi)
-
-
-def _rowdot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.einsum("ij,ij->i", a, b)
-
 
 LAYOUT = {"p": slice(0, 3), "ng": slice(3, 6), "ns": slice(6, 9), "wo": slice(9, 12), "kd": slice(12, 15),
           "a": slice(15, 18), "b": slice(18, 21), "co": 21, "alpha2": 22, "alpha": 23, "lam_o": 24, "p_spec": 25,
@@ -37,95 +34,173 @@ WIDTH = 27  # float32 per surface: 108 bytes
 
 
 class ShadingTerms:
-    """Per-surface terms of p̂, packed as (n, 27) float32 rows (:data:`LAYOUT`) so that the terms of
-    other pixels (spatial and temporal neighbours) are one row gather away."""
+    """Per-surface terms of p̂ as a (27, n) float32 block (:data:`LAYOUT`): each term a contiguous row, the
+    terms of other pixels (spatial and temporal neighbours) one column gather away (:meth:`take`)."""
 
     def __init__(self, packed: np.ndarray):
         self.packed = packed
-        for name, cols in LAYOUT.items():
-            setattr(self, name, packed[:, cols])
-        self.glossy = bool((self.spec_on > 0).any() or (self.p_spec > 0).any())
+        for name, rows in LAYOUT.items():
+            setattr(self, name, packed[rows])
+        self.glossy = bool((self.spec_on > 0).any())
+
+    def __len__(self) -> int:
+        return self.packed.shape[1]
 
     @staticmethod
     def of_surfaces(surf) -> "ShadingTerms":
-        """Terms of surfaces ``surf`` (anything with p, ng, ns, t, bt, wo_l, params)."""
+        """Terms of surfaces ``surf`` (a surface.Surface: p, ng, ns, wo, wo_l, params)."""
         prm = surf.params
-        packed = np.empty((len(surf.p), WIDTH), np.float32)
-        put = lambda name, v: packed.__setitem__((slice(None), LAYOUT[name]), v)  # noqa: E731
-        put("p", surf.p)
-        put("ng", surf.ng)
-        put("ns", surf.ns)
-        put("wo", to_world(surf.wo_l, surf.ns, surf.t, surf.bt))
-        co = surf.wo_l[:, 2].astype(np.float32)
-        put("co", co)
-        fd = np.where(prm.f0_dielectric > 0, 1.0 - _schlick(prm.f0_dielectric, co), 1.0)
-        put("kd", prm.diffuse * (fd * INV_PI)[:, None] * LUM)
-        put("spec_on", prm.spec_on)
-        put("p_spec", prm.p_spec)
-        put("alpha", prm.alpha)
-        put("alpha2", prm.alpha * prm.alpha)
-        e = view_albedo(prm, surf.wo_l)
+        packed = np.empty((WIDTH, len(surf.p)), np.float32)
+        packed[LAYOUT["p"]] = surf.p.T
+        packed[LAYOUT["ng"]] = surf.ng.T
+        packed[LAYOUT["ns"]] = surf.ns.T
+        # wo in the bent frame: the local view vector back in world space (wo·ns = cos θ_o exactly)
+        wl = surf.wo_l
+        packed[LAYOUT["wo"]] = (surf.t * wl[:, 0:1] + surf.bt * wl[:, 1:2] + surf.ns * wl[:, 2:3]).T
+        co = wl[:, 2]
+        packed[LAYOUT["co"]] = co
+        fd = np.where(prm.f0_dielectric > 0, 1.0 - schlick(prm.f0_dielectric, co), 1.0)
+        packed[LAYOUT["kd"]] = (prm.diffuse * (fd * INV_PI)[:, None] * LUM).T
+        packed[LAYOUT["spec_on"]] = prm.spec_on
+        packed[LAYOUT["p_spec"]] = prm.p_spec
+        packed[LAYOUT["alpha"]] = prm.alpha
+        packed[LAYOUT["alpha2"]] = prm.alpha * prm.alpha
+        e = view_albedo(prm, wl)
         comp = 1.0 + prm.f0 * ((1.0 - e) / e)[:, None]
-        put("a", prm.f0 * comp * LUM)
-        put("b", (1.0 - prm.f0) * comp * LUM)
-        put("lam_o", _smith_lambda(prm.alpha, co))
+        packed[LAYOUT["a"]] = (prm.f0 * comp * LUM).T
+        packed[LAYOUT["b"]] = ((1.0 - prm.f0) * comp * LUM).T
+        packed[LAYOUT["lam_o"]] = smith_lambda(prm.alpha, co)
         return ShadingTerms(packed)
 
-    def take(self, rows) -> "ShadingTerms":
-        return ShadingTerms(self.packed.take(rows, axis=0))
+    def take(self, idx) -> "ShadingTerms":
+        """Terms of surfaces ``idx`` (index array or slice)."""
+        if isinstance(idx, slice):
+            return ShadingTerms(self.packed[:, idx])
+        return ShadingTerms(np.take(self.packed, idx, axis=1))
 
-    def evaluate(self, pts, want_pdf: bool = True):
-        """p̂ (n,) and the BSDF pdf in area measure (n,) (None unless ``want_pdf``) of light points ``pts``
-        (light_tiles.LightPoints, one per surface; spot cones already applied, see :func:`with_spots`)."""
-        d = pts.pos - self.p
-        d2 = _rowdot(d, d)
-        inv = 1.0 / np.sqrt(np.maximum(d2, 1e-30))
-        ci = _rowdot(d, self.ns) * inv
-        cos_l = -_rowdot(d, pts.normal) * inv
-        ok = (_rowdot(d, self.ng) > 0) & (ci > 0) & (d2 > 0) & (np.abs(cos_l) > 1e-8) & ((cos_l > 0) | pts.two_sided)
-        to_area = np.abs(cos_l) / np.maximum(d2, 1e-30)
-        le = pts.le
-        lum = _rowdot(le, self.kd)
+    def evaluate(self, pts: PackedPoints, want_pdf: bool = True):
+        """p̂ and the BSDF pdf in area measure (None unless ``want_pdf``) of light points ``pts`` whose
+        components are (...) arrays broadcasting against this block's (n,) rows: (n,) for one point per
+        surface, (m, n) for m candidates per surface. Spot cones must already be applied (:func:`with_spots`)."""
+        pos, nl, le = pts.pos, pts.normal, pts.le
+        p, ns, ng = self.p, self.ns, self.ng
+        dx = pos[0] - p[0]
+        dy = pos[1] - p[1]
+        dz = pos[2] - p[2]
+        d2 = dx * dx
+        d2 += dy * dy
+        d2 += dz * dz
+        inv = np.maximum(d2, np.float32(1e-30))
+        np.sqrt(inv, out=inv)
+        np.divide(np.float32(1.0), inv, out=inv)
+        ci = dx * ns[0]
+        ci += dy * ns[1]
+        ci += dz * ns[2]
+        ci *= inv
+        cl = dx * nl[0]
+        cl += dy * nl[1]
+        cl += dz * nl[2]
+        cl *= inv
+        np.negative(cl, out=cl)                      # cos θ_l, positive on the light's front face
+        ok = ci > 0
+        gn = dx * ng[0]
+        gn += dy * ng[1]
+        gn += dz * ng[2]
+        ok &= gn > 0
+        acl = np.abs(cl)
+        ok &= acl > 1e-8
+        ok &= (cl > 0) | pts.two_sided
+        to_area = acl
+        to_area *= inv
+        to_area *= inv                               # |cos θ_l| / d²
+        lum = le[0] * self.kd[0]
+        lum += le[1] * self.kd[1]
+        lum += le[2] * self.kd[2]
         pdf_s = None
         if self.glossy:
-            wi = d * inv[:, None]
-            h = self.wo + wi
-            hinv = 1.0 / np.maximum(np.sqrt(_rowdot(h, h)), 1e-12)
-            cos_h = np.clip(_rowdot(h, self.ns) * hinv, 0.0, 1.0)
-            odh = np.clip(_rowdot(h, self.wo) * hinv, 1e-6, 1.0)
-            c2 = cos_h * cos_h
-            den = c2 * (self.alpha2 - 1.0) + 1.0
-            dist_d = self.alpha2 / (np.pi * den * den)
-            g = 1.0 / (1.0 + self.lam_o + _smith_lambda(self.alpha, ci))
-            s = self.spec_on * dist_d * g / np.maximum(4.0 * self.co * ci, 1e-12)
-            c = np.clip(1.0 - odh, 0.0, 1.0)
-            c5 = (c * c) * (c * c) * c
-            lum = lum + s * (_rowdot(le, self.a) + c5 * _rowdot(le, self.b))
-            pdf_s = dist_d * cos_h / (4.0 * odh)
-        p_hat = np.where(ok, lum * ci * to_area, 0.0).astype(np.float32)
+            wdw = dx * self.wo[0]
+            wdw += dy * self.wo[1]
+            wdw += dz * self.wo[2]
+            wdw *= inv                               # ωo·ωi
+            hinv = 2.0 + 2.0 * wdw
+            np.maximum(hinv, np.float32(1e-24), out=hinv)
+            np.sqrt(hinv, out=hinv)
+            np.divide(np.float32(1.0), hinv, out=hinv)
+            cos_h = (self.co + ci) * hinv
+            np.clip(cos_h, 0.0, 1.0, out=cos_h)
+            odh = wdw
+            odh += 1.0
+            odh *= hinv
+            np.clip(odh, 1e-6, 1.0, out=odh)
+            den = cos_h * cos_h
+            den *= self.alpha2 - 1.0
+            den += 1.0
+            dist_d = den * den
+            dist_d *= np.float32(np.pi)
+            np.divide(self.alpha2, dist_d, out=dist_d)  # GGX D(h)
+            c2 = ci * ci
+            np.clip(c2, 1e-12, 1.0, out=c2)
+            tan2 = 1.0 - c2
+            tan2 /= c2
+            tan2 *= self.alpha2
+            tan2 += 1.0
+            np.sqrt(tan2, out=tan2)
+            g = tan2
+            g *= 0.5
+            g += 0.5 + self.lam_o                    # 1 + Λ(ωo) + Λ(ωi)
+            s = self.spec_on * dist_d
+            s /= g
+            den4 = (4.0 * self.co) * ci
+            np.maximum(den4, np.float32(1e-12), out=den4)
+            s /= den4                                # D·G/(4 cos θ_o cos θ_i)
+            c = 1.0 - odh
+            np.clip(c, 0.0, 1.0, out=c)
+            c5 = c * c
+            c5 *= c5
+            c5 *= c
+            spec = le[0] * self.b[0]
+            spec += le[1] * self.b[1]
+            spec += le[2] * self.b[2]
+            spec *= c5
+            spec += le[0] * self.a[0]
+            spec += le[1] * self.a[1]
+            spec += le[2] * self.a[2]
+            spec *= s
+            lum += spec
+            if want_pdf:
+                pdf_s = dist_d * cos_h
+                pdf_s /= 4.0 * odh
+        lum *= ci
+        lum *= to_area
+        p_hat = np.where(ok, lum, np.float32(0.0))
         if not want_pdf:
             return p_hat, None
-        pdf = (1.0 - self.p_spec) * np.maximum(ci, 0.0) * INV_PI
+        pdf = np.maximum(ci, np.float32(0.0))
+        pdf *= (1.0 - self.p_spec) * INV_PI
         if pdf_s is not None:
-            pdf = pdf + self.p_spec * pdf_s
-        return p_hat, np.where(ok, pdf * to_area, 0.0).astype(np.float32)
+            pdf_s *= self.p_spec
+            pdf += pdf_s
+        pdf *= to_area
+        return p_hat, np.where(ok, pdf, np.float32(0.0))
 
 
-def with_spots(pts, lamps, p: np.ndarray, spot_tri: np.ndarray | None = None):
-    """``pts`` with spot-cone attenuation towards receivers p applied to the radiance (a copy if any).
-    ``spot_tri`` (n,) lamp triangle per point, -1 without a cone (default: ``pts.spot_tri``)."""
-    spot_tri = pts.spot_tri if spot_tri is None else spot_tri
-    spot = np.flatnonzero(spot_tri >= 0)
-    if spot.size == 0:
+def with_spots(pts: PackedPoints, spot_tri: np.ndarray, lamps, receivers: np.ndarray) -> PackedPoints:
+    """``pts`` with the spot-cone attenuation of lamp triangles ``spot_tri`` (same shape as the points,
+    -1 = no cone) towards ``receivers`` ((3, n), broadcasting like the points) applied to the radiance."""
+    spot = np.nonzero(spot_tri >= 0)
+    if spot[0].size == 0:
         return pts
+    rec = np.broadcast_to(receivers, (3,) + spot_tri.shape)
     le = pts.le.copy()
-    le[spot] *= spot_factor(lamps, spot_tri[spot], p[spot])[:, None]
-    return dataclasses.replace(pts, le=le)
+    f = spot_factor(lamps, spot_tri[spot], np.stack([rec[i][spot] for i in range(3)], axis=1))
+    for i in range(3):
+        le[i][spot] *= f
+    return PackedPoints(pts.pos, pts.normal, le, pts.pdf, pts.two_sided)
 
 
 class FramePoints:
-    """The light points of a frame of reservoirs (light -1 rows hold an arbitrary point), packed for
-    row gathers by neighbouring pixels."""
+    """The light points of a frame of reservoirs (empty reservoirs hold an arbitrary point), packed as
+    (11, n) for column gathers by neighbouring pixels, with their spot lamp triangles (None: no spots)."""
 
     def __init__(self, lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray):
         pts = light_points(lights, np.maximum(light, 0), b1, b2)
@@ -133,9 +208,9 @@ class FramePoints:
         self.spot_tri = pts.spot_tri if pts.has_spots else None
         self.lamps = lights.scene.lamps
 
-    def at(self, q: np.ndarray, receivers: np.ndarray):
-        """Points of reservoirs ``q`` as seen from receivers (n, 3) (spot cones applied)."""
-        pts = unpack(self.rows.take(q, axis=0))
+    def at(self, q, receivers: np.ndarray) -> PackedPoints:
+        """Points of reservoirs ``q`` as seen from receivers ((3, n); spot cones applied)."""
+        pts = PackedPoints.of(np.take(self.rows, q, axis=1) if not isinstance(q, slice) else self.rows[:, q])
         if self.spot_tri is not None:
-            pts = with_spots(pts, self.lamps, receivers, self.spot_tri[q])
+            pts = with_spots(pts, self.spot_tri[q], self.lamps, receivers)
         return pts

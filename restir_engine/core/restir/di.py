@@ -1,0 +1,230 @@
+"""ReSTIR DI: reservoirs over light points, initial resampling and shading.
+
+Initial resampling (streaming RIS, Talbot et al. 2005; Bitterli et al. 2020 §3-4) combines candidates of two
+strategies by the balance heuristic:
+  light candidates: ``light_candidates`` points from the power alias table over triangle lights (through
+                    light tiles when they pay), pdf p_l = p_select / A (area measure)
+  BSDF candidates:  ``bsdf_candidates`` BSDF-sampled rays; a ray that reaches emitters yields the lamp it
+                    crosses and the emissive surface it stops at (each generated with p_b), a ray that
+                    reaches none is a null candidate (it still counts in M_b, never re-drawn)
+Everything is in AREA measure on the lights, so a sample (a point on a light) and its weight W mean the same
+at every pixel and are reused across pixels without a Jacobian:
+  target p̂(y) = luminance(f(ωo, ωi) · Le(y)) · G(x, y), G = |cos θ_s| |cos θ_l| / d²  (target.py)
+  BSDF pdf in area measure p_b(y) = p_b,ω · |cos θ_l| / d²
+Resampling weight of candidate y: w = p̂(y) / (M_l p_l(y) + M_b p_b(y)); W = Σw / p̂(y_selected) (m²).
+Shading traces one shadow ray: L_direct = f · Le · G · V · W. Suns are not resampled: one light-sampled sun
+per pixel is added.
+
+Reservoir memory per pixel: light index (int32), barycentrics b1, b2, M, W, p̂ (float32) = 24 bytes.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..accel import offset_origin, shadow_rays
+from ..bsdf import eval_bsdf, luminance, sample_bsdf, view_albedo
+from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
+from ..sampling import dot, to_local, to_world
+from ..target import FramePoints, with_spots
+from .reservoir import Reservoirs, Stream
+
+DIRECT_METHODS = ("LIGHT_SAMPLING", "RIS", "RESTIR")
+CANDIDATE_BLOCK = 65536  # candidate x surface elements evaluated per pass over memory (256 kB per float32 array)
+
+
+class DIReservoirs(Reservoirs):
+    """light int32 (-1 = empty), barycentrics b1, b2 of the point on that triangle light; M, W (m²), p̂."""
+
+    SAMPLE = {"light": np.int32, "b1": np.float32, "b2": np.float32}
+
+
+@dataclass
+class CandidateSettings:
+    """Initial resampling: method (DIRECT_METHODS), candidates per strategy, light tiles (settings, and the
+    sample pass's light_tiles.LightTiles or None)."""
+
+    method: str = "RESTIR"
+    light_candidates: int = 32
+    bsdf_candidates: int = 1
+    tile_settings: TileSettings = None
+    tiles: object = None
+
+
+class LightSpace:
+    """DI samples for the generic reuse code (reuse.py): light points, target p̂ of target.py."""
+
+    kind = DIReservoirs
+
+    def __init__(self, lights):
+        self.lights = lights
+
+    def prepare(self, res: DIReservoirs) -> FramePoints:
+        return FramePoints(self.lights, res.light, res.b1, res.b2)
+
+    @staticmethod
+    def target(terms, prepared: FramePoints, idx) -> np.ndarray:
+        return terms.evaluate(prepared.at(idx, terms.p), want_pdf=False)[0]
+
+
+@dataclass
+class BsdfRay:
+    """The first BSDF candidate's ray, handed to the path tracer as its first bounce (the same distribution
+    as a fresh BSDF sample): rows of the surfaces it left from, local direction, f, pdf (solid angle),
+    origins, directions and the closest geometry hits."""
+
+    rows: np.ndarray
+    wi_l: np.ndarray
+    f: np.ndarray
+    pdf: np.ndarray
+    o: np.ndarray
+    d: np.ndarray
+    hits: object
+
+
+def _light_candidates(ctx, terms, rng, tiles, m_l: int, m_b: int, px, py):
+    """Weights and targets (m_l, n) of the light candidates (from ``tiles`` or the power table), the light
+    points they index and the index of each candidate."""
+    n = len(terms)
+    lights = ctx.lights
+    if tiles is not None:
+        points, block = tiles.points, tiles.rows
+        pick = (rng.random((m_l, n), dtype=np.float32) * tiles.size).astype(np.int64)
+        np.minimum(pick, tiles.size - 1, out=pick)
+        pick += tiles.tile_base(px, py)[None, :]
+    else:
+        points = sample_points(lights, rng.random((m_l * n, 4), dtype=np.float32))
+        block = points.packed()
+        pick = np.arange(m_l * n).reshape(m_l, n)
+    spot_tri = points.spot_tri if points.has_spots else None
+    w = np.empty((m_l, n), np.float32)
+    p_hats = np.empty((m_l, n), np.float32)
+    group = max(1, CANDIDATE_BLOCK // max(n, 1))
+    for k0 in range(0, m_l, group):
+        k1 = min(m_l, k0 + group)
+        idx = pick[k0:k1]
+        pts = PackedPoints.of(np.take(block, idx, axis=1))
+        if spot_tri is not None:  # spot cones need the lamp of each candidate and the receiver
+            pts = with_spots(pts, spot_tri[idx], ctx.scene.lamps, terms.p[:, None, :])
+        p_hat, p_b = terms.evaluate(pts, want_pdf=m_b > 0)
+        den = m_l * pts.pdf if p_b is None else m_l * pts.pdf + m_b * p_b
+        np.maximum(den, np.float32(1e-30), out=den)
+        wk = np.divide(p_hat, den, out=den)
+        wk[~np.isfinite(wk)] = 0.0
+        w[k0:k1] = wk
+        p_hats[k0:k1] = p_hat
+    return w, p_hats, points, pick
+
+
+def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettings, px=None, py=None,
+                keep_bsdf_ray: bool = False):
+    """One reservoir per surface (n) from M_l light and M_b BSDF candidates (see module docstring).
+
+    ``terms``: target.ShadingTerms of the surfaces; ``px``, ``py``: their window pixels (pick the light tile).
+    All light candidates are weighed first and one is selected per surface in proportion to its weight (the
+    same distribution as streaming them one at a time). Returns (DIReservoirs, BsdfRay or None): the first
+    BSDF candidate's ray when ``keep_bsdf_ray``."""
+    n = len(surf.p)
+    lights = ctx.lights
+    m_l = cfg.light_candidates if lights.tri_alias is not None else 0
+    m_b = cfg.bsdf_candidates if lights.n_tri else 0
+    stream = Stream(DIReservoirs, n, rng)
+    res = stream.res
+    if m_l and n:
+        w, p_hats, points, pick = _light_candidates(ctx, terms, rng, cfg.tiles if px is not None else None,
+                                                    m_l, m_b, px, py)
+        cum = np.cumsum(w, axis=0)
+        total = cum[-1]
+        k_sel = np.minimum((cum <= (rng.random(n, dtype=np.float32) * total)[None, :]).sum(axis=0), m_l - 1)
+        take = np.flatnonzero(total > 0)
+        flat = pick[k_sel[take], take]
+        res.light[take] = points.light[flat]
+        res.b1[take] = points.b1[flat]
+        res.b2[take] = points.b2[flat]
+        res.p_hat[take] = p_hats[k_sel[take], take]
+        stream.w_sum[:] = total
+    first_ray = None
+    lamps = ctx.scene.lamps
+    for j in range(max(m_b, 1 if keep_bsdf_ray else 0)):
+        u = rng.random((n, 3), dtype=np.float32)
+        wi_l, f, p_b = sample_bsdf(surf.params, surf.wo_l, u[:, 0], u[:, 1], u[:, 2])
+        wi = to_world(wi_l, surf.ns, surf.t, surf.bt).astype(np.float32)
+        wi /= np.maximum(np.sqrt(dot(wi, wi)), 1e-12)[:, None]
+        live = np.flatnonzero((p_b > 0) & (dot(wi, surf.ng) > 0))
+        o = offset_origin(surf.p[live], surf.ng[live], wi[live])
+        d = wi[live]
+        hits = ctx.geom_accel.intersect(o, d)
+        if j == 0 and keep_bsdf_ray:
+            first_ray = BsdfRay(live, wi_l[live], f[live], p_b[live], o, d, hits)
+        if j >= m_b or live.size == 0:
+            continue
+        candidates = []
+        hp = np.maximum(hits.prim, 0)
+        candidates.append((np.where(hits.prim >= 0, lights.geom_to_light[hp], -1), hits.u, hits.v))
+        if len(lamps.tris):
+            lh = ctx.lamp_accel.intersect(o, d, hits.t)
+            lamp_ok = (lh.prim >= 0) & (lh.t < hits.t)
+            candidates.append((np.where(lamp_ok, lights.lamp_to_light[np.maximum(lh.prim, 0)], -1), lh.u, lh.v))
+        for light, cu, cv in candidates:
+            sel = np.flatnonzero(light >= 0)
+            if sel.size == 0:
+                continue
+            r = live[sel]
+            lp = light_points(lights, light[sel], cu[sel], cv[sel])
+            here = terms.take(r)
+            pts = PackedPoints.of(lp.packed())
+            if lp.has_spots:
+                pts = with_spots(pts, lp.spot_tri, lamps, here.p)
+            p_hat, pb = here.evaluate(pts)
+            cand = DIReservoirs(light=lp.light, b1=lp.b1, b2=lp.b2, M=None, W=None, p_hat=None)
+            stream.add(p_hat / np.maximum(m_l * pts.pdf + m_b * pb, 1e-30), p_hat, cand, rows=r)
+    return stream.finish(1.0), first_ray
+
+
+def shading_value(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l: np.ndarray):
+    """Target p̂ (n,), f (n, 3), geometry term G (n,) and the BSDF pdf in area measure (n,) of light points
+    in directions wi (world) at distances dist (the exact RGB model of bsdf.py)."""
+    wi_l = to_local(wi, surf.ns, surf.t, surf.bt)
+    f, pdf_b = eval_bsdf(surf.params, surf.wo_l, wi_l, view_albedo(surf.params, surf.wo_l))
+    ok = (dot(wi, surf.ng) > 0) & (dist > 0)
+    to_area = np.abs(cos_l) / np.maximum(dist * dist, 1e-30)
+    g = np.abs(wi_l[:, 2]) * to_area
+    p_hat = np.where(ok, luminance(f * le) * g, 0.0).astype(np.float32)
+    return p_hat, f, np.where(ok, g, 0.0).astype(np.float32), np.where(ok, pdf_b * to_area, 0.0).astype(np.float32)
+
+
+def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
+    """Direct radiance (n, 3) at the surfaces: each reservoir's sample with one shadow ray, plus one
+    light-sampled sun."""
+    n = len(surf.p)
+    out = np.zeros((n, 3), np.float32)
+    lights = ctx.lights
+    live = np.flatnonzero(res.has_sample() & (res.W > 0))
+    rays = []  # (rows, contributions, origins, directions, tmax): one Embree call for both kinds
+    if live.size:
+        sub = surf.take(live)
+        q, wi, dist, cos_l, le = lights.point_towards(res.light[live], res.b1[live], res.b2[live], sub.p)
+        _p, f, g, _pb = shading_value(sub, wi, le, dist, cos_l)
+        contrib = f * le * (g * res.W[live])[:, None]
+        go = np.flatnonzero(contrib.max(axis=1) > 0)
+        if go.size:
+            rays.append((live[go], contrib[go], *shadow_rays(sub.p[go], sub.ng[go], q[go], wi[go], dist[go])))
+    if lights.sun_alias is not None:
+        ls = lights.sample_suns(n, rng.random((n, 4), dtype=np.float32))
+        wi_l = to_local(ls.wi, surf.ns, surf.t, surf.bt)
+        f, _pb = eval_bsdf(surf.params, surf.wo_l, wi_l)
+        ok = (dot(ls.wi, surf.ng) > 0) & (ls.pdf > 0)
+        contrib = f * ls.le * (np.abs(wi_l[:, 2]) / np.maximum(ls.pdf, 1e-30) * ok)[:, None]
+        go = np.flatnonzero(contrib.max(axis=1) > 0)
+        if go.size:
+            rays.append((go, contrib[go], *shadow_rays(surf.p[go], surf.ng[go], ls.pos[go], ls.wi[go], ls.dist[go])))
+    if rays:
+        _rows, _c, o, d, far = (np.concatenate(parts) for parts in zip(*rays))
+        visible = ~ctx.geom_accel.occluded(o, d, far)
+        start = 0
+        for rows, contrib, *_ in rays:  # rows are unique within each kind
+            vis = visible[start:start + len(rows)]
+            out[rows[vis]] += contrib[vis]
+            start += len(rows)
+    return np.where(np.isfinite(out), out, 0.0).astype(np.float32)

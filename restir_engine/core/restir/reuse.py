@@ -1,0 +1,213 @@
+"""Spatial and temporal reuse, generic over the sample type.
+
+Both merge a pixel's own (canonical) reservoir with other reservoirs whose samples are shifted to the pixel:
+spatial reuse with up to k similar neighbours of the same frame, temporal reuse with the reservoir its
+surface had in the previous frame. The sample type enters through a *space* object:
+  space.kind                          the Reservoirs subclass
+  space.prepare(res)                  per-frame data for gathers of the samples of ``res``
+  space.target(terms, prepared, idx)  p̂ (n,) of samples ``idx`` of ``prepared`` at surfaces ``terms``
+  space.jacobian (optional)           shift Jacobians; DI samples live in area measure: none is needed
+
+Merges (one code path, :func:`merge`):
+  NONE      w_i = p̂_c(y_i) W_i M_i,  W = Σw / (p̂_c(y) ΣM)    (1/M: fast, darkens where a neighbour's
+                                                              sample is impossible at the pixel)
+  UNBIASED  w_i = m_i(y_i) p̂_c(y_i) W_i,  W = Σw / p̂_c(y)  with pairwise MIS weights m_i
+            (:func:`pairwise_weights`), which sum to one for every sample: unbiased.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .reservoir import Reservoirs, Stream
+
+DEPTH_TOLERANCE = 0.1    # relative planar-depth difference above which a neighbour is rejected
+NORMAL_COS = 0.906       # cos 25°: shading normals further apart are rejected
+BIAS_CORRECTIONS = ("NONE", "UNBIASED")
+
+
+def rows_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
+
+
+def similar(depth_ref: np.ndarray, depth: np.ndarray, ns_ref: np.ndarray, ns: np.ndarray) -> np.ndarray:
+    """Whether a neighbour's surface (planar depth, shading normal (n, 3)) may share samples with the
+    reference: depth within DEPTH_TOLERANCE of the reference's and normals within 25°."""
+    ok = np.abs(depth - depth_ref) <= DEPTH_TOLERANCE * np.maximum(depth_ref, 1e-6)
+    ok &= rows_dot(ns, ns_ref) >= NORMAL_COS
+    return ok
+
+
+def neighbor_offsets(k: int, radius: float, rng: np.random.Generator, n: int) -> np.ndarray:
+    """Per-pixel neighbour offsets (n, k, 2) in pixels: a golden-angle spiral filling the disc of
+    ``radius`` (low discrepancy), rotated by a random angle per pixel and pass (no ring artefacts)."""
+    j = np.arange(k, dtype=np.float32)
+    r = radius * np.sqrt((j + 0.5) / k)
+    phi = j * np.float32(2.39996323) + rng.random((n, 1), dtype=np.float32) * np.float32(2 * np.pi)
+    return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=-1)
+
+
+def pairwise_weights(m_c, p_c, m_q, p_q, pc_at_q, pq_at_c, oks):
+    """Pairwise MIS weights with confidences for one canonical reservoir c and neighbours q = 1..k.
+
+    Each neighbour forms a pair with c, in which c takes a 1/k share of its confidence; pair q holds the
+    share π_q = (M_q + M_c/k) / M_total of the estimate and splits it by the balance heuristic:
+      m_q(y_q) = π_q · M_q p̂_q(y_q) / (M_q p̂_q(y_q) + M_c/k · p̂_c(y_q))
+      m_c(y_c) = Σ_q π_q · M_c/k · p̂_c(y_c) / (M_q p̂_q(y_c) + M_c/k · p̂_c(y_c))      (1 when k = 0)
+    For every sample the weights of all techniques sum to one, and a technique whose target is zero gets
+    weight zero, so the merged reservoir stays unbiased; where all targets agree the weights are the
+    confidence shares M/M_total (the generalized balance heuristic). Arguments are per-slot lists of (n,)
+    arrays (``oks``: the neighbour was accepted); ``p_c`` = p̂_c(y_c), ``p_q`` = p̂_q(y_q) (the targets
+    cached in the reservoirs). Returns (m_c (n,), [m_q (n,)])."""
+    k = np.sum(oks, axis=0).astype(np.float32) if oks else np.zeros_like(m_c)
+    m_total = m_c + (np.sum(m_q, axis=0) if m_q else 0.0)
+    share_c = np.where(k > 0, m_c / np.maximum(k, 1.0), 0.0)
+    inv_total = 1.0 / np.maximum(m_total, 1e-30)
+    w_c = np.where(k > 0, 0.0, 1.0)
+    w_q = []
+    for mq, pq, pcq, pqc, ok in zip(m_q, p_q, pc_at_q, pq_at_c, oks):
+        pi = (mq + share_c) * inv_total
+        a = mq * pq
+        w_q.append(np.where(ok, pi * a / np.maximum(a + share_c * pcq, 1e-30), 0.0))
+        b = share_c * p_c
+        w_c = w_c + np.where(ok, pi * b / np.maximum(mq * pqc + b, 1e-30), 0.0)
+    return w_c.astype(np.float32), [w.astype(np.float32) for w in w_q]
+
+
+@dataclass
+class Neighbour:
+    """One reservoir offered to each canonical pixel: ``src[q]`` where ``ok``; M its (capped) confidence,
+    pc_at_q = p̂_c(y_q) (target of the canonical pixel at the neighbour's sample), pq_at_c = p̂_q(y_c)
+    (the neighbour's target at the canonical sample; UNBIASED only). Arrays (n,), zero where not ok."""
+
+    src: Reservoirs
+    q: np.ndarray
+    ok: np.ndarray
+    M: np.ndarray
+    pc_at_q: np.ndarray
+    pq_at_c: np.ndarray | None = None
+
+
+def merge(canonical: Reservoirs, neighbours: list, bias_correction: str, rng: np.random.Generator) -> Reservoirs:
+    """Resample the canonical reservoirs (n) and their neighbours into new reservoirs (see module docstring).
+    The canonical reservoirs' M, W and p̂ are their own; the result's M is the sum of confidences."""
+    kind = type(canonical)
+    n = len(canonical)
+    stream = Stream(kind, n, rng)
+    own = canonical.has_sample()
+    p_c = np.where(own, canonical.p_hat, np.float32(0.0))
+    m_total = canonical.M + (np.sum([nb.M for nb in neighbours], axis=0) if neighbours else 0.0)
+    if bias_correction == "UNBIASED":
+        w_c, w_q = pairwise_weights(canonical.M, p_c, [nb.M for nb in neighbours],
+                                    [nb.src.p_hat[nb.q] for nb in neighbours], [nb.pc_at_q for nb in neighbours],
+                                    [nb.pq_at_c for nb in neighbours], [nb.ok for nb in neighbours])
+        stream.add(w_c * p_c * canonical.W, canonical.p_hat, canonical)
+        for nb, w in zip(neighbours, w_q):
+            stream.add(np.where(nb.ok, w * nb.pc_at_q * nb.src.W[nb.q], 0.0), nb.pc_at_q, nb.src, nb.q)
+        denom = None
+    elif bias_correction == "NONE":
+        stream.add(p_c * canonical.W * canonical.M, canonical.p_hat, canonical)
+        for nb in neighbours:
+            stream.add(np.where(nb.ok, nb.pc_at_q * nb.src.W[nb.q] * nb.M, 0.0), nb.pc_at_q, nb.src, nb.q)
+        denom = m_total
+    else:
+        raise ValueError(f"unknown bias correction {bias_correction!r}; available: {BIAS_CORRECTIONS}")
+    return stream.finish(m_total, denom)
+
+
+@dataclass
+class SpatialSettings:
+    """neighbors per pass, radius in pixels (of the full render width), passes, bias correction."""
+
+    neighbors: int = 5
+    radius: float = 30.0
+    passes: int = 1
+    bias_correction: str = "UNBIASED"
+
+
+def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: SpatialSettings,
+                  rng: np.random.Generator) -> Reservoirs:
+    """One spatial pass for surfaces ``rows`` of the G-buffer ``gb`` (restir.gbuffer.GBuffer): merge up to
+    ``cfg.neighbors`` similar neighbours' reservoirs of ``res`` (the whole frame; ``prepared`` =
+    ``space.prepare(res)``) into each surface's own. Returns the new reservoirs of ``rows``."""
+    n = len(rows)
+    unbiased = cfg.bias_correction == "UNBIASED"
+    me = gb.terms.take(rows)
+    pix = gb.pix[rows]
+    px, py = pix % gb.width, pix // gb.width
+    offs = neighbor_offsets(cfg.neighbors, cfg.radius, rng, n)
+    canonical = res.take(rows)
+    neighbours, taken = [], []
+    for k in range(cfg.neighbors):
+        qx = np.round(px + offs[:, k, 0]).astype(np.int64)
+        qy = np.round(py + offs[:, k, 1]).astype(np.int64)
+        inside = (qx >= 0) & (qx < gb.width) & (qy >= 0) & (qy < gb.height)
+        q = gb.slot[np.where(inside, qy * gb.width + qx, pix)]
+        # a neighbour outside the window or without a surface, the pixel itself or one already merged would
+        # be a correlated duplicate (biased): skip it
+        ok = inside & (q >= 0) & (q != rows)
+        for q_prev in taken:
+            ok &= q != q_prev
+        q = np.where(ok, q, rows)
+        ok &= similar(gb.depth[rows], gb.depth[q], gb.ns[rows], gb.ns[q])
+        q = np.where(ok, q, rows)
+        taken.append(q)
+        m_q = np.where(ok, res.M[q], np.float32(0.0))
+        if not ok.any():
+            z = np.zeros(n, np.float32)
+            neighbours.append(Neighbour(res, q, ok, m_q, z, z))
+            continue
+        pc = np.where(ok & res.has_sample()[q], space.target(me, prepared, q), np.float32(0.0))
+        pq = None
+        if unbiased:
+            pq = np.where(ok & canonical.has_sample(), space.target(gb.terms.take(q), prepared, rows),
+                          np.float32(0.0))
+        neighbours.append(Neighbour(res, q, ok, m_q, pc, pq))
+    return merge(canonical, neighbours, cfg.bias_correction, rng)
+
+
+def temporal_reuse(space, gb, res: Reservoirs, hist, prepared_prev, rows: np.ndarray, confidence_cap: float,
+                   bias_correction: str, motion, rng: np.random.Generator, possible_before=None) -> Reservoirs:
+    """Merge the reservoirs of surfaces ``rows`` with the reservoir each surface had in the previous frame
+    (``hist``: restir.history.TemporalHistory, its reservoirs prepared as ``prepared_prev``).
+
+    The hit is moved with its object's previous transform (``motion``: scene.Motion, or None when the
+    history is not from the previous frame) and projected with the previous camera; the match must pass the
+    similarity tests (depth within 10 %, normals within 25°) and have the same material, else it is a
+    disocclusion. The previous confidence is capped at ``confidence_cap`` x the current one.
+    ``possible_before(rows)`` (optional): (n,) bool, False where the previous frame could not have produced
+    the current sample (a light switched on since): its target there is zero for the MIS weights."""
+    from ..camera import project
+
+    n = len(rows)
+    prev_gb = hist.gbuf
+    p_now = gb.terms.p[:, rows].T
+    p_then = p_now if motion is None else motion.moved_points(p_now, gb.instance[rows], "prev")
+    raster, depth_then = project(hist.camera, p_then)
+    x0, y0, w, h = hist.camera.window
+    px = np.floor(raster[:, 0]).astype(np.int64) - x0
+    py = np.floor(raster[:, 1]).astype(np.int64) - y0
+    inside = (px >= 0) & (px < w) & (py >= 0) & (py < h) & (depth_then > 0)
+    q = prev_gb.slot[np.where(inside, py * w + px, 0)]
+    ok = inside & (q >= 0)
+    q = np.where(ok, q, 0)
+    ok &= similar(depth_then, prev_gb.depth[q], gb.ns[rows], prev_gb.ns[q])
+    ok &= prev_gb.material[q] == gb.material[rows]
+    canonical = res.take(rows)
+    prev = hist.res
+    m_prev = np.where(ok, np.minimum(prev.M[q], confidence_cap * np.maximum(canonical.M, 1.0)), 0.0).astype(np.float32)
+    use = ok & prev.has_sample()[q]
+    pc = np.zeros(n, np.float32)
+    if use.any():
+        pc = np.where(use, space.target(gb.terms.take(rows), prepared_prev, q), np.float32(0.0))
+    pq = None
+    if bias_correction == "UNBIASED":
+        pq = np.zeros(n, np.float32)
+        both = ok & canonical.has_sample()
+        if both.any():
+            pq = space.target(prev_gb.terms.take(q), space.prepare(canonical), np.arange(n))
+            if possible_before is not None:
+                pq = np.where(possible_before(rows), pq, 0.0)
+            pq = np.where(both, pq, np.float32(0.0)).astype(np.float32)
+    return merge(canonical, [Neighbour(prev, q, ok, m_prev, pc, pq)], bias_correction, rng)
