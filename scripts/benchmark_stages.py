@@ -61,7 +61,7 @@ def blend_path(scene: str) -> str:
     return ensure_blend(scene, "10k" if scene == "many_lights" else "default", "large")
 
 
-def run(name, scene_name, kw, frames):
+def run(name, scene_name, kw, frames, tile_pixels=None):
     bpy.ops.wm.open_mainfile(filepath=blend_path(scene_name))
     t0 = time.perf_counter()
     scene = export_scene(bpy.context.evaluated_depsgraph_get())
@@ -72,6 +72,8 @@ def run(name, scene_name, kw, frames):
         e0, c0 = embree_seconds(), time.process_time()
         t = time.perf_counter()
         extra = {"clock": clock} if "clock" in inspect.signature(render_frame).parameters else {}
+        if tile_pixels:
+            kw = dict(kw, tile_pixels=tile_pixels)
         r = render_frame(scene, RenderSettings(**kw, samples=1, seed=0, frame=f, data_passes=False), history=hist,
                          **extra)
         wall = time.perf_counter() - t
@@ -137,7 +139,19 @@ def main():
     ap.add_argument("--label", default="after", choices=("after", "before"))
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "results", "stages"))
     ap.add_argument("--only", default=None, help="run only the runs whose name contains this")
+    ap.add_argument("--tile-sweep", action="store_true",
+                    help="instead: frame time of each run at 4k, 16k and 64k pixels per chunk (tile_sweep.json)")
     args = ap.parse_args()
+    if args.tile_sweep:
+        sweep = {}
+        for n, s, kw in RUNS:
+            if args.only and args.only not in n:
+                continue
+            sweep[n] = {str(tp): run(f"{n} @{tp}", s, kw, args.frames, tp)["frame_s"] for tp in (4096, 16384, 65536)}
+        os.makedirs(args.out, exist_ok=True)
+        with open(os.path.join(args.out, "tile_sweep.json"), "w") as f:
+            json.dump(sweep, f, indent=1)
+        return
     os.makedirs(args.out, exist_ok=True)
     results = [run(n, s, kw, args.frames) for n, s, kw in RUNS if not args.only or args.only in n]
     meta = {"machine": platform.processor() or platform.machine(), "cores": thread_count(),

@@ -86,3 +86,10 @@ def test_white_metal_reflects_all_energy(roughness, theta):
     se = est.std() / np.sqrt(N)
     # 1% allowance for the 32x32 albedo table's interpolation, plus 5 standard errors
     assert abs(est.mean() - 1.0) < 0.01 + 5 * se, (est.mean(), se)
+
+
+def test_stored_ggx_albedo_table_is_the_computed_one():
+    """core/data/ggx_albedo.npy (read at start-up instead of a second of computation) is what
+    scripts/make_ggx_table.py computes."""
+    from restir_engine.core.bsdf import TABLE_FILE, compute_ggx_albedo_table
+    np.testing.assert_allclose(np.load(TABLE_FILE), compute_ggx_albedo_table(), rtol=0, atol=1e-7)

@@ -32,7 +32,7 @@ def test_manifest_wheels_match_the_pinned_embreex():
 
 
 def test_core_never_imports_bpy():
-    for path in glob.glob(os.path.join(ROOT, "restir_engine", "core", "*.py")):
+    for path in glob.glob(os.path.join(ROOT, "restir_engine", "core", "**", "*.py"), recursive=True):
         with open(path) as f:
             text = f.read()
         assert "import bpy" not in text and "from bpy" not in text, path

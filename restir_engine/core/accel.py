@@ -14,7 +14,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from .profile import add_embree_seconds
-from .sampling import dot, norm
+from .sampling import dot, norm, row_max
 
 CHUNK_RAYS = 32768  # rays per Embree call: large enough to amortize the call, small for load balance
 
@@ -53,8 +53,8 @@ def offset_origin(p: np.ndarray, ng: np.ndarray, direction: np.ndarray) -> np.nd
     The offset scales with the coordinate magnitude (float32 spacing) so it works at any scene scale.
     """
     side = np.where(dot(ng, direction) >= 0.0, 1.0, -1.0).astype(np.float32)
-    mag = np.maximum(np.abs(p).max(axis=1), 1.0).astype(np.float32)
-    return (p + ng * (side * mag * 1e-4)[:, None]).astype(np.float32)
+    mag = np.maximum(row_max(np.abs(p)), np.float32(1.0))
+    return (p + ng * (side * mag * np.float32(1e-4))[:, None]).astype(np.float32, copy=False)
 
 
 def shadow_rays(p: np.ndarray, ng: np.ndarray, light_pos: np.ndarray, wi: np.ndarray, dist: np.ndarray):

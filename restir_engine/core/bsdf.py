@@ -16,6 +16,7 @@ cosine hemisphere for the diffuse lobe, the GGX normal distribution for the spec
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,33 +81,46 @@ _ALBEDO_TABLE = None
 _TABLE_N = 32
 
 
+TABLE_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "ggx_albedo.npy")
+
+
 def ggx_albedo_table() -> np.ndarray:
     """E[α index, μ index]: directional albedo of single-scattering GGX (F = 1, height-correlated Smith)
-    on a 32 x 32 grid of α in [ALPHA_MIN, 1] and μo in [1/64, 1], by stratified NDF sampling
-    (64 x 64 strata per entry); computed once, in about a second."""
+    on a 32 x 32 grid of α in [ALPHA_MIN, 1] and μo in [1/64, 1]. Read from core/data/ggx_albedo.npy
+    (written by scripts/make_ggx_table.py from :func:`compute_ggx_albedo_table`; computed here if missing)."""
     global _ALBEDO_TABLE
     if _ALBEDO_TABLE is None:
-        n = _TABLE_N
-        alphas = np.linspace(ALPHA_MIN, 1.0, n)
-        mus = np.linspace(1.0 / 64, 1.0, n)
-        k = 64
-        u1 = ((np.arange(k) + 0.5) / k)[:, None].repeat(k, 1).ravel()
-        u2 = ((np.arange(k) + 0.5) / k)[None, :].repeat(k, 0).ravel()
-        table = np.empty((n, n))
-        for i, a in enumerate(alphas):  # loop over table rows, vectorized over μ and strata
-            tan2 = a * a * u1 / np.maximum(1 - u1, 1e-9)
-            ch = 1 / np.sqrt(1 + tan2)
-            sh = np.sqrt(np.maximum(0, 1 - ch * ch))
-            h = np.stack([sh * np.cos(2 * np.pi * u2), sh * np.sin(2 * np.pi * u2), ch], axis=1)
-            mu = mus[:, None]
-            wo = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=-1)  # (n, 1, 3)
-            odh = (wo * h[None]).sum(-1)
-            wi_z = 2 * odh * h[None, :, 2] - mu
-            g = 1 / (1 + smith_lambda(a, np.broadcast_to(mu, wi_z.shape)) + smith_lambda(a, np.maximum(wi_z, 1e-6)))
-            wgt = np.where((wi_z > 0) & (odh > 0), g * odh / (mu * h[None, :, 2]), 0.0)
-            table[i] = wgt.mean(axis=1)
-        _ALBEDO_TABLE = np.clip(table, 1e-3, 1.0).astype(np.float32)
+        try:
+            table = np.load(TABLE_FILE)
+        except OSError:
+            table = compute_ggx_albedo_table()
+        _ALBEDO_TABLE = table.astype(np.float32)
     return _ALBEDO_TABLE
+
+
+def compute_ggx_albedo_table() -> np.ndarray:
+    """The table of :func:`ggx_albedo_table` by stratified NDF sampling (64 x 64 strata per entry; about a
+    second)."""
+    n = _TABLE_N
+    alphas = np.linspace(ALPHA_MIN, 1.0, n)
+    mus = np.linspace(1.0 / 64, 1.0, n)
+    k = 64
+    u1 = ((np.arange(k) + 0.5) / k)[:, None].repeat(k, 1).ravel()
+    u2 = ((np.arange(k) + 0.5) / k)[None, :].repeat(k, 0).ravel()
+    table = np.empty((n, n))
+    for i, a in enumerate(alphas):  # loop over table rows, vectorized over μ and strata
+        tan2 = a * a * u1 / np.maximum(1 - u1, 1e-9)
+        ch = 1 / np.sqrt(1 + tan2)
+        sh = np.sqrt(np.maximum(0, 1 - ch * ch))
+        h = np.stack([sh * np.cos(2 * np.pi * u2), sh * np.sin(2 * np.pi * u2), ch], axis=1)
+        mu = mus[:, None]
+        wo = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=-1)  # (n, 1, 3)
+        odh = (wo * h[None]).sum(-1)
+        wi_z = 2 * odh * h[None, :, 2] - mu
+        g = 1 / (1 + smith_lambda(a, np.broadcast_to(mu, wi_z.shape)) + smith_lambda(a, np.maximum(wi_z, 1e-6)))
+        wgt = np.where((wi_z > 0) & (odh > 0), g * odh / (mu * h[None, :, 2]), 0.0)
+        table[i] = wgt.mean(axis=1)
+    return np.clip(table, 1e-3, 1.0).astype(np.float32)
 
 
 def ggx_albedo(alpha: np.ndarray, mu: np.ndarray) -> np.ndarray:
@@ -135,35 +149,38 @@ def view_albedo(p: SurfaceParams, wo: np.ndarray) -> np.ndarray:
 
 
 def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray, albedo: np.ndarray | None = None):
-    """f (n, 3) and pdf (n,) of sampling wi given wo (``albedo``: :func:`view_albedo`, if known)."""
+    """f (n, 3) and pdf (n,) of sampling wi given wo, both unit vectors (``albedo``: :func:`view_albedo`, if
+    known). The half vector h = (wo + wi)/|wo + wi| enters only through cos θ_h = (cos θ_o + cos θ_i)/|wo + wi|
+    and wo·h = (1 + wo·wi)/|wo + wi|, with |wo + wi|² = 2 + 2 wo·wi."""
     co = wo[:, 2]
     ci = wi[:, 2]
     valid = (co > 0) & (ci > 0)
     # a lobe with f0 = 0 does not exist (Diffuse BSDF): no Fresnel split, no grazing specular
-    fd = np.where(p.f0_dielectric > 0, 1.0 - schlick(p.f0_dielectric, co), 1.0)
+    fd = np.where(p.f0_dielectric > 0, 1.0 - schlick(p.f0_dielectric, co), np.float32(1.0))
     f = p.diffuse * (fd * INV_PI)[:, None]
     pdf_d = np.maximum(ci, 0) * INV_PI
-    h = wo + wi
-    hn = norm(h)
-    h = h / np.maximum(hn, 1e-12)[:, None]
-    cos_h = np.clip(h[:, 2], 0, 1)
-    odh = np.clip(dot(wo, h), 1e-6, 1.0)
+    wdw = dot(wo, wi)
+    hinv = 1.0 / np.sqrt(np.maximum(2.0 + 2.0 * wdw, np.float32(1e-24)))
+    cos_h = np.clip((co + ci) * hinv, 0, 1)
+    odh = np.clip((1.0 + wdw) * hinv, 1e-6, 1.0)
     d = _ggx_d(p.alpha, cos_h)
     g = 1.0 / (1.0 + smith_lambda(p.alpha, co) + smith_lambda(p.alpha, ci))
     fr = schlick(p.f0, odh[:, None])
     e = view_albedo(p, wo) if albedo is None else albedo
     compensation = 1.0 + p.f0 * ((1.0 - e) / e)[:, None]
-    spec = (p.spec_on * d * g / np.maximum(4.0 * co * ci, 1e-12))[:, None] * fr * compensation
+    spec = (p.spec_on * d * g / np.maximum(4.0 * co * ci, np.float32(1e-12)))[:, None] * fr * compensation
     f = f + spec
     pdf_s = d * cos_h / (4.0 * odh)
     pdf = (1 - p.p_spec) * pdf_d + p.p_spec * pdf_s
-    f = np.where(valid[:, None], f, 0.0).astype(np.float32)
-    pdf = np.where(valid, pdf, 0.0).astype(np.float32)
+    f = np.where(valid[:, None], f, np.float32(0.0)).astype(np.float32, copy=False)
+    pdf = np.where(valid, pdf, np.float32(0.0)).astype(np.float32, copy=False)
     return f, pdf
 
 
-def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.ndarray, u2: np.ndarray):
-    """Sample wi; returns wi (n, 3), f (n, 3), pdf (n,) (the mixture pdf, so MIS-ready)."""
+def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.ndarray, u2: np.ndarray,
+                albedo: np.ndarray | None = None):
+    """Sample wi; returns wi (n, 3), f (n, 3), pdf (n,) (the mixture pdf, so MIS-ready). ``albedo``: see
+    :func:`eval_bsdf`."""
     spec = u_lobe < p.p_spec
     wi = cosine_hemisphere(u1, u2)
     if spec.any():
@@ -176,6 +193,6 @@ def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.nda
         h = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=-1)
         o = wo[spec]
         wi[spec] = (2.0 * dot(o, h)[:, None] * h - o).astype(np.float32)
-    f, pdf = eval_bsdf(p, wo, wi)
+    f, pdf = eval_bsdf(p, wo, wi, albedo)
     ok = (pdf > 0) & (wi[:, 2] > 0)
     return wi, np.where(ok[:, None], f, 0.0).astype(np.float32), np.where(ok, pdf, 0.0).astype(np.float32)

@@ -1,7 +1,7 @@
 """One light table over every emitter, with power-proportional selection.
 
-Entries, in order: emissive scene triangles (kind GEOM), Blender lamp triangles (kind LAMP,
-non-occluding) and suns (kind SUN, distant lights). Triangle lights are sampled uniformly in
+Entries, in order: emissive scene triangles, Blender lamp triangles (non-occluding) and suns
+(distant lights). Triangle lights are sampled uniformly in
 area; the returned pdf is converted to solid angle: p_ω = p_select · (1/A) · d² / |cos θ_light|.
 Suns are sampled uniformly in their cone and are handled by light sampling only (a BSDF ray
 that escapes never collects a sun), which keeps the MIS estimator unbiased.
@@ -13,12 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bsdf import luminance
-from .sampling import AliasTable, dot, norm, orthonormal_basis, uniform_triangle
+from .sampling import AliasTable, barycentric, dot, norm, orthonormal_basis, row_max, uniform_triangle
 from .scene import Lamps, MaterialTable, Scene, TriangleSet
 from .textures import apply_texture, mean_color
-
-GEOM, LAMP, SUN = 0, 1, 2
-
 
 def triangle_geometry(verts: np.ndarray):
     """Unit geometric normals (winding order) and areas of (n, 3, 3) triangles."""
@@ -34,7 +31,7 @@ def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarra
     mat = tris.material[tri]
     le = materials.emission[mat]
     if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
-        uv = np.einsum("ijk,ij->ik", tris.uvs[tri], np.stack([1 - b1 - b2, b1, b2], axis=1))
+        uv = barycentric(tris.uvs[tri], b1, b2)
         le = apply_texture(le, materials.emit_tex[mat], uv, materials.textures)
     return le
 
@@ -91,6 +88,12 @@ class LightTable:
             np.zeros((0, 3), np.float32), np.zeros(0, np.float32))
         tri_mat = np.concatenate([geom.material[g_idx], lamps.tris.material[l_idx]]).astype(np.int64)
         self.tri_two_sided = mats.two_sided_emission[tri_mat] if len(tri_mat) else np.zeros(0, bool)
+        # radiance of each light where no texture modulates it (most lights): one gather per point
+        self.tri_le = mats.emission[tri_mat].astype(np.float32) if len(tri_mat) else np.zeros((0, 3), np.float32)
+        tri_uvs = len(tri_mat) and (geom.uvs is not None or lamps.tris.uvs is not None)
+        self.tri_textured = (mats.emit_tex[tri_mat] >= 0) if tri_uvs else np.zeros(len(tri_mat), bool)
+        self.any_textured = bool(self.tri_textured.any())
+        self.any_spots = bool(len(lamps.tris) and (lamps.spot_cos[l_idx] > -1.5).any())
         # power (W, luminance-weighted) decides selection; zero-area triangles get zero power
         tri_power = mat_power_density[tri_mat] * self.tri_area if len(tri_mat) else np.zeros(0, np.float32)
         sun_power = luminance(lamps.sun_irradiance) * np.pi * scene_radius ** 2 if len(lamps.sun_dir) else np.zeros(0)
@@ -129,7 +132,7 @@ class LightTable:
         """Triangle light ``light`` at barycentrics (b1, b2) seen from points p (n, 3): the light point
         (n, 3), unit direction wi from p (n, 3), distance (n,), cos at the light (n,) and the radiance
         arriving at p (n, 3) (zero from a back face of a one-sided emitter, spot cones applied)."""
-        q = np.einsum("ijk,ij->ik", self.tri_verts[light], np.stack([1 - b1 - b2, b1, b2], axis=1))
+        q = barycentric(self.tri_verts[light], b1, b2)
         d = q - p
         dl = norm(d)
         w = d / np.maximum(dl, 1e-30)[:, None]
@@ -148,21 +151,29 @@ class LightTable:
         """Radiance (n, 3) leaving triangle light ``light`` at (b1, b2) towards p_receiver,
         before the sidedness test (spot cones included unless p_receiver is None)."""
         scene = self.scene
-        out = np.zeros((len(light), 3), np.float32)
-        is_geom = light < self.n_geom
-        if is_geom.any():
-            g = self.geom_ids[light[is_geom]]
-            out[is_geom] = emitted_radiance(scene.geometry, scene.materials, g, b1[is_geom], b2[is_geom])
-        lm = ~is_geom
-        if lm.any():
-            t = self.lamp_ids[light[lm] - self.n_geom]
-            le = emitted_radiance(scene.lamps.tris, scene.materials, t, b1[lm], b2[lm])
-            out[lm] = le if p_receiver is None else le * spot_factor(scene.lamps, t, p_receiver[lm])[:, None]
+        out = self.tri_le[light]
+        if self.any_textured:
+            tex = np.flatnonzero(self.tri_textured[light])
+            if tex.size:
+                lt = light[tex]
+                geo = lt < self.n_geom
+                for sel, tris, ids, offset in ((geo, scene.geometry, self.geom_ids, 0),
+                                               (~geo, scene.lamps.tris, self.lamp_ids, self.n_geom)):
+                    if sel.any():
+                        out[tex[sel]] = emitted_radiance(tris, scene.materials, ids[lt[sel] - offset],
+                                                         b1[tex[sel]], b2[tex[sel]])
+        if p_receiver is not None and self.any_spots:
+            lm = np.flatnonzero(light >= self.n_geom)
+            if lm.size:
+                t = self.lamp_ids[light[lm] - self.n_geom]
+                out[lm] *= spot_factor(scene.lamps, t, p_receiver[lm])[:, None]
         return out
 
     def spot_lamp_tri(self, light: np.ndarray) -> np.ndarray:
         """Lamp triangle index (n,) int32 of lights with a spot cone, -1 for every other light."""
         out = np.full(len(light), -1, np.int32)
+        if not self.any_spots:
+            return out
         lm = np.flatnonzero(light >= self.n_geom)
         if lm.size:
             t = self.lamp_ids[light[lm] - self.n_geom]
@@ -185,7 +196,7 @@ class LightTable:
             b1, b2 = uniform_triangle(u[tri, 2], u[tri, 3])
             q, w, dl, cos_l, rad = self.point_towards(li, b1, b2, p[tri])
             pd = self.tri_pdf_solid_angle(li, dl, cos_l)
-            ok = (rad.max(axis=1) > 0) & np.isfinite(pd)
+            ok = (row_max(rad) > 0) & np.isfinite(pd)
             pos[tri] = q
             wi[tri] = w
             dist[tri] = dl

@@ -25,7 +25,7 @@ from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
 from .bsdf import SurfaceParams, eval_bsdf, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
-from .sampling import dot, norm, to_local, to_world
+from .sampling import dot, norm, row_max, rows_finite, to_local, to_world
 from .scene import Scene
 from .surface import Surface
 
@@ -116,12 +116,12 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         return out
     ls = ctx.lights.sample(s.p, rng.random((n, 4), dtype=np.float32))
     wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
-    f, pdf_b = eval_bsdf(s.params, s.wo_l, wi_l)
+    f, pdf_b = eval_bsdf(s.params, s.wo_l, wi_l, s.albedo)
     w = np.where(ls.delta, 1.0, power_heuristic(ls.pdf, pdf_b))
     contrib = f * (np.abs(wi_l[:, 2]) * w / np.maximum(ls.pdf, 1e-30))[:, None] * ls.le
     if throughput is not None:
         contrib *= throughput
-    live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (contrib.max(axis=1) > 0))
+    live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (row_max(contrib) > 0))
     if live.size:
         so, sd, far = shadow_rays(s.p[live], s.ng[live], ls.pos[live], ls.wi[live], ls.dist[live])
         vis = ~ctx.geom_accel.occluded(so, sd, far)
@@ -157,16 +157,16 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             o, d, hits = first_ray.o, first_ray.d, first_ray.hits
         else:
             u = rng.random((len(idx), 3), dtype=np.float32)
-            wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[:, 0], u[:, 1], u[:, 2])
+            wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[:, 0], u[:, 1], u[:, 2], s.albedo)
             wi = to_world(wi_l, s.ns, s.t, s.bt)
             wi /= np.maximum(norm(wi), 1e-12)[:, None]
             rows = np.flatnonzero((pdf > 0) & (dot(wi, s.ng) > 0))
             wi_l, f, pdf = wi_l[rows], f[rows], pdf[rows]
             o, d, hits = offset_origin(s.p[rows], s.ng[rows], wi[rows]), wi[rows].astype(np.float32), None
         thr = throughput[rows] * f * (wi_l[:, 2] / np.maximum(pdf, 1e-30))[:, None]
-        ok = np.isfinite(thr).all(axis=1)
+        ok = rows_finite(thr)
         if bounce + 1 >= ctx.rr_start:
-            q = np.clip(thr.max(axis=1), 0.05, 1.0)
+            q = np.clip(row_max(thr), 0.05, 1.0)
             ok &= rng.random(len(rows), dtype=np.float32) < q
             thr /= q[:, None]
         keep = np.flatnonzero(ok)

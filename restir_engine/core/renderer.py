@@ -332,10 +332,11 @@ class FrameRenderer:
                 # object motion is known for the previous frame only; a history from another frame gets none
                 motion = ctx.scene.motion if hist.frame == st.frame - 1 else None
                 prepared = space.prepare(hist.res)
+                now = space.prepare(res) if st.bias_correction == "UNBIASED" else None
                 had = hist.had_light
                 possible = None if had is None else (lambda rows: had[np.maximum(res.light[rows], 0)])
                 parts = list(pool().map(lambda a: (a[1], reuse.temporal_reuse(
-                    space, gb, res, hist, prepared, a[1], st.confidence_cap, st.bias_correction, motion,
+                    space, gb, res, now, hist, prepared, a[1], st.confidence_cap, st.bias_correction, motion,
                     rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]), possible)), enumerate(spans)))
                 res = _gather(space.kind, parts, len(gb))
         if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode

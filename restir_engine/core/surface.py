@@ -7,22 +7,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import SurfaceParams
+from .bsdf import SurfaceParams, view_albedo
 from .lights import emitted_radiance
-from .sampling import orthonormal_basis
+from .sampling import barycentric, dot, orthonormal_basis
 from .textures import apply_texture
 
 PARAM_FIELDS = ("diffuse", "f0", "f0_dielectric", "alpha", "p_spec", "spec_on")
-
-
-def _rows_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
-
-
-def interpolate(corners: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
-    """Barycentric interpolation of per-corner values (n, 3, c) at (b1, b2) -> (n, c)."""
-    b0 = (1.0 - b1 - b2)[:, None]
-    return corners[:, 0] * b0 + corners[:, 1] * b1[:, None] + corners[:, 2] * b2[:, None]
 
 
 class Surface:
@@ -36,15 +26,15 @@ class Surface:
         self.b1, self.b2 = u, v
         self.p = (o + d * t[:, None]).astype(np.float32)
         ng = ctx.geom_ng[prim]
-        ns = interpolate(geom.normals[prim], u, v)
-        ln = np.sqrt(_rows_dot(ns, ns))
+        ns = barycentric(geom.normals[prim], u, v)
+        ln = np.sqrt(dot(ns, ns))
         ns /= np.maximum(ln, 1e-12)[:, None]
         bad = ~np.isfinite(ln) | (ln < 0.5)
         if bad.any():
             ns[bad] = ng[bad]
         # shading normal on the geometric normal's side, both facing the incoming ray
-        s_ns = np.where(_rows_dot(ns, ng) < 0, -1.0, 1.0).astype(np.float32)
-        s_ng = np.where(_rows_dot(ng, d) > 0, -1.0, 1.0).astype(np.float32)
+        s_ns = np.where(dot(ns, ng) < 0, -1.0, 1.0).astype(np.float32)
+        s_ng = np.where(dot(ng, d) > 0, -1.0, 1.0).astype(np.float32)
         self.ng = ng * s_ng[:, None]
         self.ns = ns * (s_ns * s_ng)[:, None]
         self.wo = -d
@@ -54,7 +44,7 @@ class Surface:
         if geom.uvs is not None:
             textured = np.flatnonzero(mats.base_tex[mat] >= 0)
             if textured.size:  # re-derive the parameters where a texture drives the base colour
-                uv = interpolate(geom.uvs[prim[textured]], u[textured], v[textured])
+                uv = barycentric(geom.uvs[prim[textured]], u[textured], v[textured])
                 tm = mat[textured]
                 base = apply_texture(mats.base_color[tm], mats.base_tex[tm], uv, mats.textures)
                 sub = SurfaceParams.from_material(base, mats.metallic[tm], mats.roughness[tm], mats.f0[tm])
@@ -63,12 +53,13 @@ class Surface:
         self.t, self.bt = orthonormal_basis(self.ns)
         wo = self.wo
         wo_l = np.empty_like(wo)
-        wo_l[:, 0] = _rows_dot(wo, self.t)
-        wo_l[:, 1] = _rows_dot(wo, self.bt)
+        wo_l[:, 0] = dot(wo, self.t)
+        wo_l[:, 1] = dot(wo, self.bt)
         # view vectors below the shading hemisphere (shading-normal artefact): bend to the horizon
-        wo_l[:, 2] = np.maximum(_rows_dot(wo, self.ns), 1e-4)
-        wo_l /= np.sqrt(_rows_dot(wo_l, wo_l))[:, None]
+        wo_l[:, 2] = np.maximum(dot(wo, self.ns), 1e-4)
+        wo_l /= np.sqrt(dot(wo_l, wo_l))[:, None]
         self.wo_l = wo_l
+        self.albedo = view_albedo(self.params, wo_l)  # GGX directional albedo toward the viewer, once per hit
 
     def __len__(self) -> int:
         return len(self.p)
@@ -80,7 +71,7 @@ class Surface:
     def take(self, rows) -> "Surface":
         """The surfaces ``rows`` (an index array or a slice) as a new Surface."""
         out = Surface.__new__(Surface)
-        for name in ("prim", "b1", "b2", "p", "ng", "ns", "wo", "mat", "t", "bt", "wo_l"):
+        for name in ("prim", "b1", "b2", "p", "ng", "ns", "wo", "mat", "t", "bt", "wo_l", "albedo"):
             setattr(out, name, getattr(self, name)[rows])
         out.params = self.params.take(rows)
         return out

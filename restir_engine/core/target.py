@@ -65,7 +65,7 @@ class ShadingTerms:
         packed[LAYOUT["p_spec"]] = prm.p_spec
         packed[LAYOUT["alpha"]] = prm.alpha
         packed[LAYOUT["alpha2"]] = prm.alpha * prm.alpha
-        e = view_albedo(prm, wl)
+        e = surf.albedo if getattr(surf, "albedo", None) is not None else view_albedo(prm, wl)
         comp = 1.0 + prm.f0 * ((1.0 - e) / e)[:, None]
         packed[LAYOUT["a"]] = (prm.f0 * comp * LUM).T
         packed[LAYOUT["b"]] = ((1.0 - prm.f0) * comp * LUM).T
@@ -208,9 +208,13 @@ class FramePoints:
         self.spot_tri = pts.spot_tri if pts.has_spots else None
         self.lamps = lights.scene.lamps
 
+    def points(self, q) -> PackedPoints:
+        """Points of reservoirs ``q`` (index array or slice), spot cones not applied."""
+        return PackedPoints.of(np.take(self.rows, q, axis=1) if not isinstance(q, slice) else self.rows[:, q])
+
     def at(self, q, receivers: np.ndarray) -> PackedPoints:
         """Points of reservoirs ``q`` as seen from receivers ((3, n); spot cones applied)."""
-        pts = PackedPoints.of(np.take(self.rows, q, axis=1) if not isinstance(q, slice) else self.rows[:, q])
+        pts = self.points(q)
         if self.spot_tri is not None:
             pts = with_spots(pts, self.spot_tri[q], self.lamps, receivers)
         return pts

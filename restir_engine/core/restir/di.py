@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..accel import offset_origin, shadow_rays
-from ..bsdf import eval_bsdf, luminance, sample_bsdf, view_albedo
+from ..bsdf import eval_bsdf, luminance, sample_bsdf
 from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
-from ..sampling import dot, to_local, to_world
+from ..sampling import dot, row_max, to_local, to_world
 from ..target import FramePoints, with_spots
 from .reservoir import Reservoirs, Stream
 
@@ -64,8 +64,20 @@ class LightSpace:
         return FramePoints(self.lights, res.light, res.b1, res.b2)
 
     @staticmethod
-    def target(terms, prepared: FramePoints, idx) -> np.ndarray:
-        return terms.evaluate(prepared.at(idx, terms.p), want_pdf=False)[0]
+    def gather(prepared: FramePoints, idx):
+        """The samples ``idx`` of ``prepared``, to be evaluated at any surfaces (spot cones applied then)."""
+        return prepared.points(idx), (None if prepared.spot_tri is None else prepared.spot_tri[idx])
+
+    def evaluate(self, terms, gathered) -> np.ndarray:
+        """p̂ (n,) of gathered samples at surfaces ``terms``."""
+        pts, spot_tri = gathered
+        if spot_tri is not None:
+            pts = with_spots(pts, spot_tri, self.lights.scene.lamps, terms.p)
+        return terms.evaluate(pts, want_pdf=False)[0]
+
+    def target(self, terms, prepared: FramePoints, idx) -> np.ndarray:
+        """p̂ (n,) of samples ``idx`` of ``prepared`` at surfaces ``terms``."""
+        return self.evaluate(terms, self.gather(prepared, idx))
 
 
 @dataclass
@@ -148,7 +160,7 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     lamps = ctx.scene.lamps
     for j in range(max(m_b, 1 if keep_bsdf_ray else 0)):
         u = rng.random((n, 3), dtype=np.float32)
-        wi_l, f, p_b = sample_bsdf(surf.params, surf.wo_l, u[:, 0], u[:, 1], u[:, 2])
+        wi_l, f, p_b = sample_bsdf(surf.params, surf.wo_l, u[:, 0], u[:, 1], u[:, 2], surf.albedo)
         wi = to_world(wi_l, surf.ns, surf.t, surf.bt).astype(np.float32)
         wi /= np.maximum(np.sqrt(dot(wi, wi)), 1e-12)[:, None]
         live = np.flatnonzero((p_b > 0) & (dot(wi, surf.ng) > 0))
@@ -186,7 +198,7 @@ def shading_value(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l:
     """Target p̂ (n,), f (n, 3), geometry term G (n,) and the BSDF pdf in area measure (n,) of light points
     in directions wi (world) at distances dist (the exact RGB model of bsdf.py)."""
     wi_l = to_local(wi, surf.ns, surf.t, surf.bt)
-    f, pdf_b = eval_bsdf(surf.params, surf.wo_l, wi_l, view_albedo(surf.params, surf.wo_l))
+    f, pdf_b = eval_bsdf(surf.params, surf.wo_l, wi_l, getattr(surf, "albedo", None))
     ok = (dot(wi, surf.ng) > 0) & (dist > 0)
     to_area = np.abs(cos_l) / np.maximum(dist * dist, 1e-30)
     g = np.abs(wi_l[:, 2]) * to_area
@@ -207,16 +219,16 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
         q, wi, dist, cos_l, le = lights.point_towards(res.light[live], res.b1[live], res.b2[live], sub.p)
         _p, f, g, _pb = shading_value(sub, wi, le, dist, cos_l)
         contrib = f * le * (g * res.W[live])[:, None]
-        go = np.flatnonzero(contrib.max(axis=1) > 0)
+        go = np.flatnonzero(row_max(contrib) > 0)
         if go.size:
             rays.append((live[go], contrib[go], *shadow_rays(sub.p[go], sub.ng[go], q[go], wi[go], dist[go])))
     if lights.sun_alias is not None:
         ls = lights.sample_suns(n, rng.random((n, 4), dtype=np.float32))
         wi_l = to_local(ls.wi, surf.ns, surf.t, surf.bt)
-        f, _pb = eval_bsdf(surf.params, surf.wo_l, wi_l)
+        f, _pb = eval_bsdf(surf.params, surf.wo_l, wi_l, surf.albedo)
         ok = (dot(ls.wi, surf.ng) > 0) & (ls.pdf > 0)
         contrib = f * ls.le * (np.abs(wi_l[:, 2]) / np.maximum(ls.pdf, 1e-30) * ok)[:, None]
-        go = np.flatnonzero(contrib.max(axis=1) > 0)
+        go = np.flatnonzero(row_max(contrib) > 0)
         if go.size:
             rays.append((go, contrib[go], *shadow_rays(surf.p[go], surf.ng[go], ls.pos[go], ls.wi[go], ls.dist[go])))
     if rays:

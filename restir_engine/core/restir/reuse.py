@@ -5,7 +5,9 @@ spatial reuse with up to k similar neighbours of the same frame, temporal reuse 
 surface had in the previous frame. The sample type enters through a *space* object:
   space.kind                          the Reservoirs subclass
   space.prepare(res)                  per-frame data for gathers of the samples of ``res``
-  space.target(terms, prepared, idx)  p̂ (n,) of samples ``idx`` of ``prepared`` at surfaces ``terms``
+  space.gather(prepared, idx)         samples ``idx`` of ``prepared``, evaluable at any surfaces
+  space.evaluate(terms, gathered)     p̂ (n,) of gathered samples at surfaces ``terms``
+  space.target(terms, prepared, idx)  both in one
   space.jacobian (optional)           shift Jacobians; DI samples live in area measure: none is needed
 
 Merges (one code path, :func:`merge`):
@@ -138,6 +140,7 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
     px, py = pix % gb.width, pix // gb.width
     offs = neighbor_offsets(cfg.neighbors, cfg.radius, rng, n)
     canonical = res.take(rows)
+    own = space.gather(prepared, rows) if unbiased else None
     neighbours, taken = [], []
     for k in range(cfg.neighbors):
         qx = np.round(px + offs[:, k, 0]).astype(np.int64)
@@ -161,16 +164,17 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
         pc = np.where(ok & res.has_sample()[q], space.target(me, prepared, q), np.float32(0.0))
         pq = None
         if unbiased:
-            pq = np.where(ok & canonical.has_sample(), space.target(gb.terms.take(q), prepared, rows),
-                          np.float32(0.0))
+            pq = np.where(ok & canonical.has_sample(), space.evaluate(gb.terms.take(q), own), np.float32(0.0))
         neighbours.append(Neighbour(res, q, ok, m_q, pc, pq))
     return merge(canonical, neighbours, cfg.bias_correction, rng)
 
 
-def temporal_reuse(space, gb, res: Reservoirs, hist, prepared_prev, rows: np.ndarray, confidence_cap: float,
-                   bias_correction: str, motion, rng: np.random.Generator, possible_before=None) -> Reservoirs:
-    """Merge the reservoirs of surfaces ``rows`` with the reservoir each surface had in the previous frame
-    (``hist``: restir.history.TemporalHistory, its reservoirs prepared as ``prepared_prev``).
+def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev, rows: np.ndarray,
+                   confidence_cap: float, bias_correction: str, motion, rng: np.random.Generator,
+                   possible_before=None) -> Reservoirs:
+    """Merge the reservoirs of surfaces ``rows`` (of ``res``, prepared as ``prepared_now``) with the reservoir
+    each surface had in the previous frame (``hist``: restir.history.TemporalHistory, its reservoirs prepared
+    as ``prepared_prev``).
 
     The hit is moved with its object's previous transform (``motion``: scene.Motion, or None when the
     history is not from the previous frame) and projected with the previous camera; the match must pass the
@@ -206,7 +210,7 @@ def temporal_reuse(space, gb, res: Reservoirs, hist, prepared_prev, rows: np.nda
         pq = np.zeros(n, np.float32)
         both = ok & canonical.has_sample()
         if both.any():
-            pq = space.target(prev_gb.terms.take(q), space.prepare(canonical), np.arange(n))
+            pq = space.evaluate(prev_gb.terms.take(q), space.gather(prepared_now, rows))
             if possible_before is not None:
                 pq = np.where(possible_before(rows), pq, 0.0)
             pq = np.where(both, pq, np.float32(0.0)).astype(np.float32)
