@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .sampling import cosine_hemisphere, dot, norm
+from .sampling import cosine_hemisphere, dot
 
 ALPHA_MIN = 1e-3
 INV_PI = np.float32(1.0 / np.pi)

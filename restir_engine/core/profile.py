@@ -46,16 +46,6 @@ class StageClock:
             rec["embree"] += embree_seconds() - e0
             rec["calls"] += 1
 
-    def merged(self, other: "StageClock") -> "StageClock":
-        """A clock holding both clocks' sums."""
-        out = StageClock()
-        for clock in (self, other):
-            for name, rec in clock.stages.items():
-                acc = out.stages.setdefault(name, {"wall": 0.0, "cpu": 0.0, "embree": 0.0, "calls": 0})
-                for k in acc:
-                    acc[k] += rec[k]
-        return out
-
 
 class NullClock(StageClock):
     """A clock that times nothing (the default)."""

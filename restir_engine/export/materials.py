@@ -26,14 +26,6 @@ def uses_nodes(idblock) -> bool:
     return True if bpy.app.version >= (5, 0, 0) else bool(idblock.use_nodes)
 
 
-def _value(socket, default):
-    v = getattr(socket, "default_value", default)
-    try:
-        return tuple(v)[:3]
-    except TypeError:
-        return float(v)
-
-
 class MaterialRegistry:
     """Assigns table indices to Blender materials (index 0 is Blender's default grey) and
     collects textures; reports approximations through ``warnings``."""
@@ -44,7 +36,6 @@ class MaterialRegistry:
         self.index: dict = {}
         self.textures: list[np.ndarray] = []
         self.texture_index: dict = {}
-        self.needs_uv = False
 
     # -- public -------------------------------------------------------------------------
     def material_index(self, material) -> int:
@@ -94,7 +85,6 @@ class MaterialRegistry:
             if node.inputs["Vector"].is_linked:
                 self._warn(material, f"'{node.name}' has a mapped vector input; the active UV map is used instead")
             row[key_tex] = self._texture(material, node.image)
-            self.needs_uv = True
             return (1.0, 1.0, 1.0)
         if node.type == "RGB":
             return tuple(node.outputs[0].default_value[:3])
