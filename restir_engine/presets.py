@@ -4,18 +4,20 @@ from __future__ import annotations
 import bpy
 from bpy.props import EnumProperty
 
+from .core.restir.reuse import SpatialSettings, TemporalSettings
+
 PRESETS = {
     "FAST": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 4, "light_candidates": 8,
-             "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 3,
-             "preroll_frames": 2, "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE",
+             "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": TemporalSettings.confidence_cap, "spatial_neighbors": 3,
+             "preroll_frames": 2, "spatial_radius": SpatialSettings.radius, "spatial_passes": 1, "bias_correction": "NONE",
              "light_tiles": "AUTO", "boiling_filter": True},
     "BALANCED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
-                 "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 5,
-                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "NONE", "light_tiles": "AUTO",
+                 "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": TemporalSettings.confidence_cap, "spatial_neighbors": 5,
+                 "spatial_radius": SpatialSettings.radius, "spatial_passes": 1, "bias_correction": "NONE", "light_tiles": "AUTO",
                  "boiling_filter": False},
     "UNBIASED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
-                 "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": 20.0, "spatial_neighbors": 5,
-                 "spatial_radius": 30.0, "spatial_passes": 1, "bias_correction": "UNBIASED",
+                 "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": TemporalSettings.confidence_cap, "spatial_neighbors": 5,
+                 "spatial_radius": SpatialSettings.radius, "spatial_passes": 1, "bias_correction": "UNBIASED",
                  "light_tiles": "AUTO", "boiling_filter": False},
     "REFERENCE": {"integrator": "PATH", "samples": 256},
 }

@@ -4,6 +4,11 @@ from __future__ import annotations
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
+from .core.boiling import THRESHOLD as BOILING_THRESHOLD
+from .core.light_tiles import TileSettings
+from .core.restir.di import CandidateSettings
+from .core.restir.reuse import SpatialSettings, TemporalSettings
+
 
 def _update_passes(self, context):
     """Pass toggles change the render result layout: ask Blender to re-query the pass list."""
@@ -31,9 +36,9 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                 "and of neighbouring pixels' (spatial)", 2)],
         default="RESTIR", update=_update_passes)
     light_candidates: IntProperty(name="Light Candidates", description="Light samples per pixel resampled by RIS",
-                                  default=32, min=0, soft_max=256)
+                                  default=CandidateSettings.light_candidates, min=0, soft_max=256)
     bsdf_candidates: IntProperty(name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",
-                                 default=1, min=0, soft_max=8)
+                                 default=CandidateSettings.bsdf_candidates, min=0, soft_max=8)
     light_tiles: EnumProperty(
         name="Light Tiles",
         description="Draw light candidates from small presampled tiles of light points (one tile per 16x16 "
@@ -43,10 +48,10 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                 "eight times (any image larger than about 180x180 at 32 candidates)", 0),
                ("ON", "On", "Always draw candidates from tiles", 1),
                ("OFF", "Off", "Draw every candidate from the full light table", 2)],
-        default="AUTO")
-    light_tile_count: IntProperty(name="Tiles", description="Light tiles drawn per sample pass", default=128,
+        default=TileSettings.mode)
+    light_tile_count: IntProperty(name="Tiles", description="Light tiles drawn per sample pass", default=TileSettings.count,
                                   min=1, soft_max=1024)
-    light_tile_size: IntProperty(name="Tile Size", description="Light points per tile", default=1024, min=1,
+    light_tile_size: IntProperty(name="Tile Size", description="Light points per tile", default=TileSettings.size, min=1,
                                  soft_max=8192)
     temporal_reuse: BoolProperty(name="Temporal Reuse", description="Reuse the reservoir the pixel's surface had "
                                  "in the previous frame of an animation (through each frame's first sample pass; "
@@ -57,27 +62,27 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                                 "sample pass of this many frames before it, unsaved: the chunk then matches a "
                                 "sequential render exactly", default=3, min=0, soft_max=16)
     confidence_cap: FloatProperty(name="Confidence Cap", description="Largest confidence M a reused reservoir keeps",
-                                  default=20.0, min=1.0, soft_max=100.0)
+                                  default=TemporalSettings.confidence_cap, min=1.0, soft_max=100.0)
     spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring reservoirs merged per spatial pass",
-                                   default=5, min=0, soft_max=16)
-    spatial_radius: FloatProperty(name="Radius", description="Spatial reuse radius in pixels", default=30.0,
+                                   default=SpatialSettings.neighbors, min=0, soft_max=16)
+    spatial_radius: FloatProperty(name="Radius", description="Spatial reuse radius in pixels", default=SpatialSettings.radius,
                                   min=1.0, soft_max=100.0, subtype="PIXEL")
     spatial_passes: IntProperty(name="Passes", description="Spatial reuse passes (more passes add correlation)",
-                                default=1, min=0, soft_max=4)
+                                default=SpatialSettings.passes, min=0, soft_max=4)
     bias_correction: EnumProperty(
         name="Bias Correction",
         description="How merged reservoirs are normalized",
         items=[("NONE", "None (1/M)", "Fastest; darkens where neighbours could not have produced the sample", 0),
                ("UNBIASED", "Unbiased (pairwise MIS)", "Pairwise MIS weights with confidences: converges to the "
                 "path tracer and Cycles, robust where neighbours' targets differ; two target evaluations per neighbour", 1)],
-        default="UNBIASED")
+        default=SpatialSettings.bias_correction)
     boiling_filter: BoolProperty(
         name="Boiling Filter", description="With bias correction None: empty reservoirs whose contribution is "
         "far above their 16x16 pixel block's mean, so a rare bright sample does not spread into blotches over "
         "neighbours and frames. Biased (darker); never used by the unbiased mode", default=False)
     boiling_threshold: FloatProperty(
         name="Threshold", description="A reservoir is emptied when its contribution exceeds this many times its "
-        "block's mean (lower filters more)", default=20.0, min=1.5, soft_max=100.0)
+        "block's mean (lower filters more)", default=BOILING_THRESHOLD, min=1.5, soft_max=100.0)
     samples: IntProperty(name="Samples", description="Iterations averaged per frame", default=16, min=1,
                          soft_max=4096)
     seed: IntProperty(name="Seed", description="Noise pattern; different seeds give independent noise", default=0,

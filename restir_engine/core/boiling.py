@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 BLOCK = 16  # pixels: the neighbourhood whose mean weight an outlier is compared with
+THRESHOLD = 20.0  # default: x the block mean
 
 
 def boiling_filter(res, pixels: np.ndarray, width: int, height: int, threshold: float) -> np.ndarray:

@@ -25,6 +25,7 @@ import numpy as np
 from . import camera as camera_mod
 from . import pathtracer
 from .accel import pool
+from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
 from .context_cache import context_for
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
@@ -64,9 +65,9 @@ class RenderSettings:
     spatial_passes: int = reuse.SpatialSettings.passes
     bias_correction: str = reuse.SpatialSettings.bias_correction  # "NONE" (1/M) or "UNBIASED" (pairwise MIS)
     temporal_reuse: bool = True  # ReSTIR: pass 0 of a frame reuses pass 0 of the previous frame (history)
-    confidence_cap: float = 20.0
+    confidence_cap: float = reuse.TemporalSettings.confidence_cap
     boiling_filter: bool = False  # bias_correction NONE only: drop reservoirs far above their block's mean
-    boiling_threshold: float = 20.0  # x the 16x16 block's mean p̂·W (core.boiling)
+    boiling_threshold: float = BOILING_THRESHOLD  # x the 16x16 block's mean p̂·W (core.boiling)
     light_tiles: str = TileSettings.mode  # light candidates from presampled tiles: "AUTO", "ON", "OFF"
     light_tile_count: int = TileSettings.count
     light_tile_size: int = TileSettings.size

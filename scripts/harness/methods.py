@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from restir_engine.core.restir.reuse import SpatialSettings
+
 
 @dataclass(frozen=True)
 class Method:
@@ -64,5 +66,6 @@ def settings_for(method: Method, width: int) -> dict:
     is the 30 px default at 640 px and above, scaled down with the width (at least 6 px) below."""
     out = dict(method.settings)
     if out.get("direct_method") == "RESTIR" and "spatial_radius" not in out:
-        out["spatial_radius"] = float(max(6.0, min(30.0, 30.0 * width / 640)))
+        default = SpatialSettings.radius
+        out["spatial_radius"] = float(max(6.0, min(default, default * width / 640)))
     return out

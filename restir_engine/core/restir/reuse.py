@@ -119,6 +119,14 @@ def merge(canonical: Reservoirs, neighbours: list, bias_correction: str, rng: np
 
 
 @dataclass
+class TemporalSettings:
+    """confidence_cap: the largest confidence M a reused reservoir keeps (as a multiple of the current M
+    when merged; absolute in the history)."""
+
+    confidence_cap: float = 20.0
+
+
+@dataclass
 class SpatialSettings:
     """neighbors per pass, radius in pixels (of the full render width), passes, bias correction."""
 
