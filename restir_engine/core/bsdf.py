@@ -45,6 +45,9 @@ class SurfaceParams:
     spec_on: np.ndarray
 
     def take(self, rows: np.ndarray) -> "SurfaceParams":
+        if isinstance(rows, np.ndarray) and rows.dtype != bool:
+            return SurfaceParams(np.take(self.diffuse, rows, axis=0), np.take(self.f0, rows, axis=0),
+                                 self.f0_dielectric[rows], self.alpha[rows], self.p_spec[rows], self.spec_on[rows])
         return SurfaceParams(self.diffuse[rows], self.f0[rows], self.f0_dielectric[rows], self.alpha[rows],
                              self.p_spec[rows], self.spec_on[rows])
 
@@ -134,6 +137,29 @@ def ggx_albedo(alpha: np.ndarray, mu: np.ndarray) -> np.ndarray:
     fx, fy = (x - x0).astype(np.float32), (y - y0).astype(np.float32)
     return ((t[x0, y0] * (1 - fy) + t[x0, y0 + 1] * fy) * (1 - fx)
             + (t[x0 + 1, y0] * (1 - fy) + t[x0 + 1, y0 + 1] * fy) * fx)
+
+
+def ggx_albedo_rows(alpha: np.ndarray) -> np.ndarray:
+    """The table interpolated at fixed roughnesses α (m,) -> (m, 32) rows over μo (materials' α is constant,
+    so a hit's albedo is then one linear interpolation in μo: :func:`ggx_albedo_at`)."""
+    t = ggx_albedo_table()
+    n = _TABLE_N
+    x = np.clip((np.asarray(alpha, np.float32) - ALPHA_MIN) / (1.0 - ALPHA_MIN) * (n - 1), 0, n - 1)
+    x0 = np.minimum(x.astype(np.int64), n - 2)
+    fx = (x - x0).astype(np.float32)[:, None]
+    return (t[x0] * (1 - fx) + t[x0 + 1] * fx).astype(np.float32)
+
+
+def ggx_albedo_at(rows: np.ndarray, index: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """E(μo) (n,) from rows of :func:`ggx_albedo_rows` (row ``index`` per point): equals :func:`ggx_albedo`
+    at that row's α to float32 rounding."""
+    n = _TABLE_N
+    y = np.clip((mu - np.float32(1.0 / 64)) * np.float32((n - 1) / (1.0 - 1.0 / 64)), 0, n - 1)
+    y0 = np.minimum(y.astype(np.intp), n - 2)
+    fy = y - y0
+    k = index * n + y0
+    flat = rows.reshape(-1)
+    return flat[k] * (1 - fy) + flat[k + 1] * fy
 
 
 def smith_lambda(alpha, cos):

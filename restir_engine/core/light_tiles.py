@@ -83,9 +83,9 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> L
         z3 = np.zeros((n, 3), np.float32)
         return LightPoints(np.full(n, -1, np.int32), np.zeros(n, np.float32), np.zeros(n, np.float32), z3, z3.copy(),
                            z3.copy(), np.zeros(n, np.float32), np.zeros(n, bool), np.full(n, -1, np.int32))
-    pos = barycentric(lights.tri_verts[light], b1, b2).astype(np.float32)
+    pos = barycentric(np.take(lights.tri_verts, light, axis=0), b1, b2).astype(np.float32)
     le = lights.radiance_of(light, b1, b2, None)
-    return LightPoints(light, b1.astype(np.float32), b2.astype(np.float32), pos, lights.tri_normal[light], le,
+    return LightPoints(light, b1.astype(np.float32), b2.astype(np.float32), pos, np.take(lights.tri_normal, light, axis=0), le,
                        lights.tri_only_pdf_area(light), lights.tri_two_sided[light], lights.spot_lamp_tri(light))
 
 

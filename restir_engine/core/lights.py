@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bsdf import luminance
-from .sampling import AliasTable, barycentric, dot, norm, orthonormal_basis, row_max, uniform_triangle
+from .sampling import AliasTable, barycentric, dot, norm, orthonormal_basis, row_max, take_rows, uniform_triangle
 from .scene import Lamps, MaterialTable, Scene, TriangleSet
 from .textures import apply_texture, mean_color
 
@@ -29,7 +29,7 @@ def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarra
                      b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
     """Emitted radiance (n, 3), W·sr⁻¹·m⁻², at barycentrics (b1, b2) of triangles ``tri``."""
     mat = tris.material[tri]
-    le = materials.emission[mat]
+    le = take_rows(materials.emission, mat)
     if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
         uv = barycentric(tris.uvs[tri], b1, b2)
         le = apply_texture(le, materials.emit_tex[mat], uv, materials.textures)
@@ -110,6 +110,12 @@ class LightTable:
         # separate tables for ReSTIR: triangle lights are resampled, suns are light-sampled on their own
         self.tri_alias = AliasTable(power[:self.n_tri]) if (power[:self.n_tri] > 0).any() else None
         self.sun_alias = AliasTable(power[self.n_tri:]) if (power[self.n_tri:] > 0).any() else None
+        # float32 per-light pdfs in area measure (m⁻²): selection by ``alias`` (all lights) or ``tri_alias``
+        area = np.maximum(self.tri_area, 1e-30)
+        self.sel_pdf_area = (self.alias.pdf[:self.n_tri] / area).astype(np.float32) if self.alias is not None \
+            else np.zeros(self.n_tri, np.float32)
+        self.tri_pdf_area = (self.tri_alias.pdf / area).astype(np.float32) if self.tri_alias is not None \
+            else np.zeros(self.n_tri, np.float32)
         self.scene = scene
         # stable ids across frames: scene triangle index, or len(scene triangles) + lamp triangle index
         self.light_uid = np.concatenate([g_idx, len(geom) + l_idx]).astype(np.int64)
@@ -122,36 +128,41 @@ class LightTable:
 
     def tri_pdf_solid_angle(self, light: np.ndarray, dist: np.ndarray, cos_light: np.ndarray) -> np.ndarray:
         """Solid-angle pdf with which :meth:`sample` would pick this point of triangle light ``light``."""
-        if self.alias is None:
-            return np.zeros(len(light), np.float32)
-        p_sel = self.alias.pdf[light]
-        area = np.maximum(self.tri_area[light], 1e-30)
-        return (p_sel / area * dist * dist / np.maximum(np.abs(cos_light), 1e-8)).astype(np.float32)
+        return self.sel_pdf_area[light] * (dist * dist / np.maximum(np.abs(cos_light), np.float32(1e-8)))
+
+    def triangle_points(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, p: np.ndarray):
+        """Points (b1, b2) of triangle lights ``light`` as light samples for receivers p (n, 3): position,
+        unit direction from p, distance, cos at the light, radiance arriving at p (zero from a back face of a
+        one-sided emitter, spot cones applied) and the solid-angle pdf of :meth:`sample` (0 where no light
+        arrives)."""
+        q, w, dl, cos_l, rad = self.point_towards(light, b1, b2, p)
+        pd = self.tri_pdf_solid_angle(light, dl, cos_l)
+        ok = (row_max(rad) > 0) & np.isfinite(pd)
+        return q, w, dl, cos_l, np.where(ok[:, None], rad, np.float32(0.0)), np.where(ok, pd, np.float32(0.0))
 
     def point_towards(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, p: np.ndarray):
         """Triangle light ``light`` at barycentrics (b1, b2) seen from points p (n, 3): the light point
         (n, 3), unit direction wi from p (n, 3), distance (n,), cos at the light (n,) and the radiance
         arriving at p (n, 3) (zero from a back face of a one-sided emitter, spot cones applied)."""
-        q = barycentric(self.tri_verts[light], b1, b2)
+        q = barycentric(take_rows(self.tri_verts, light), b1, b2)
         d = q - p
         dl = norm(d)
-        w = d / np.maximum(dl, 1e-30)[:, None]
-        cos_l = -dot(w, self.tri_normal[light])
+        w = d / np.maximum(dl, np.float32(1e-30))[:, None]
+        cos_l = -dot(w, take_rows(self.tri_normal, light))
         facing = ((cos_l > 0) | self.tri_two_sided[light]) & (dl > 0) & (np.abs(cos_l) > 1e-8)
-        le = np.where(facing[:, None], self.radiance_of(light, b1, b2, p), 0.0).astype(np.float32)
-        return q.astype(np.float32), w.astype(np.float32), dl.astype(np.float32), cos_l.astype(np.float32), le
+        le = self.radiance_of(light, b1, b2, p)
+        le *= facing[:, None]
+        return q, w, dl, cos_l, le
 
     def tri_only_pdf_area(self, light: np.ndarray) -> np.ndarray:
         """Area-measure pdf (m⁻²) of a uniform point of triangle light ``light`` chosen by ``tri_alias``."""
-        if self.tri_alias is None:
-            return np.zeros(len(light), np.float32)
-        return (self.tri_alias.pdf[light] / np.maximum(self.tri_area[light], 1e-30)).astype(np.float32)
+        return self.tri_pdf_area[light]
 
     def radiance_of(self, light: np.ndarray, b1, b2, p_receiver: np.ndarray) -> np.ndarray:
         """Radiance (n, 3) leaving triangle light ``light`` at (b1, b2) towards p_receiver,
         before the sidedness test (spot cones included unless p_receiver is None)."""
         scene = self.scene
-        out = self.tri_le[light]
+        out = take_rows(self.tri_le, light)
         if self.any_textured:
             tex = np.flatnonzero(self.tri_textured[light])
             if tex.size:
@@ -190,18 +201,14 @@ class LightTable:
         if self.alias is None or n == 0:
             return out
         light = self.alias.sample(u[:, 0], u[:, 1])
+        if self.n_sun == 0:  # triangle lights only: no row selections
+            b1, b2 = uniform_triangle(u[:, 2], u[:, 3])
+            out.pos, out.wi, out.dist, _cos, out.le, out.pdf = self.triangle_points(light, b1, b2, p)
+            return out
         tri = light < self.n_tri
         if tri.any():
-            li = light[tri]
             b1, b2 = uniform_triangle(u[tri, 2], u[tri, 3])
-            q, w, dl, cos_l, rad = self.point_towards(li, b1, b2, p[tri])
-            pd = self.tri_pdf_solid_angle(li, dl, cos_l)
-            ok = (row_max(rad) > 0) & np.isfinite(pd)
-            pos[tri] = q
-            wi[tri] = w
-            dist[tri] = dl
-            le[tri] = np.where(ok[:, None], rad, 0.0)
-            pdf[tri] = np.where(ok, pd, 0.0)
+            pos[tri], wi[tri], dist[tri], _cos, le[tri], pdf[tri] = self.triangle_points(light[tri], b1, b2, p[tri])
         sun = ~tri
         if sun.any():
             self._sun_sample(light[sun] - self.n_tri, self.alias.pdf[light[sun]], u[sun], sun, wi, dist, le, pdf, delta)

@@ -23,9 +23,9 @@ import numpy as np
 
 from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
-from .bsdf import SurfaceParams, eval_bsdf, sample_bsdf
+from .bsdf import SurfaceParams, eval_bsdf, ggx_albedo_rows, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
-from .sampling import dot, norm, row_max, rows_finite, to_local, to_world
+from .sampling import dot, norm, row_max, rows_finite, take_rows, to_local, to_world
 from .scene import Scene
 from .surface import Surface
 
@@ -42,6 +42,8 @@ class TraceContext:
     lamp_ng: np.ndarray
     material_params: SurfaceParams  # per material, untextured (gathered per hit)
     max_bounces: int
+    material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α (bsdf.ggx_albedo_rows)
+    geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     rr_start: int = 3
     film_transparent: bool = False
 
@@ -60,10 +62,10 @@ def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
     solid-angle light pdf of that point for MIS."""
     prim = lh.prim[sel]
     t = lh.t[sel]
-    cos_l = -dot(d[sel], ctx.lamp_ng[prim])
+    cos_l = -dot(take_rows(d, sel), take_rows(ctx.lamp_ng, prim))
     lamps = ctx.scene.lamps
     le = emitted_radiance(lamps.tris, ctx.scene.materials, prim, lh.u[sel], lh.v[sel])
-    le *= spot_factor(lamps, prim, o[sel])[:, None]
+    le *= spot_factor(lamps, prim, take_rows(o, sel))[:, None]
     le = np.where((cos_l > 0)[:, None], le, 0.0)
     light = ctx.lights.lamp_to_light[prim]
     pdf = np.where(light >= 0, ctx.lights.tri_pdf_solid_angle(np.maximum(light, 0), t, cos_l), 0.0)
@@ -102,7 +104,8 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray) -> PrimaryHits:
     else:
         emitted[miss] += ctx.scene.world_radiance
     rows = np.flatnonzero(alive)
-    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], o[rows], d[rows], hits.t[rows])
+    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], take_rows(o, rows), take_rows(d, rows),
+                   hits.t[rows])
     emitted[rows] += surf.emission(ctx)
     return PrimaryHits(_sanitize(emitted), alpha, rows, surf)
 
@@ -123,9 +126,11 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         contrib *= throughput
     live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (row_max(contrib) > 0))
     if live.size:
-        so, sd, far = shadow_rays(s.p[live], s.ng[live], ls.pos[live], ls.wi[live], ls.dist[live])
+        so, sd, far = shadow_rays(take_rows(s.p, live), take_rows(s.ng, live), take_rows(ls.pos, live),
+                                  take_rows(ls.wi, live), ls.dist[live])
         vis = ~ctx.geom_accel.occluded(so, sd, far)
-        out[live[vis]] = _sanitize(contrib[live[vis]])
+        lv = live[vis]
+        out[lv] = _sanitize(take_rows(contrib, lv))
     return out
 
 
@@ -161,9 +166,9 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             wi = to_world(wi_l, s.ns, s.t, s.bt)
             wi /= np.maximum(norm(wi), 1e-12)[:, None]
             rows = np.flatnonzero((pdf > 0) & (dot(wi, s.ng) > 0))
-            wi_l, f, pdf = wi_l[rows], f[rows], pdf[rows]
-            o, d, hits = offset_origin(s.p[rows], s.ng[rows], wi[rows]), wi[rows].astype(np.float32), None
-        thr = throughput[rows] * f * (wi_l[:, 2] / np.maximum(pdf, 1e-30))[:, None]
+            wi_l, f, pdf, d = take_rows(wi_l, rows), take_rows(f, rows), pdf[rows], take_rows(wi, rows)
+            o, hits = offset_origin(take_rows(s.p, rows), take_rows(s.ng, rows), d), None
+        thr = take_rows(throughput, rows) * f * (wi_l[:, 2] / np.maximum(pdf, 1e-30))[:, None]
         ok = rows_finite(thr)
         if bounce + 1 >= ctx.rr_start:
             q = np.clip(row_max(thr), 0.05, 1.0)
@@ -172,8 +177,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         keep = np.flatnonzero(ok)
         if keep.size == 0:
             break
-        idx, throughput, prev_pdf = idx[rows[keep]], thr[keep], pdf[keep]
-        o, d = o[keep], d[keep]
+        idx, throughput, prev_pdf = idx[rows[keep]], take_rows(thr, keep), pdf[keep]
+        o, d = take_rows(o, keep), take_rows(d, keep)
         if hits is None:
             hits = ctx.geom_accel.intersect(o, d)
         else:
@@ -186,11 +191,11 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             if sel.size:
                 le, pl = _lamp_emission(ctx, lh, o, d, sel)
                 w = power_heuristic(prev_pdf[sel], pl)
-                target[idx[sel]] += _sanitize(throughput[sel] * le * w[:, None])
+                target[idx[sel]] += _sanitize(take_rows(throughput, sel) * le * w[:, None])
         hit = hits.prim >= 0
         esc = np.flatnonzero(~hit)
         if esc.size:  # film transparency affects camera rays only
-            target[idx[esc]] += _sanitize(throughput[esc] * ctx.scene.world_radiance)
+            target[idx[esc]] += _sanitize(take_rows(throughput, esc) * ctx.scene.world_radiance)
         hsel = np.flatnonzero(hit)
         if hsel.size == 0:
             break
@@ -201,16 +206,16 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             if em.size:
                 hs = hsel[em]
                 le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
-                cos_l = -dot(d[hs], ctx.geom_ng[hp[em]])
+                cos_l = -dot(take_rows(d, hs), take_rows(ctx.geom_ng, hp[em]))
                 two = ctx.lights.tri_two_sided[light[em]]
                 le = np.where(((cos_l > 0) | two)[:, None], le, 0.0)
                 pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
                 w = power_heuristic(prev_pdf[hs], pl)
-                target[idx[hs]] += _sanitize(throughput[hs] * le * w[:, None])
+                target[idx[hs]] += _sanitize(take_rows(throughput, hs) * le * w[:, None])
         if bounce == ctx.max_bounces:
             break
-        idx, throughput = idx[hsel], throughput[hsel]
-        s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], o[hsel], d[hsel], hits.t[hsel])
+        idx, throughput = idx[hsel], take_rows(throughput, hsel)
+        s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], take_rows(o, hsel), take_rows(d, hsel), hits.t[hsel])
     return direct, indirect
 
 
@@ -252,9 +257,12 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     radius = float(np.linalg.norm(finite.max(0) - finite.min(0)) / 2) if len(finite) else 1.0
     geom_ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
     lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
+    params = SurfaceParams.from_material(scene.materials.base_color, scene.materials.metallic,
+                                         scene.materials.roughness, scene.materials.f0)
+    nrm = geom.normals
+    flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
     return TraceContext(scene=scene, geom_accel=Accel(geom.verts), lamp_accel=Accel(lamps.tris.verts),
                         lights=LightTable(scene, max(radius, 1e-3)), geom_ng=geom_ng, lamp_ng=lamp_ng,
-                        material_params=SurfaceParams.from_material(
-                            scene.materials.base_color, scene.materials.metallic, scene.materials.roughness,
-                            scene.materials.f0),
-                        max_bounces=int(max(0, max_bounces)), film_transparent=film_transparent)
+                        material_params=params, max_bounces=int(max(0, max_bounces)),
+                        film_transparent=film_transparent, material_albedo=ggx_albedo_rows(params.alpha),
+                        geom_flat=flat)

@@ -99,6 +99,12 @@ def cosine_hemisphere(u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=-1).astype(np.float32)
 
 
+def take_rows(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """a[idx] for an index array over the first axis of a multi-dimensional array (np.take: 3-4x faster than
+    fancy indexing of (n, 3) rows in NumPy 1.26)."""
+    return np.take(a, idx, axis=0)
+
+
 def norm(v: np.ndarray) -> np.ndarray:
     """Row lengths of (n, 3) vectors (column arithmetic: NumPy's reductions over a 3-wide axis are slow)."""
     return np.sqrt(dot(v, v))

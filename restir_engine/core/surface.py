@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import SurfaceParams, view_albedo
+from .bsdf import SurfaceParams, ggx_albedo_at
 from .lights import emitted_radiance
-from .sampling import barycentric, dot, orthonormal_basis
+from .sampling import barycentric, dot, orthonormal_basis, take_rows
 from .textures import apply_texture
 
 PARAM_FIELDS = ("diffuse", "f0", "f0_dielectric", "alpha", "p_spec", "spec_on")
@@ -22,11 +22,18 @@ class Surface:
     def __init__(self, ctx, prim, u, v, o, d, t):
         geom = ctx.scene.geometry
         mats = ctx.scene.materials
+        prim = prim.astype(np.intp)  # one index conversion for every gather below
         self.prim = prim
         self.b1, self.b2 = u, v
         self.p = (o + d * t[:, None]).astype(np.float32)
-        ng = ctx.geom_ng[prim]
-        ns = barycentric(geom.normals[prim], u, v)
+        ng = take_rows(ctx.geom_ng, prim)
+        smooth = np.flatnonzero(~ctx.geom_flat[prim])
+        if smooth.size == len(prim):
+            ns = barycentric(take_rows(geom.normals, prim), u, v)
+        else:  # flat-shaded triangles: the corner normal as it is
+            ns = take_rows(geom.normals, prim)[:, 0]
+            if smooth.size:
+                ns[smooth] = barycentric(take_rows(geom.normals, prim[smooth]), u[smooth], v[smooth])
         ln = np.sqrt(dot(ns, ns))
         ns /= np.maximum(ln, 1e-12)[:, None]
         bad = ~np.isfinite(ln) | (ln < 0.5)
@@ -38,7 +45,7 @@ class Surface:
         self.ng = ng * s_ng[:, None]
         self.ns = ns * (s_ns * s_ng)[:, None]
         self.wo = -d
-        mat = geom.material[prim]
+        mat = geom.material[prim].astype(np.intp)
         self.mat = mat
         self.params = ctx.material_params.take(mat)
         if geom.uvs is not None:
@@ -59,7 +66,8 @@ class Surface:
         wo_l[:, 2] = np.maximum(dot(wo, self.ns), 1e-4)
         wo_l /= np.sqrt(dot(wo_l, wo_l))[:, None]
         self.wo_l = wo_l
-        self.albedo = view_albedo(self.params, wo_l)  # GGX directional albedo toward the viewer, once per hit
+        # GGX directional albedo toward the viewer, once per hit (α is constant per material)
+        self.albedo = ggx_albedo_at(ctx.material_albedo, mat, wo_l[:, 2])
 
     def __len__(self) -> int:
         return len(self.p)
@@ -72,6 +80,7 @@ class Surface:
         """The surfaces ``rows`` (an index array or a slice) as a new Surface."""
         out = Surface.__new__(Surface)
         for name in ("prim", "b1", "b2", "p", "ng", "ns", "wo", "mat", "t", "bt", "wo_l", "albedo"):
-            setattr(out, name, getattr(self, name)[rows])
+            a = getattr(self, name)
+            setattr(out, name, take_rows(a, rows) if a.ndim > 1 and not isinstance(rows, slice) else a[rows])
         out.params = self.params.take(rows)
         return out

@@ -161,7 +161,7 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
         for q_prev in taken:
             ok &= q != q_prev
         q = np.where(ok, q, rows)
-        ok &= similar(gb.depth[rows], gb.depth[q], gb.ns[rows], gb.ns[q])
+        ok &= similar(gb.depth[rows], gb.depth[q], np.take(gb.ns, rows, axis=0), np.take(gb.ns, q, axis=0))
         q = np.where(ok, q, rows)
         taken.append(q)
         m_q = np.where(ok, res.M[q], np.float32(0.0))
@@ -204,7 +204,7 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     q = prev_gb.slot[np.where(inside, py * w + px, 0)]
     ok = inside & (q >= 0)
     q = np.where(ok, q, 0)
-    ok &= similar(depth_then, prev_gb.depth[q], gb.ns[rows], prev_gb.ns[q])
+    ok &= similar(depth_then, prev_gb.depth[q], np.take(gb.ns, rows, axis=0), np.take(prev_gb.ns, q, axis=0))
     ok &= prev_gb.material[q] == gb.material[rows]
     canonical = res.take(rows)
     prev = hist.res
