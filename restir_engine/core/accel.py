@@ -67,6 +67,11 @@ def shadow_rays(p: np.ndarray, ng: np.ndarray, light_pos: np.ndarray, wi: np.nda
     """
     o = offset_origin(p, ng, wi)
     finite = np.isfinite(dist)
+    if finite.all():
+        d = light_pos - o
+        ln = norm(d)
+        d /= np.maximum(ln, np.float32(1e-30))[:, None]
+        return o, d.astype(np.float32, copy=False), (ln * np.float32(1.0 - 1e-4)).astype(np.float32, copy=False)
     d = np.where(finite[:, None], light_pos - o, wi)
     ln = norm(d)
     d = d / np.maximum(ln, 1e-30)[:, None]

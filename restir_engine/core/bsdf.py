@@ -28,7 +28,8 @@ INV_PI = np.float32(1.0 / np.pi)
 
 
 def luminance(rgb: np.ndarray) -> np.ndarray:
-    return rgb @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
+    """Rec. 709 luminance of scene-linear RGB rows (..., 3)."""
+    return np.float32(0.2126) * rgb[..., 0] + np.float32(0.7152) * rgb[..., 1] + np.float32(0.0722) * rgb[..., 2]
 
 
 @dataclass

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .sampling import barycentric, uniform_triangle
+from .sampling import uniform_triangle
 
 TILE_MODES = ("AUTO", "ON", "OFF")
 BLOCK = 16              # pixels per side of a screen block sharing one tile
@@ -27,7 +27,7 @@ class LightPoints:
     """SoA light points (n,): light int32, b1, b2 float32, pos (n, 3), normal (n, 3) unit geometric
     normal, le (n, 3) radiance leaving the front face (W·sr⁻¹·m⁻², scene-linear; spot cones not
     applied), pdf (n,) area measure (m⁻²), two_sided bool, spot_tri int32 (lamp triangle with a
-    spot cone, else -1)."""
+    spot cone, else -1). ``block``: the packed (11, n) form when it was built first (see :meth:`packed`)."""
 
     light: np.ndarray
     b1: np.ndarray
@@ -38,10 +38,7 @@ class LightPoints:
     pdf: np.ndarray
     two_sided: np.ndarray
     spot_tri: np.ndarray
-
-    def take(self, idx) -> "LightPoints":
-        """Rows ``idx`` (an index array or a slice)."""
-        return LightPoints(*(getattr(self, f)[idx] for f in self.__dataclass_fields__))
+    block: np.ndarray | None = None
 
     @property
     def has_spots(self) -> bool:
@@ -50,6 +47,8 @@ class LightPoints:
     def packed(self) -> np.ndarray:
         """(11, n) float32 block [pos, normal, le, pdf, two_sided] (rows): one column gather per candidate
         (see :class:`PackedPoints`)."""
+        if self.block is not None:
+            return self.block
         out = np.empty((11, len(self.light)), np.float32)
         out[0:3] = self.pos.T
         out[3:6] = self.normal.T
@@ -76,17 +75,31 @@ class PackedPoints:
 
 
 def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> LightPoints:
-    """The points (b1, b2) of triangle lights ``light`` of a lights.LightTable."""
-    light = light.astype(np.int32)
+    """The points (b1, b2) of triangle lights ``light`` of a lights.LightTable, built in packed form (column
+    gathers from the table's (3, n_tri) corner, edge, normal and radiance rows)."""
+    n = len(light)
     if lights.n_tri == 0:  # no triangle lights: every point is an empty placeholder
-        n = len(light)
         z3 = np.zeros((n, 3), np.float32)
         return LightPoints(np.full(n, -1, np.int32), np.zeros(n, np.float32), np.zeros(n, np.float32), z3, z3.copy(),
                            z3.copy(), np.zeros(n, np.float32), np.zeros(n, bool), np.full(n, -1, np.int32))
-    pos = barycentric(np.take(lights.tri_verts, light, axis=0), b1, b2).astype(np.float32)
-    le = lights.radiance_of(light, b1, b2, None)
-    return LightPoints(light, b1.astype(np.float32), b2.astype(np.float32), pos, np.take(lights.tri_normal, light, axis=0), le,
-                       lights.tri_only_pdf_area(light), lights.tri_two_sided[light], lights.spot_lamp_tri(light))
+    light = light.astype(np.intp)
+    b1 = np.asarray(b1, np.float32)
+    b2 = np.asarray(b2, np.float32)
+    blk = np.empty((11, n), np.float32)
+    pos = blk[0:3]
+    np.take(lights.rows_v0, light, axis=1, out=pos)
+    pos += np.take(lights.rows_e1, light, axis=1) * b1
+    pos += np.take(lights.rows_e2, light, axis=1) * b2
+    np.take(lights.rows_normal, light, axis=1, out=blk[3:6])
+    np.take(lights.rows_le, light, axis=1, out=blk[6:9])
+    if lights.any_textured:
+        tex = np.flatnonzero(lights.tri_textured[light])
+        if tex.size:
+            blk[6:9, tex] = lights.radiance_of(light[tex], b1[tex], b2[tex], None).T
+    np.take(lights.tri_pdf_area, light, out=blk[9])
+    blk[10] = lights.tri_two_sided[light]
+    return LightPoints(light.astype(np.int32), b1, b2, blk[0:3].T, blk[3:6].T, blk[6:9].T, blk[9], blk[10] > 0,
+                       lights.spot_lamp_tri(light), block=blk)
 
 
 def sample_points(lights, u: np.ndarray) -> LightPoints:

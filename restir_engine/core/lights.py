@@ -88,11 +88,18 @@ class LightTable:
             np.zeros((0, 3), np.float32), np.zeros(0, np.float32))
         tri_mat = np.concatenate([geom.material[g_idx], lamps.tris.material[l_idx]]).astype(np.int64)
         self.tri_two_sided = mats.two_sided_emission[tri_mat] if len(tri_mat) else np.zeros(0, bool)
+        # (3, n_tri) rows for column gathers: corner 0, edges to corners 1 and 2, unit normal (light_tiles)
+        v = self.tri_verts
+        self.rows_v0 = np.ascontiguousarray(v[:, 0].T)
+        self.rows_e1 = np.ascontiguousarray((v[:, 1] - v[:, 0]).T)
+        self.rows_e2 = np.ascontiguousarray((v[:, 2] - v[:, 0]).T)
+        self.rows_normal = np.ascontiguousarray(self.tri_normal.T)
         # radiance of each light where no texture modulates it (most lights): one gather per point
         self.tri_le = mats.emission[tri_mat].astype(np.float32) if len(tri_mat) else np.zeros((0, 3), np.float32)
         tri_uvs = len(tri_mat) and (geom.uvs is not None or lamps.tris.uvs is not None)
         self.tri_textured = (mats.emit_tex[tri_mat] >= 0) if tri_uvs else np.zeros(len(tri_mat), bool)
         self.any_textured = bool(self.tri_textured.any())
+        self.rows_le = np.ascontiguousarray(self.tri_le.T)
         self.any_spots = bool(len(lamps.tris) and (lamps.spot_cos[l_idx] > -1.5).any())
         # power (W, luminance-weighted) decides selection; zero-area triangles get zero power
         tri_power = mat_power_density[tri_mat] * self.tri_area if len(tri_mat) else np.zeros(0, np.float32)

@@ -26,7 +26,7 @@ import numpy as np
 from ..accel import offset_origin, shadow_rays
 from ..bsdf import eval_bsdf, luminance, sample_bsdf
 from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
-from ..sampling import dot, row_max, to_local, to_world
+from ..sampling import dot, row_max, take_rows, to_local, to_world
 from ..target import FramePoints, with_spots
 from .reservoir import Reservoirs, Stream
 
@@ -102,9 +102,8 @@ def _light_candidates(ctx, terms, rng, tiles, m_l: int, m_b: int, px, py):
     lights = ctx.lights
     if tiles is not None:
         points, block = tiles.points, tiles.rows
-        pick = (rng.random((m_l, n), dtype=np.float32) * tiles.size).astype(np.int64)
-        np.minimum(pick, tiles.size - 1, out=pick)
-        pick += tiles.tile_base(px, py)[None, :]
+        pick = rng.integers(0, tiles.size, (m_l, n), dtype=np.int32)
+        pick += tiles.tile_base(px, py).astype(np.int32)[None, :]
     else:
         points = sample_points(lights, rng.random((m_l * n, 4), dtype=np.float32))
         block = points.packed()
@@ -212,16 +211,16 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
     n = len(surf.p)
     out = np.zeros((n, 3), np.float32)
     lights = ctx.lights
-    live = np.flatnonzero(res.has_sample() & (res.W > 0))
+    live = res.has_sample() & (res.W > 0)
     rays = []  # (rows, contributions, origins, directions, tmax): one Embree call for both kinds
-    if live.size:
-        sub = surf.take(live)
-        q, wi, dist, cos_l, le = lights.point_towards(res.light[live], res.b1[live], res.b2[live], sub.p)
-        _p, f, g, _pb = shading_value(sub, wi, le, dist, cos_l)
-        contrib = f * le * (g * res.W[live])[:, None]
+    if live.any():  # every row at once (empty reservoirs contribute zero): no row subsets to copy
+        q, wi, dist, cos_l, le = lights.point_towards(np.maximum(res.light, 0), res.b1, res.b2, surf.p)
+        _p, f, g, _pb = shading_value(surf, wi, le, dist, cos_l)
+        contrib = f * le * (g * res.W * live)[:, None]
         go = np.flatnonzero(row_max(contrib) > 0)
         if go.size:
-            rays.append((live[go], contrib[go], *shadow_rays(sub.p[go], sub.ng[go], q[go], wi[go], dist[go])))
+            rays.append((go, take_rows(contrib, go), *shadow_rays(take_rows(surf.p, go), take_rows(surf.ng, go),
+                                                                  take_rows(q, go), take_rows(wi, go), dist[go])))
     if lights.sun_alias is not None:
         ls = lights.sample_suns(n, rng.random((n, 4), dtype=np.float32))
         wi_l = to_local(ls.wi, surf.ns, surf.t, surf.bt)
@@ -230,7 +229,9 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
         contrib = f * ls.le * (np.abs(wi_l[:, 2]) / np.maximum(ls.pdf, 1e-30) * ok)[:, None]
         go = np.flatnonzero(row_max(contrib) > 0)
         if go.size:
-            rays.append((go, contrib[go], *shadow_rays(surf.p[go], surf.ng[go], ls.pos[go], ls.wi[go], ls.dist[go])))
+            rays.append((go, take_rows(contrib, go), *shadow_rays(take_rows(surf.p, go), take_rows(surf.ng, go),
+                                                                  take_rows(ls.pos, go), take_rows(ls.wi, go),
+                                                                  ls.dist[go])))
     if rays:
         _rows, _c, o, d, far = (np.concatenate(parts) for parts in zip(*rays))
         visible = ~ctx.geom_accel.occluded(o, d, far)
@@ -239,4 +240,7 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
             vis = visible[start:start + len(rows)]
             out[rows[vis]] += contrib[vis]
             start += len(rows)
-    return np.where(np.isfinite(out), out, 0.0).astype(np.float32)
+    bad = ~np.isfinite(out)
+    if bad.any():
+        out[bad] = 0.0
+    return out

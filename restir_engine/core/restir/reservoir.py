@@ -84,7 +84,10 @@ class Stream:
     def add(self, w: np.ndarray, p_hat: np.ndarray, src: Reservoirs, src_rows=None, rows=None) -> None:
         """Offer the samples ``src[src_rows]`` (default: src row i for candidate i) with resampling weights w
         and target values p̂ (at this stream's pixels) to rows ``rows`` (default: every row, in order)."""
-        w = np.where(np.isfinite(w) & (w > 0), w, np.float32(0.0)).astype(np.float32)
+        w = np.asarray(w, np.float32)
+        w = w * (w > 0)  # NaN and negative weights: 0 (NaN > 0 is False, NaN * 0 stays NaN: replaced below)
+        if not np.isfinite(w).all():
+            w[~np.isfinite(w)] = 0.0
         if rows is None:
             self.w_sum += w
             take = np.flatnonzero(self.rng.random(len(w), dtype=np.float32) * self.w_sum < w)
@@ -106,7 +109,7 @@ class Stream:
         res = self.res
         scale = res.p_hat if denom is None else res.p_hat * denom
         ok = res.has_sample() & (scale > 0)
-        res.W = np.where(ok, self.w_sum / np.where(ok, scale, np.float32(1.0)), np.float32(0.0)).astype(np.float32)
+        res.W = (self.w_sum / np.maximum(scale, np.float32(1e-30)) * ok).astype(np.float32, copy=False)
         res.key[~ok] = -1
         res.p_hat[~ok] = 0.0
         res.M = np.asarray(M, np.float32) * np.ones(len(res.W), np.float32)

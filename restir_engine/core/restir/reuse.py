@@ -64,17 +64,17 @@ def pairwise_weights(m_c, p_c, m_q, p_q, pc_at_q, pq_at_c, oks):
     cached in the reservoirs). Returns (m_c (n,), [m_q (n,)])."""
     k = np.sum(oks, axis=0).astype(np.float32) if oks else np.zeros_like(m_c)
     m_total = m_c + (np.sum(m_q, axis=0) if m_q else 0.0)
-    share_c = np.where(k > 0, m_c / np.maximum(k, 1.0), 0.0)
+    share_c = m_c / np.maximum(k, np.float32(1.0)) * (k > 0)
     inv_total = 1.0 / np.maximum(m_total, 1e-30)
-    w_c = np.where(k > 0, 0.0, 1.0)
+    w_c = (k == 0).astype(np.float32)
     w_q = []
     for mq, pq, pcq, pqc, ok in zip(m_q, p_q, pc_at_q, pq_at_c, oks):
         pi = (mq + share_c) * inv_total
         a = mq * pq
-        w_q.append(np.where(ok, pi * a / np.maximum(a + share_c * pcq, 1e-30), 0.0))
+        w_q.append(pi * a / np.maximum(a + share_c * pcq, np.float32(1e-30)) * ok)
         b = share_c * p_c
-        w_c = w_c + np.where(ok, pi * b / np.maximum(mq * pqc + b, 1e-30), 0.0)
-    return w_c.astype(np.float32), [w.astype(np.float32) for w in w_q]
+        w_c = w_c + pi * b / np.maximum(mq * pqc + b, np.float32(1e-30)) * ok
+    return w_c.astype(np.float32, copy=False), [w.astype(np.float32, copy=False) for w in w_q]
 
 
 @dataclass
@@ -98,7 +98,7 @@ def merge(canonical: Reservoirs, neighbours: list, bias_correction: str, rng: np
     n = len(canonical)
     stream = Stream(kind, n, rng)
     own = canonical.has_sample()
-    p_c = np.where(own, canonical.p_hat, np.float32(0.0))
+    p_c = canonical.p_hat * own
     m_total = canonical.M + (np.sum([nb.M for nb in neighbours], axis=0) if neighbours else 0.0)
     if bias_correction == "UNBIASED":
         w_c, w_q = pairwise_weights(canonical.M, p_c, [nb.M for nb in neighbours],
@@ -106,12 +106,12 @@ def merge(canonical: Reservoirs, neighbours: list, bias_correction: str, rng: np
                                     [nb.pq_at_c for nb in neighbours], [nb.ok for nb in neighbours])
         stream.add(w_c * p_c * canonical.W, canonical.p_hat, canonical)
         for nb, w in zip(neighbours, w_q):
-            stream.add(np.where(nb.ok, w * nb.pc_at_q * nb.src.W[nb.q], 0.0), nb.pc_at_q, nb.src, nb.q)
+            stream.add(w * nb.pc_at_q * nb.src.W[nb.q] * nb.ok, nb.pc_at_q, nb.src, nb.q)
         denom = None
     elif bias_correction == "NONE":
         stream.add(p_c * canonical.W * canonical.M, canonical.p_hat, canonical)
         for nb in neighbours:
-            stream.add(np.where(nb.ok, nb.pc_at_q * nb.src.W[nb.q] * nb.M, 0.0), nb.pc_at_q, nb.src, nb.q)
+            stream.add(nb.pc_at_q * nb.src.W[nb.q] * nb.M * nb.ok, nb.pc_at_q, nb.src, nb.q)
         denom = m_total
     else:
         raise ValueError(f"unknown bias correction {bias_correction!r}; available: {BIAS_CORRECTIONS}")
@@ -164,15 +164,15 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
         ok &= similar(gb.depth[rows], gb.depth[q], np.take(gb.ns, rows, axis=0), np.take(gb.ns, q, axis=0))
         q = np.where(ok, q, rows)
         taken.append(q)
-        m_q = np.where(ok, res.M[q], np.float32(0.0))
+        m_q = res.M[q] * ok
         if not ok.any():
             z = np.zeros(n, np.float32)
             neighbours.append(Neighbour(res, q, ok, m_q, z, z))
             continue
-        pc = np.where(ok & res.has_sample()[q], space.target(me, prepared, q), np.float32(0.0))
+        pc = space.target(me, prepared, q) * (ok & res.has_sample()[q])
         pq = None
         if unbiased:
-            pq = np.where(ok & canonical.has_sample(), space.evaluate(gb.terms.take(q), own), np.float32(0.0))
+            pq = space.evaluate(gb.terms.take(q), own) * (ok & canonical.has_sample())
         neighbours.append(Neighbour(res, q, ok, m_q, pc, pq))
     return merge(canonical, neighbours, cfg.bias_correction, rng)
 
@@ -208,11 +208,11 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     ok &= prev_gb.material[q] == gb.material[rows]
     canonical = res.take(rows)
     prev = hist.res
-    m_prev = np.where(ok, np.minimum(prev.M[q], confidence_cap * np.maximum(canonical.M, 1.0)), 0.0).astype(np.float32)
+    m_prev = np.minimum(prev.M[q], np.float32(confidence_cap) * np.maximum(canonical.M, np.float32(1.0))) * ok
     use = ok & prev.has_sample()[q]
     pc = np.zeros(n, np.float32)
     if use.any():
-        pc = np.where(use, space.target(gb.terms.take(rows), prepared_prev, q), np.float32(0.0))
+        pc = space.target(gb.terms.take(rows), prepared_prev, q) * use
     pq = None
     if bias_correction == "UNBIASED":
         pq = np.zeros(n, np.float32)
@@ -220,6 +220,6 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
         if both.any():
             pq = space.evaluate(prev_gb.terms.take(q), space.gather(prepared_now, rows))
             if possible_before is not None:
-                pq = np.where(possible_before(rows), pq, 0.0)
-            pq = np.where(both, pq, np.float32(0.0)).astype(np.float32)
+                pq = pq * possible_before(rows)
+            pq = pq * both
     return merge(canonical, [Neighbour(prev, q, ok, m_prev, pc, pq)], bias_correction, rng)
