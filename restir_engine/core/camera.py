@@ -73,12 +73,17 @@ def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray):
 
 def project(cam: Camera, points: np.ndarray):
     """Raster coordinates (n, 2) of world points seen by ``cam`` (x right, y up, full-resolution pixels)
-    and their planar depth along the camera axis (n,); depth <= 0 means behind the camera."""
+    and their planar depth along the camera axis (n,); depth <= 0 means behind the camera. The matrices
+    are combined in float64, the points transformed in float32."""
     w2c = np.linalg.inv(cam.cam_to_world.astype(np.float64))
-    proj = np.linalg.inv(cam.ndc_to_cam)
-    pc = points.astype(np.float64) @ w2c[:3, :3].T + w2c[:3, 3]
-    h = pc @ proj[:3, :3].T + proj[:3, 3]
-    w = pc @ proj[3, :3] + proj[3, 3]
-    ndc = h[:, :2] / np.where(np.abs(w) > 1e-12, w, 1e-12)[:, None]
-    raster = np.stack([(ndc[:, 0] + 1) * 0.5 * cam.width, (ndc[:, 1] + 1) * 0.5 * cam.height], axis=1)
-    return raster.astype(np.float32), (-pc[:, 2]).astype(np.float32)
+    clip = (np.linalg.inv(cam.ndc_to_cam.astype(np.float64)) @ w2c).astype(np.float32)
+    zrow = w2c[2].astype(np.float32)
+    p = np.asarray(points, np.float32)
+    x, y, z = p[:, 0], p[:, 1], p[:, 2]
+    h = [clip[i, 0] * x + clip[i, 1] * y + clip[i, 2] * z + clip[i, 3] for i in (0, 1, 3)]
+    w = np.where(np.abs(h[2]) > 1e-12, h[2], np.float32(1e-12))
+    raster = np.empty((len(p), 2), np.float32)
+    raster[:, 0] = (h[0] / w + 1) * np.float32(0.5 * cam.width)
+    raster[:, 1] = (h[1] / w + 1) * np.float32(0.5 * cam.height)
+    depth = -(zrow[0] * x + zrow[1] * y + zrow[2] * z + zrow[3])
+    return raster, depth.astype(np.float32, copy=False)

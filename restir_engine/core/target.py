@@ -37,11 +37,11 @@ class ShadingTerms:
     """Per-surface terms of p̂ as a (27, n) float32 block (:data:`LAYOUT`): each term a contiguous row, the
     terms of other pixels (spatial and temporal neighbours) one column gather away (:meth:`take`)."""
 
-    def __init__(self, packed: np.ndarray):
+    def __init__(self, packed: np.ndarray, glossy: bool | None = None):
         self.packed = packed
         for name, rows in LAYOUT.items():
             setattr(self, name, packed[rows])
-        self.glossy = bool((self.spec_on > 0).any())
+        self.glossy = bool((self.spec_on > 0).any()) if glossy is None else glossy
 
     def __len__(self) -> int:
         return self.packed.shape[1]
@@ -73,10 +73,17 @@ class ShadingTerms:
         return ShadingTerms(packed)
 
     def take(self, idx) -> "ShadingTerms":
-        """Terms of surfaces ``idx`` (index array or slice)."""
+        """Terms of surfaces ``idx`` (index array or slice). Without a glossy surface among them only the
+        rows the diffuse target and pdf read are gathered (p, ng, ns, kd, p_spec: 13 of 27)."""
         if isinstance(idx, slice):
-            return ShadingTerms(self.packed[:, idx])
-        return ShadingTerms(np.take(self.packed, idx, axis=1))
+            return ShadingTerms(self.packed[:, idx], self.glossy)
+        if self.glossy:
+            return ShadingTerms(np.take(self.packed, idx, axis=1), True)
+        out = np.empty((WIDTH, len(idx)), np.float32)
+        np.take(self.packed[0:9], idx, axis=1, out=out[0:9])
+        np.take(self.packed[12:15], idx, axis=1, out=out[12:15])
+        np.take(self.packed[25], idx, out=out[25])  # p_spec (the BSDF pdf)
+        return ShadingTerms(out, False)
 
     def evaluate(self, pts: PackedPoints, want_pdf: bool = True):
         """p̂ and the BSDF pdf in area measure (None unless ``want_pdf``) of light points ``pts`` whose
