@@ -175,51 +175,86 @@ def view_albedo(p: SurfaceParams, wo: np.ndarray) -> np.ndarray:
     return ggx_albedo(p.alpha, np.clip(wo[:, 2], 0, 1))
 
 
-def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray, albedo: np.ndarray | None = None):
-    """f (n, 3) and pdf (n,) of sampling wi given wo, both unit vectors (``albedo``: :func:`view_albedo`, if
-    known). The half vector h = (wo + wi)/|wo + wi| enters only through cos θ_h = (cos θ_o + cos θ_i)/|wo + wi|
-    and wo·h = (1 + wo·wi)/|wo + wi|, with |wo + wi|² = 2 + 2 wo·wi."""
-    co = wo[:, 2]
+@dataclass
+class ViewTerms:
+    """The factors of f and its pdf that depend on the view direction only, per surface (n): computed once
+    and reused by every wi evaluated there (next-event estimation, BSDF sampling, shading).
+    kd (n, 3) = diffuse (1 - F_d(cos θ_o)) / π; spec_a, spec_b (n, 3) = f0 · c, (1 - f0) · c with c the
+    energy compensation 1 + f0 (1 - E)/E (so the specular lobe is D G / (4 cos θ_o cos θ_i) · (spec_a + c⁵
+    spec_b), c⁵ = (1 - ωo·h)⁵); alpha, alpha2, lam_o = Λ(ωo), co = cos θ_o, spec_on, p_spec (n,)."""
+
+    kd: np.ndarray
+    spec_a: np.ndarray
+    spec_b: np.ndarray
+    alpha: np.ndarray
+    alpha2: np.ndarray
+    lam_o: np.ndarray
+    co: np.ndarray
+    spec_on: np.ndarray
+    p_spec: np.ndarray
+
+    @staticmethod
+    def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None) -> "ViewTerms":
+        co = wo[:, 2]
+        # a lobe with f0 = 0 does not exist (Diffuse BSDF): no Fresnel split, no grazing specular
+        fd = np.where(p.f0_dielectric > 0, 1.0 - schlick(p.f0_dielectric, co), np.float32(1.0))
+        e = view_albedo(p, wo) if albedo is None else albedo
+        comp = 1.0 + p.f0 * ((1.0 - e) / e)[:, None]
+        return ViewTerms(p.diffuse * (fd * INV_PI)[:, None], p.f0 * comp, (1.0 - p.f0) * comp, p.alpha,
+                         p.alpha * p.alpha, smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec)
+
+
+def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
+    """f (n, 3) and pdf (n,) (solid angle) of unit directions wi at surfaces with view terms ``v``. The half
+    vector h = (wo + wi)/|wo + wi| enters only through cos θ_h = (cos θ_o + cos θ_i)/|wo + wi| and
+    wo·h = (1 + wo·wi)/|wo + wi|, with |wo + wi|² = 2 + 2 wo·wi."""
+    co = v.co
     ci = wi[:, 2]
     valid = (co > 0) & (ci > 0)
-    # a lobe with f0 = 0 does not exist (Diffuse BSDF): no Fresnel split, no grazing specular
-    fd = np.where(p.f0_dielectric > 0, 1.0 - schlick(p.f0_dielectric, co), np.float32(1.0))
-    f = p.diffuse * (fd * INV_PI)[:, None]
-    pdf_d = np.maximum(ci, 0) * INV_PI
     wdw = dot(wo, wi)
     hinv = 1.0 / np.sqrt(np.maximum(2.0 + 2.0 * wdw, np.float32(1e-24)))
     cos_h = np.clip((co + ci) * hinv, 0, 1)
     odh = np.clip((1.0 + wdw) * hinv, 1e-6, 1.0)
-    d = _ggx_d(p.alpha, cos_h)
-    g = 1.0 / (1.0 + smith_lambda(p.alpha, co) + smith_lambda(p.alpha, ci))
-    fr = schlick(p.f0, odh[:, None])
-    e = view_albedo(p, wo) if albedo is None else albedo
-    compensation = 1.0 + p.f0 * ((1.0 - e) / e)[:, None]
-    spec = (p.spec_on * d * g / np.maximum(4.0 * co * ci, np.float32(1e-12)))[:, None] * fr * compensation
-    f = f + spec
-    pdf_s = d * cos_h / (4.0 * odh)
-    pdf = (1 - p.p_spec) * pdf_d + p.p_spec * pdf_s
-    f = np.where(valid[:, None], f, np.float32(0.0)).astype(np.float32, copy=False)
-    pdf = np.where(valid, pdf, np.float32(0.0)).astype(np.float32, copy=False)
-    return f, pdf
+    den = cos_h * cos_h * (v.alpha2 - 1.0) + 1.0
+    d = v.alpha2 / (np.float32(np.pi) * den * den)
+    g = 1.0 / (1.0 + v.lam_o + smith_lambda(v.alpha, ci))
+    c = np.clip(1.0 - odh, 0.0, 1.0)
+    c5 = (c * c) * (c * c) * c
+    s = v.spec_on * d * g / np.maximum(4.0 * co * ci, np.float32(1e-12))
+    f = v.kd + s[:, None] * v.spec_a + (s * c5)[:, None] * v.spec_b
+    f *= valid[:, None]
+    pdf = (1 - v.p_spec) * np.maximum(ci, 0) * INV_PI + v.p_spec * (d * cos_h / (4.0 * odh))
+    pdf *= valid
+    return f.astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
+
+
+def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray, albedo: np.ndarray | None = None):
+    """f (n, 3) and pdf (n,) of sampling wi given wo, both unit vectors (``albedo``: :func:`view_albedo`, if
+    known). For many wi at the same surfaces build :class:`ViewTerms` once and call :func:`eval_view`."""
+    return eval_view(ViewTerms.of(p, wo, albedo), wo, wi)
 
 
 def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.ndarray, u2: np.ndarray,
-                albedo: np.ndarray | None = None):
+                albedo: np.ndarray | None = None, view: ViewTerms | None = None):
     """Sample wi; returns wi (n, 3), f (n, 3), pdf (n,) (the mixture pdf, so MIS-ready). ``albedo``: see
-    :func:`eval_bsdf`."""
-    spec = u_lobe < p.p_spec
+    :func:`eval_bsdf`; ``view``: the surfaces' :class:`ViewTerms` if known."""
+    spec = np.flatnonzero(u_lobe < p.p_spec)
     wi = cosine_hemisphere(u1, u2)
-    if spec.any():
+    if spec.size:
         a = p.alpha[spec]
         uu1, uu2 = u1[spec], u2[spec]
         tan2 = a * a * uu1 / np.maximum(1.0 - uu1, 1e-7)
         cos_t = 1.0 / np.sqrt(1.0 + tan2)
         sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
         phi = 2 * np.pi * uu2
-        h = np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), cos_t], axis=-1)
-        o = wo[spec]
-        wi[spec] = (2.0 * dot(o, h)[:, None] * h - o).astype(np.float32)
-    f, pdf = eval_bsdf(p, wo, wi, albedo)
+        h = np.empty((spec.size, 3), np.float32)
+        h[:, 0] = sin_t * np.cos(phi)
+        h[:, 1] = sin_t * np.sin(phi)
+        h[:, 2] = cos_t
+        o = np.take(wo, spec, axis=0)
+        wi[spec] = 2.0 * dot(o, h)[:, None] * h - o
+    f, pdf = eval_view(ViewTerms.of(p, wo, albedo) if view is None else view, wo, wi)
     ok = (pdf > 0) & (wi[:, 2] > 0)
-    return wi, np.where(ok[:, None], f, 0.0).astype(np.float32), np.where(ok, pdf, 0.0).astype(np.float32)
+    f *= ok[:, None]
+    pdf *= ok
+    return wi, f, pdf

@@ -23,7 +23,7 @@ import numpy as np
 
 from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
-from .bsdf import SurfaceParams, eval_bsdf, ggx_albedo_rows, sample_bsdf
+from .bsdf import SurfaceParams, eval_view, ggx_albedo_rows, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
 from .sampling import dot, norm, row_max, rows_finite, take_rows, to_local, to_world
 from .scene import Scene
@@ -119,7 +119,7 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         return out
     ls = ctx.lights.sample(s.p, rng.random((n, 4), dtype=np.float32))
     wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
-    f, pdf_b = eval_bsdf(s.params, s.wo_l, wi_l, s.albedo)
+    f, pdf_b = eval_view(s.view, s.wo_l, wi_l)
     w = np.where(ls.delta, 1.0, power_heuristic(ls.pdf, pdf_b))
     contrib = f * (np.abs(wi_l[:, 2]) * w / np.maximum(ls.pdf, 1e-30))[:, None] * ls.le
     if throughput is not None:
@@ -162,7 +162,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             o, d, hits = first_ray.o, first_ray.d, first_ray.hits
         else:
             u = rng.random((len(idx), 3), dtype=np.float32)
-            wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[:, 0], u[:, 1], u[:, 2], s.albedo)
+            wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[:, 0], u[:, 1], u[:, 2], view=s.view)
             wi = to_world(wi_l, s.ns, s.t, s.bt)
             wi /= np.maximum(norm(wi), 1e-12)[:, None]
             rows = np.flatnonzero((pdf > 0) & (dot(wi, s.ng) > 0))

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import SurfaceParams, ggx_albedo_at
+from .bsdf import SurfaceParams, ViewTerms, ggx_albedo_at
 from .lights import emitted_radiance
 from .sampling import barycentric, dot, orthonormal_basis, take_rows
 from .textures import apply_texture
@@ -71,6 +71,14 @@ class Surface:
 
     def __len__(self) -> int:
         return len(self.p)
+
+    @property
+    def view(self) -> ViewTerms:
+        """The BSDF's view-dependent factors (bsdf.ViewTerms), computed on first use."""
+        v = getattr(self, "_view", None)
+        if v is None:
+            v = self._view = ViewTerms.of(self.params, self.wo_l, self.albedo)
+        return v
 
     def emission(self, ctx) -> np.ndarray:
         """Emitted radiance (n, 3) towards the incoming ray (mesh emission is two-sided by default)."""

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..accel import offset_origin, shadow_rays
-from ..bsdf import eval_bsdf, luminance, sample_bsdf
+from ..bsdf import ViewTerms, eval_view, luminance, sample_bsdf
 from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
 from ..sampling import dot, row_max, take_rows, to_local, to_world
 from ..target import FramePoints, with_spots
@@ -159,7 +159,7 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     lamps = ctx.scene.lamps
     for j in range(max(m_b, 1 if keep_bsdf_ray else 0)):
         u = rng.random((n, 3), dtype=np.float32)
-        wi_l, f, p_b = sample_bsdf(surf.params, surf.wo_l, u[:, 0], u[:, 1], u[:, 2], surf.albedo)
+        wi_l, f, p_b = sample_bsdf(surf.params, surf.wo_l, u[:, 0], u[:, 1], u[:, 2], view=surf.view)
         wi = to_world(wi_l, surf.ns, surf.t, surf.bt).astype(np.float32)
         wi /= np.maximum(np.sqrt(dot(wi, wi)), 1e-12)[:, None]
         live = np.flatnonzero((p_b > 0) & (dot(wi, surf.ng) > 0))
@@ -197,7 +197,8 @@ def shading_value(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l:
     """Target p̂ (n,), f (n, 3), geometry term G (n,) and the BSDF pdf in area measure (n,) of light points
     in directions wi (world) at distances dist (the exact RGB model of bsdf.py)."""
     wi_l = to_local(wi, surf.ns, surf.t, surf.bt)
-    f, pdf_b = eval_bsdf(surf.params, surf.wo_l, wi_l, getattr(surf, "albedo", None))
+    view = surf.view if hasattr(type(surf), "view") else ViewTerms.of(surf.params, surf.wo_l)
+    f, pdf_b = eval_view(view, surf.wo_l, wi_l)
     ok = (dot(wi, surf.ng) > 0) & (dist > 0)
     to_area = np.abs(cos_l) / np.maximum(dist * dist, 1e-30)
     g = np.abs(wi_l[:, 2]) * to_area
@@ -224,7 +225,7 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
     if lights.sun_alias is not None:
         ls = lights.sample_suns(n, rng.random((n, 4), dtype=np.float32))
         wi_l = to_local(ls.wi, surf.ns, surf.t, surf.bt)
-        f, _pb = eval_bsdf(surf.params, surf.wo_l, wi_l, surf.albedo)
+        f, _pb = eval_view(surf.view, surf.wo_l, wi_l)
         ok = (dot(ls.wi, surf.ng) > 0) & (ls.pdf > 0)
         contrib = f * ls.le * (np.abs(wi_l[:, 2]) / np.maximum(ls.pdf, 1e-30) * ok)[:, None]
         go = np.flatnonzero(row_max(contrib) > 0)
