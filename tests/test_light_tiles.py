@@ -16,7 +16,7 @@ from restir_engine.core.target import ShadingTerms
 class _Surf:
     """Random surfaces: positions in a box, tilted shading normals, mixed diffuse / glossy / metal."""
 
-    def __init__(self, n, g):
+    def __init__(self, n, g, diffuse_only=False):
         self.p = g.uniform(-1, 1, (n, 3)).astype(np.float32)
         ng = g.normal(size=(n, 3))
         ng /= np.linalg.norm(ng, axis=1)[:, None]
@@ -29,26 +29,30 @@ class _Surf:
         wo_l = to_local(wo.astype(np.float32), self.ns, self.t, self.bt)
         wo_l[:, 2] = np.maximum(wo_l[:, 2], 1e-4)
         self.wo_l = (wo_l / np.linalg.norm(wo_l, axis=1)[:, None]).astype(np.float32)
-        kind = g.integers(0, 3, n)
+        kind = g.integers(0, 1 if diffuse_only else 3, n)
         base = g.uniform(0.05, 0.95, (n, 3)).astype(np.float32)
         self.params = SurfaceParams.from_material(base, (kind == 2).astype(np.float32),
                                                   g.uniform(0.05, 1.0, n).astype(np.float32),
                                                   np.where(kind == 0, 0.0, 0.04).astype(np.float32))
 
 
-def test_packed_target_matches_the_bsdf_model():
+@pytest.mark.parametrize("diffuse_only", [False, True], ids=["mixed", "diffuse-only"])
+def test_packed_target_matches_the_bsdf_model(diffuse_only):
     """ShadingTerms.evaluate (per-surface terms folded) agrees with bsdf.eval_bsdf for p̂ (including
-    points below the horizon and back faces of one-sided lights) and for the BSDF pdf where p̂ > 0."""
+    points below the horizon and back faces of one-sided lights) and for the BSDF pdf where p̂ > 0; with
+    diffuse surfaces only it takes its square-root-free path."""
     g = np.random.default_rng(3)
     n = 4000
-    surf = _Surf(n, g)
+    surf = _Surf(n, g, diffuse_only)
     pts = light_tiles.LightPoints(np.zeros(n, np.int32), np.zeros(n, np.float32), np.zeros(n, np.float32),
                                   g.uniform(-2, 2, (n, 3)).astype(np.float32), np.zeros((n, 3), np.float32),
                                   g.uniform(0, 5, (n, 3)).astype(np.float32), np.ones(n, np.float32),
                                   g.random(n) < 0.5, np.full(n, -1, np.int32))
     nl = g.normal(size=(n, 3))
     pts.normal[:] = nl / np.linalg.norm(nl, axis=1)[:, None]
-    p_hat, pdf = ShadingTerms.of_surfaces(surf).evaluate(light_tiles.PackedPoints.of(pts.packed()))
+    terms = ShadingTerms.of_surfaces(surf)
+    assert terms.glossy != diffuse_only
+    p_hat, pdf = terms.evaluate(light_tiles.PackedPoints.of(pts.packed()))
     d = pts.pos - surf.p
     dist = np.linalg.norm(d, axis=1)
     wi = (d / dist[:, None]).astype(np.float32)

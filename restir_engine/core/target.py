@@ -97,6 +97,8 @@ class ShadingTerms:
         d2 = dx * dx
         d2 += dy * dy
         d2 += dz * dz
+        if not self.glossy:
+            return self._evaluate_diffuse(dx, dy, dz, d2, pts, want_pdf)
         inv = np.maximum(d2, np.float32(1e-30))
         np.sqrt(inv, out=inv)
         np.divide(np.float32(1.0), inv, out=inv)
@@ -190,6 +192,42 @@ class ShadingTerms:
             pdf += pdf_s
         pdf *= to_area
         return p_hat, np.multiply(pdf, ok, out=pdf)
+
+
+    def _evaluate_diffuse(self, dx, dy, dz, d2, pts: PackedPoints, want_pdf: bool):
+        """:meth:`evaluate` for blocks without a glossy surface, without square roots: with unnormalized
+        d·n_s > 0 and -d·n_l, |cos θ_s| |cos θ_l| / d² = (d·n_s)(|d·n_l|) / d⁴."""
+        ns, ng, nl = self.ns, self.ng, pts.normal
+        dn = dx * ns[0]
+        dn += dy * ns[1]
+        dn += dz * ns[2]
+        ln = dx * nl[0]
+        ln += dy * nl[1]
+        ln += dz * nl[2]
+        np.negative(ln, out=ln)                      # -d·n_l: positive on the light's front face
+        ok = dn > 0
+        gn = dx * ng[0]
+        gn += dy * ng[1]
+        gn += dz * ng[2]
+        ok &= gn > 0
+        ok &= (ln > 0) | pts.two_sided
+        aln = np.abs(ln, out=ln)
+        ok &= aln * aln > np.float32(1e-16) * d2     # |cos θ_l| > 1e-8
+        geo = dn
+        geo *= aln
+        d2 *= d2
+        np.maximum(d2, np.float32(1e-30), out=d2)
+        geo /= d2
+        geo *= ok                                    # |cos θ_s| |cos θ_l| / d² where the point lights x
+        le, kd = pts.le, self.kd
+        p_hat = le[0] * kd[0]
+        p_hat += le[1] * kd[1]
+        p_hat += le[2] * kd[2]
+        p_hat *= geo
+        if not want_pdf:
+            return p_hat, None
+        geo *= (1.0 - self.p_spec) * INV_PI
+        return p_hat, geo
 
 
 def with_spots(pts: PackedPoints, spot_tri: np.ndarray, lamps, receivers: np.ndarray) -> PackedPoints:
