@@ -38,7 +38,7 @@ from restir_engine.core.profile import StageClock, embree_seconds  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 
-STAGES = ("primary", "initial", "temporal", "spatial", "shade", "paths", "passes")
+STAGES = ("primary", "initial", "gbuffer", "temporal", "boiling", "spatial", "shade", "paths", "passes")
 RUNS = [  # (name, scene, integrator settings): RESTIR runs use the add-on's defaults (ReSTIR DI, unbiased, temporal + spatial)
     ("demo PATH", "demo", dict(integrator="PATH", max_bounces=4)),
     ("demo RESTIR", "demo", dict(integrator="RESTIR", direct_method="RESTIR", max_bounces=4)),

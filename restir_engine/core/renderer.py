@@ -2,7 +2,8 @@
 
 Stages of a sample pass (each timed by a profile.StageClock when one is given):
   primary   camera rays, emission seen directly, the G-buffer (every integrator)
-  initial   ReSTIR/RIS: target terms and initial resampling (light + BSDF candidates)
+  initial   ReSTIR/RIS: light tiles, target terms and initial resampling (light + BSDF candidates)
+  gbuffer   ReSTIR: the frame's G-buffer and reservoirs assembled from the chunks
   temporal  ReSTIR, first pass of a frame: merge with the previous frame's reservoirs
   boiling   ReSTIR biased mode with the boiling filter
   spatial   ReSTIR: spatial reuse passes
@@ -250,7 +251,8 @@ class FrameRenderer:
                 first += len(c.hits.rows)
         candidates = self.candidates
         if resampled and ctx.lights.tri_alias is not None and candidates.tile_settings.wanted(npix, candidates.light_candidates):
-            tiles = LightTiles(ctx.lights, candidates.tile_settings, w, h, rng(st.seed, st.frame, s, STREAM_TILES))
+            with clock.stage("initial"):
+                tiles = LightTiles(ctx.lights, candidates.tile_settings, w, h, rng(st.seed, st.frame, s, STREAM_TILES))
             candidates = dataclasses.replace(candidates, tiles=tiles)
             self.used_tiles = True
         continuing = pathtracer.needs_continuation(ctx, resampled)
@@ -268,10 +270,11 @@ class FrameRenderer:
                 self._map(initial, chunks, stop)
         res = gb = None
         if reusing:
-            gb = self._gbuffer(chunks, terms)
-            res = di.DIReservoirs.empty(len(gb))
-            for c in chunks:
-                res.assign(c.surfaces, c.res)
+            with clock.stage("gbuffer"):
+                gb = self._gbuffer(chunks, terms)
+                res = di.DIReservoirs.empty(len(gb))
+                for c in chunks:
+                    res.assign(c.surfaces, c.res)
             res = self._reuse(gb, res, s)
             for c in chunks:
                 c.res = res.take(c.surfaces)
@@ -389,21 +392,34 @@ class FrameRenderer:
     def combined(self) -> np.ndarray:
         """The running mean of Combined (h, w, 4) float32."""
         inv = 1.0 / max(1, self.samples_done)
-        rgb = (self.acc["emit"] + self.acc["direct"] + self.acc["indirect"]) * inv
-        out = np.concatenate([rgb, (self.acc["alpha"] * inv)[..., None]], axis=2).astype(np.float32)
-        return np.where(np.isfinite(out), out, 0.0).astype(np.float32)
+        h, w = self.acc["alpha"].shape
+        out = np.empty((h, w, 4), np.float32)
+        np.add(self.acc["emit"], self.acc["direct"], out=out[..., :3], casting="unsafe")
+        out[..., :3] += self.acc["indirect"]
+        out[..., :3] *= np.float32(inv)
+        np.multiply(self.acc["alpha"], inv, out=out[..., 3], casting="unsafe")
+        return _finite(out)
 
     def passes(self) -> dict:
-        """All passes (see :class:`FrameResult`); finite everywhere."""
+        """All passes (see :class:`FrameResult`); float32, finite everywhere."""
         inv = 1.0 / max(1, self.samples_done)
-        out = {"Combined": self.combined(), "Direct": self.acc["direct"] * inv, "Indirect": self.acc["indirect"] * inv,
-               "Emission": self.acc["emit"] * inv}
+        mean = lambda key: _finite((self.acc[key] * inv).astype(np.float32))  # noqa: E731
+        out = {"Combined": self.combined(), "Direct": mean("direct"), "Indirect": mean("indirect"),
+               "Emission": mean("emit")}
         if self.settings.data_passes:
-            out["Depth"], out["Normal"], out["Vector"] = self.data_passes()
+            out["Depth"], out["Normal"], out["Vector"] = (_finite(a) for a in self.data_passes())
         if self.candidates is not None:
-            out["Reservoir M"] = (self.acc["res_m"] * inv)[..., None]
-            out["Reservoir UCW"] = (self.acc["res_w"] * inv)[..., None]
-        return {k: np.where(np.isfinite(v), v, 0.0).astype(np.float32) for k, v in out.items()}
+            out["Reservoir M"] = mean("res_m")[..., None]
+            out["Reservoir UCW"] = mean("res_w")[..., None]
+        return out
+
+
+def _finite(a: np.ndarray) -> np.ndarray:
+    """``a`` (float32) with non-finite values set to 0, in place."""
+    bad = ~np.isfinite(a)
+    if bad.any():
+        a[bad] = 0.0
+    return a
 
 
 def _gather(kind, parts, n: int):

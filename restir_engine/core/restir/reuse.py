@@ -45,9 +45,15 @@ def neighbor_offsets(k: int, radius: float, rng: np.random.Generator, n: int) ->
     """Per-pixel neighbour offsets (n, k, 2) in pixels: a golden-angle spiral filling the disc of
     ``radius`` (low discrepancy), rotated by a random angle per pixel and pass (no ring artefacts)."""
     j = np.arange(k, dtype=np.float32)
-    r = radius * np.sqrt((j + 0.5) / k)
-    phi = j * np.float32(2.39996323) + rng.random((n, 1), dtype=np.float32) * np.float32(2 * np.pi)
-    return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=-1)
+    r = np.float32(radius) * np.sqrt((j + 0.5) / k)
+    spiral = j * np.float32(2.39996323)
+    cs, sn = r * np.cos(spiral), r * np.sin(spiral)            # (k,) the spiral before the rotation
+    turn = rng.random((n, 1), dtype=np.float32) * np.float32(2 * np.pi)
+    ct, st = np.cos(turn), np.sin(turn)                         # (n, 1) the rotation of each pixel
+    out = np.empty((n, k, 2), np.float32)
+    out[..., 0] = ct * cs - st * sn                             # r cos(spiral + turn)
+    out[..., 1] = st * cs + ct * sn                             # r sin(spiral + turn)
+    return out
 
 
 def pairwise_weights(m_c, p_c, m_q, p_q, pc_at_q, pq_at_c, oks):
@@ -149,6 +155,9 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
     offs = neighbor_offsets(cfg.neighbors, cfg.radius, rng, n)
     canonical = res.take(rows)
     own = space.gather(prepared, rows) if unbiased else None
+    depth_c, ns_c = gb.depth[rows], np.take(gb.ns, rows, axis=0)
+    own_ok = canonical.has_sample()
+    has = res.has_sample()
     neighbours, taken = [], []
     for k in range(cfg.neighbors):
         qx = np.round(px + offs[:, k, 0]).astype(np.int64)
@@ -161,7 +170,7 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
         for q_prev in taken:
             ok &= q != q_prev
         q = np.where(ok, q, rows)
-        ok &= similar(gb.depth[rows], gb.depth[q], np.take(gb.ns, rows, axis=0), np.take(gb.ns, q, axis=0))
+        ok &= similar(depth_c, gb.depth[q], ns_c, np.take(gb.ns, q, axis=0))
         q = np.where(ok, q, rows)
         taken.append(q)
         m_q = res.M[q] * ok
@@ -169,10 +178,10 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
             z = np.zeros(n, np.float32)
             neighbours.append(Neighbour(res, q, ok, m_q, z, z))
             continue
-        pc = space.target(me, prepared, q) * (ok & res.has_sample()[q])
+        pc = space.target(me, prepared, q) * (ok & has[q])
         pq = None
         if unbiased:
-            pq = space.evaluate(gb.terms.take(q), own) * (ok & canonical.has_sample())
+            pq = space.evaluate(gb.terms.take(q), own) * (ok & own_ok)
         neighbours.append(Neighbour(res, q, ok, m_q, pc, pq))
     return merge(canonical, neighbours, cfg.bias_correction, rng)
 
