@@ -25,7 +25,7 @@ import numpy as np
 
 from . import camera as camera_mod
 from . import pathtracer
-from .accel import pool
+from .accel import in_worker, pool
 from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
 from .context_cache import context_for
@@ -233,7 +233,7 @@ class FrameRenderer:
         chunks = [_Chunk(i, np.arange(a, min(npix, a + step))) for i, a in enumerate(range(0, npix, step))]
         resampled = self.candidates is not None
         reusing = self.method == "RESTIR"
-        chunk_stages = 3 + int(resampled)
+        chunk_stages = 4 + int(resampled)
         stop = _Progress(progress, should_stop, len(chunks) * chunk_stages)
         ctx = self.ctx
 
@@ -300,7 +300,7 @@ class FrameRenderer:
         with clock.stage("paths"):
             self._map(paths, chunks, stop)
         with clock.stage("passes"):
-            self._accumulate(chunks, resampled)
+            self._accumulate(chunks, resampled, stop)
 
     def _gbuffer(self, chunks, terms) -> GBuffer:
         """The frame's G-buffer from the chunks' primary hits (surfaces in chunk order)."""
@@ -361,33 +361,22 @@ class FrameRenderer:
                                            lights.uid_space)
         return res
 
-    def _accumulate(self, chunks, resampled: bool) -> None:
-        _x0, _y0, w, h = self.ctx.scene.camera.window
-        npix = w * h
-        emit = np.zeros((npix, 3), np.float32)
-        direct = np.zeros((npix, 3), np.float32)
-        indirect = np.zeros((npix, 3), np.float32)
-        alpha = np.zeros(npix, np.float32)
-        res_m = np.zeros(npix, np.float32)
-        res_w = np.zeros(npix, np.float32)
-        for c in chunks:
-            emit[c.pixels] = c.hits.emitted
-            alpha[c.pixels] = c.hits.alpha
-            pix = c.pixels[c.hits.rows]
-            direct[pix] = c.direct
-            if c.indirect is not None:
-                indirect[pix] = c.indirect
-            if resampled:
-                res_m[pix] = c.res.M
-                res_w[pix] = c.res.W
-        self.acc["emit"] += emit.reshape(h, w, 3)
-        self.acc["direct"] += direct.reshape(h, w, 3)
-        self.acc["indirect"] += indirect.reshape(h, w, 3)
-        self.acc["alpha"] += alpha.reshape(h, w)
-        if resampled:
-            self.acc["res_m"] += res_m.reshape(h, w)
-            self.acc["res_w"] += res_w.reshape(h, w)
+    def _accumulate(self, chunks, resampled: bool, stop) -> None:
+        """Add the chunks' results to the running sums (chunks hold disjoint pixels: one pool task each)."""
+        flat = {k: a.reshape(len(a) * a.shape[1], -1) if a.ndim == 3 else a.reshape(-1) for k, a in self.acc.items()}
 
+        def add(c: _Chunk):
+            flat["emit"][c.pixels] += c.hits.emitted
+            flat["alpha"][c.pixels] += c.hits.alpha
+            pix = c.pixels[c.hits.rows]
+            flat["direct"][pix] += c.direct
+            if c.indirect is not None:
+                flat["indirect"][pix] += c.indirect
+            if resampled:
+                flat["res_m"][pix] += c.res.M
+                flat["res_w"][pix] += c.res.W
+
+        self._map(add, chunks, stop)
 
     def combined(self) -> np.ndarray:
         """The running mean of Combined (h, w, 4) float32."""
@@ -402,15 +391,22 @@ class FrameRenderer:
 
     def passes(self) -> dict:
         """All passes (see :class:`FrameResult`); float32, finite everywhere."""
-        inv = 1.0 / max(1, self.samples_done)
-        mean = lambda key: _finite((self.acc[key] * inv).astype(np.float32))  # noqa: E731
-        out = {"Combined": self.combined(), "Direct": mean("direct"), "Indirect": mean("indirect"),
-               "Emission": mean("emit")}
+        inv = np.float32(1.0 / max(1, self.samples_done))
+
+        def mean(key):
+            a = self.acc[key]
+            out = np.multiply(a, inv, out=np.empty(a.shape, np.float32), casting="unsafe")
+            return _finite(out if out.ndim == 3 else out[..., None])
+
+        jobs = {"Combined": self.combined, "Direct": lambda: mean("direct"), "Indirect": lambda: mean("indirect"),
+                "Emission": lambda: mean("emit")}
+        if self.candidates is not None:
+            jobs["Reservoir M"] = lambda: mean("res_m")
+            jobs["Reservoir UCW"] = lambda: mean("res_w")
+        run = map if in_worker() else pool().map  # one pass per pool task (inline inside a worker)
+        out = dict(zip(jobs, run(lambda job: job(), jobs.values())))
         if self.settings.data_passes:
             out["Depth"], out["Normal"], out["Vector"] = (_finite(a) for a in self.data_passes())
-        if self.candidates is not None:
-            out["Reservoir M"] = mean("res_m")[..., None]
-            out["Reservoir UCW"] = mean("res_w")[..., None]
         return out
 
 
