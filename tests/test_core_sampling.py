@@ -52,3 +52,18 @@ def test_uniform_triangle_is_uniform():
     # mean barycentric of a uniform point is 1/3 each; sd of each is sqrt(1/18)
     se = np.sqrt(1 / 18 / 200_000)
     assert abs(b1.mean() - 1 / 3) < 5 * se and abs(b2.mean() - 1 / 3) < 5 * se
+
+
+def test_uniform_ints_cover_the_range_uniformly():
+    """Multiply-shift integers: inside [0, high), every value about equally often (chi-square, 1e-4 level),
+    same for the same stream."""
+    from restir_engine.core.sampling import uniform_ints
+    for high in (7, 1024):
+        k = uniform_ints(rng(1, 2, 3, 4), high, (50, 4000))
+        assert k.shape == (50, 4000) and k.min() == 0 and k.max() == high - 1
+        counts = np.bincount(k.ravel(), minlength=high)
+        expected = k.size / high
+        chi2 = ((counts - expected) ** 2 / expected).sum()
+        # chi-square with high - 1 degrees of freedom: mean high - 1, sd sqrt(2 (high - 1)); 4.5 sd ~ p < 1e-4
+        assert chi2 < (high - 1) + 4.5 * np.sqrt(2 * (high - 1)), chi2
+        assert np.array_equal(k, uniform_ints(rng(1, 2, 3, 4), high, (50, 4000)))

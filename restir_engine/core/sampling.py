@@ -25,6 +25,14 @@ def rng(seed: int, frame: int, pass_index: int, stream: int, chunk: int = 0) -> 
     return np.random.Generator(np.random.Philox(np.random.SeedSequence(key)))
 
 
+def uniform_ints(rng: np.random.Generator, high: int, shape) -> np.ndarray:
+    """Integers uniform in [0, high) (int64 array of ``shape``) from 32 random bits each by multiply-shift
+    (⌊u · high / 2³²⌋: no rejection loop; the non-uniformity is below high / 2³², e.g. 2e-7 for 1024)."""
+    count = int(np.prod(shape))
+    raw = rng.bit_generator.random_raw((count + 1) // 2).view(np.uint32)[:count]
+    return ((raw.astype(np.uint64) * np.uint64(high)) >> np.uint64(32)).astype(np.int64).reshape(shape)
+
+
 class AliasTable:
     """Walker/Vose alias table for O(1) sampling proportional to non-negative weights.
 
