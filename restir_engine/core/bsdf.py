@@ -192,6 +192,7 @@ class ViewTerms:
     co: np.ndarray
     spec_on: np.ndarray
     p_spec: np.ndarray
+    glossy: bool = True  # False: no surface has a specular lobe (Diffuse BSDFs only): Lambert alone
 
     @staticmethod
     def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None) -> "ViewTerms":
@@ -201,7 +202,8 @@ class ViewTerms:
         e = view_albedo(p, wo) if albedo is None else albedo
         comp = 1.0 + p.f0 * ((1.0 - e) / e)[:, None]
         return ViewTerms(p.diffuse * (fd * INV_PI)[:, None], p.f0 * comp, (1.0 - p.f0) * comp, p.alpha,
-                         p.alpha * p.alpha, smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec)
+                         p.alpha * p.alpha, smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec,
+                         bool((p.spec_on > 0).any() or (p.p_spec > 0).any()))
 
 
 def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
@@ -211,6 +213,9 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     co = v.co
     ci = wi[:, 2]
     valid = (co > 0) & (ci > 0)
+    if not v.glossy:
+        pdf = np.maximum(ci, np.float32(0.0)) * INV_PI * valid
+        return (v.kd * valid[:, None]).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
     wdw = dot(wo, wi)
     hinv = 1.0 / np.sqrt(np.maximum(2.0 + 2.0 * wdw, np.float32(1e-24)))
     cos_h = np.clip((co + ci) * hinv, 0, 1)
