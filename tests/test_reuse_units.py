@@ -123,7 +123,7 @@ def _gbuffer(depth, ns=None, material=(0, 0, 0)):
     n = len(depth)
     gb = GBuffer(None, np.arange(n), n, 1, np.array(depth, F), np.zeros(n, np.int32),
                  Terms(np.arange(n), np.zeros((3, n))))
-    gb.ns = np.tile(np.array([0, 0, 1], F), (n, 1)) if ns is None else np.array(ns, F)
+    gb.normals = np.tile(np.array([[0], [0], [1]], F), (1, n)) if ns is None else np.array(ns, F)
     gb.material = np.array(material, np.int32)
     return gb
 

@@ -3,12 +3,13 @@
 Stages of a sample pass (each timed by a profile.StageClock when one is given):
   primary   camera rays, emission seen directly, the G-buffer (every integrator)
   initial   ReSTIR/RIS: light tiles, target terms and initial resampling (light + BSDF candidates)
+  paths     the first vertex's BSDF ray and bounces 1..max_bounces (pathtracer.continue_paths); it needs no
+            reservoir, so it runs before reuse and the first BSDF candidate's ray it takes over is freed early
   gbuffer   ReSTIR: the frame's G-buffer and reservoirs assembled from the chunks
   temporal  ReSTIR, first pass of a frame: merge with the previous frame's reservoirs
   boiling   ReSTIR biased mode with the boiling filter
   spatial   ReSTIR: spatial reuse passes
   shade     direct light: the reservoirs' samples with shadow rays (ReSTIR/RIS), or next-event estimation
-  paths     the first vertex's BSDF ray and bounces 1..max_bounces (pathtracer.continue_paths)
   passes    accumulation into the running means
 Images are (h, w, c) float32 with row 0 at the *bottom* (Blender's pass order), covering the camera window
 (border) only. Pixels are row-major over the window; a chunk is a span of CHUNK_PIXELS pixels and its
@@ -37,7 +38,7 @@ from .restir.history import TemporalHistory
 from .sampling import (STREAM_CAMERA, STREAM_INITIAL, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL,
                        STREAM_TILES, rng)
 from .scene import Scene
-from .target import ShadingTerms
+from .target import WIDTH, ShadingTerms
 
 INTEGRATORS = ("PATH", "RESTIR")
 CHUNK_PIXELS = 16384  # pixels per chunk of work (its working set stays in the 4 MB L2 of a core)
@@ -256,11 +257,12 @@ class FrameRenderer:
             candidates = dataclasses.replace(candidates, tiles=tiles)
             self.used_tiles = True
         continuing = pathtracer.needs_continuation(ctx, resampled)
-        terms = [None] * len(chunks)
+        # the frame's target terms, one (27, surfaces) block the chunks write into (reuse gathers from it)
+        terms = np.empty((WIDTH, first), np.float32) if resampled else None
 
         def initial(c: _Chunk):
             surf = c.hits.surf
-            terms[c.index] = t = ShadingTerms.of_surfaces(surf)
+            t = ShadingTerms.of_surfaces(surf, terms[:, c.surfaces])
             pix = c.pixels[c.hits.rows]
             c.res, c.bsdf_ray = di.initial_ris(ctx, surf, t, rng(st.seed, st.frame, s, STREAM_INITIAL, c.index),
                                                candidates, pix % w, pix // w, keep_bsdf_ray=continuing)
@@ -268,37 +270,37 @@ class FrameRenderer:
         if resampled:
             with clock.stage("initial"):
                 self._map(initial, chunks, stop)
-        res = gb = None
+
+        def paths(c: _Chunk):
+            """Before reuse: the continuation needs no reservoir, and its first ray is freed early."""
+            if not continuing:
+                c.direct, c.indirect = None, None
+                return
+            c.direct, c.indirect = pathtracer.continue_paths(
+                ctx, c.hits.surf, rng(st.seed, st.frame, s, STREAM_PATH, c.index), direct_resampled=resampled,
+                first_ray=c.bsdf_ray)
+            c.bsdf_ray = None
+
+        with clock.stage("paths"):
+            self._map(paths, chunks, stop)
         if reusing:
             with clock.stage("gbuffer"):
                 gb = self._gbuffer(chunks, terms)
                 res = di.DIReservoirs.empty(len(gb))
                 for c in chunks:
                     res.assign(c.surfaces, c.res)
+                    c.res = None  # the frame's array holds them now
             res = self._reuse(gb, res, s)
             for c in chunks:
                 c.res = res.take(c.surfaces)
 
         def shade(c: _Chunk):
             r = rng(st.seed, st.frame, s, STREAM_SHADE, c.index)
-            if resampled:
-                c.direct = di.shade(ctx, c.hits.surf, c.res, r)
-            else:
-                c.direct = pathtracer.next_event(ctx, c.hits.surf, r)
+            direct = di.shade(ctx, c.hits.surf, c.res, r) if resampled else pathtracer.next_event(ctx, c.hits.surf, r)
+            c.direct = direct if c.direct is None else c.direct + direct
 
         with clock.stage("shade"):
             self._map(shade, chunks, stop)
-
-        def paths(c: _Chunk):
-            if not continuing:
-                c.indirect = None
-                return
-            d, c.indirect = pathtracer.continue_paths(ctx, c.hits.surf, rng(st.seed, st.frame, s, STREAM_PATH, c.index),
-                                                      direct_resampled=resampled, first_ray=c.bsdf_ray)
-            c.direct += d
-
-        with clock.stage("paths"):
-            self._map(paths, chunks, stop)
         with clock.stage("passes"):
             self._accumulate(chunks, resampled, stop)
 
@@ -307,15 +309,15 @@ class FrameRenderer:
         cam = self.ctx.scene.camera
         _x0, _y0, w, h = cam.window
         surfs = [c.hits.surf for c in chunks]
-        p = np.concatenate([sf.p for sf in surfs])
-        depth = (p - camera_mod.position(cam)) @ camera_mod.forward(cam)
+        rel = terms[0:3] - camera_mod.position(cam)[:, None]
+        fwd = camera_mod.forward(cam)
+        depth = fwd[0] * rel[0] + fwd[1] * rel[1] + fwd[2] * rel[2]  # planar depth along the camera axis
         inst = self.ctx.scene.geometry.instance
         prim = np.concatenate([sf.prim for sf in surfs])
         gb = GBuffer(None, np.concatenate([c.pixels[c.hits.rows] for c in chunks]), w, h, depth.astype(np.float32),
                      inst[prim] if inst is not None else np.zeros(len(prim), np.int32),
-                     ShadingTerms(np.concatenate([t.packed for t in terms], axis=1)))
+                     ShadingTerms(terms))
         gb.material = np.concatenate([sf.mat for sf in surfs])
-        gb.ns = np.concatenate([sf.ns for sf in surfs])
         return gb
 
     def _spans(self, n: int):
@@ -342,7 +344,9 @@ class FrameRenderer:
                 parts = list(pool().map(lambda a: (a[1], reuse.temporal_reuse(
                     space, gb, res, now, hist, prepared, a[1], st.confidence_cap, st.bias_correction, motion,
                     rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]), possible)), enumerate(spans)))
+                del prepared, now
                 res = _gather(space.kind, parts, len(gb))
+                del parts
         if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode
             with clock.stage("boiling"):
                 self.boiling_dropped += int(boiling_filter(res, gb.pix, gb.width, gb.height,
@@ -353,7 +357,9 @@ class FrameRenderer:
                 parts = list(pool().map(lambda a: (a[1], reuse.spatial_reuse(
                     space, gb, res, prepared, a[1], self.spatial, rng(st.seed, st.frame, s, STREAM_SPATIAL + k, a[0]))),
                     enumerate(spans)))
+                del prepared
                 res = _gather(space.kind, parts, len(gb))
+                del parts
         if s == 0:  # the next frame's history; confidence at most the cap, so no reused M ever exceeds it
             lights = ctx.lights
             self.history = TemporalHistory(gb.for_history(), res.replace(M=np.minimum(res.M, st.confidence_cap)),

@@ -47,10 +47,11 @@ class ShadingTerms:
         return self.packed.shape[1]
 
     @staticmethod
-    def of_surfaces(surf) -> "ShadingTerms":
-        """Terms of surfaces ``surf`` (a surface.Surface: p, ng, ns, wo, wo_l, params)."""
+    def of_surfaces(surf, out: np.ndarray | None = None) -> "ShadingTerms":
+        """Terms of surfaces ``surf`` (a surface.Surface: p, ng, ns, wo, wo_l, params), written into ``out``
+        ((27, n) float32, e.g. a slice of a frame's block) when given."""
         prm = surf.params
-        packed = np.empty((WIDTH, len(surf.p)), np.float32)
+        packed = np.empty((WIDTH, len(surf.p)), np.float32) if out is None else out
         packed[LAYOUT["p"]] = surf.p.T
         packed[LAYOUT["ng"]] = surf.ng.T
         packed[LAYOUT["ns"]] = surf.ns.T

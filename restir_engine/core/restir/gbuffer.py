@@ -2,8 +2,9 @@
 
 Surface i (surface.Surface rows, only pixels whose camera ray hit something) lies at window pixel pix[i]
 (row-major, row 0 at the bottom); ``slot`` maps a pixel back to its surface (-1: nothing hit). Beside the
-surfaces: planar depth along the camera axis (scene units), material and instance indices, shading normals
-(n, 3) for similarity tests and the target function's packed terms (target.ShadingTerms, (27, n))."""
+surfaces: planar depth along the camera axis (scene units), material and instance indices, the target
+function's packed terms (target.ShadingTerms, (27, n)) and their shading-normal rows ``normals`` (3, n)
+for similarity tests."""
 from __future__ import annotations
 
 import numpy as np
@@ -20,8 +21,8 @@ class GBuffer:
         self.depth = depth
         self.instance = instance
         self.material = surf.mat if surf is not None else None
-        self.ns = surf.ns if surf is not None else None
         self.terms = terms
+        self.normals = getattr(terms, "ns", None)
         self.slot = np.full(width * height, -1, np.int64)
         self.slot[pix] = np.arange(len(pix))
 

@@ -29,15 +29,11 @@ NORMAL_COS = 0.906       # cos 25°: shading normals further apart are rejected
 BIAS_CORRECTIONS = ("NONE", "UNBIASED")
 
 
-def rows_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
-
-
 def similar(depth_ref: np.ndarray, depth: np.ndarray, ns_ref: np.ndarray, ns: np.ndarray) -> np.ndarray:
-    """Whether a neighbour's surface (planar depth, shading normal (n, 3)) may share samples with the
+    """Whether a neighbour's surface (planar depth, shading normal as (3, n) rows) may share samples with the
     reference: depth within DEPTH_TOLERANCE of the reference's and normals within 25°."""
     ok = np.abs(depth - depth_ref) <= DEPTH_TOLERANCE * np.maximum(depth_ref, 1e-6)
-    ok &= rows_dot(ns, ns_ref) >= NORMAL_COS
+    ok &= ns[0] * ns_ref[0] + ns[1] * ns_ref[1] + ns[2] * ns_ref[2] >= NORMAL_COS
     return ok
 
 
@@ -155,7 +151,7 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
     offs = neighbor_offsets(cfg.neighbors, cfg.radius, rng, n)
     canonical = res.take(rows)
     own = space.gather(prepared, rows) if unbiased else None
-    depth_c, ns_c = gb.depth[rows], np.take(gb.ns, rows, axis=0)
+    depth_c, ns_c = gb.depth[rows], np.take(gb.normals, rows, axis=1)
     own_ok = canonical.has_sample()
     has = res.has_sample()
     neighbours, taken = [], []
@@ -170,7 +166,7 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
         for q_prev in taken:
             ok &= q != q_prev
         q = np.where(ok, q, rows)
-        ok &= similar(depth_c, gb.depth[q], ns_c, np.take(gb.ns, q, axis=0))
+        ok &= similar(depth_c, gb.depth[q], ns_c, np.take(gb.normals, q, axis=1))
         q = np.where(ok, q, rows)
         taken.append(q)
         m_q = res.M[q] * ok
@@ -213,7 +209,8 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     q = prev_gb.slot[np.where(inside, py * w + px, 0)]
     ok = inside & (q >= 0)
     q = np.where(ok, q, 0)
-    ok &= similar(depth_then, prev_gb.depth[q], np.take(gb.ns, rows, axis=0), np.take(prev_gb.ns, q, axis=0))
+    ok &= similar(depth_then, prev_gb.depth[q], np.take(gb.normals, rows, axis=1),
+                  np.take(prev_gb.normals, q, axis=1))
     ok &= prev_gb.material[q] == gb.material[rows]
     canonical = res.take(rows)
     prev = hist.res
