@@ -50,8 +50,10 @@ def light_near_the_floor(width=32):
 
 
 def test_biased_mode_filter_cuts_outliers():
-    """1/M with temporal + spatial reuse under a small light close to the floor: with the filter the
-    per-pixel variance across seeds falls, and the image only gets darker (the filter's bias)."""
+    """1/M with temporal + spatial reuse under a small light close to the floor: with the filter the upper
+    tail of the pixel values falls (the 99th percentile over pixels and seeds: 0.34 -> 0.27 here; the
+    per-pixel variance, dominated by a few pixels right under the light that the filter keeps, changes by
+    about 1 % and is not a usable criterion), and the image only gets darker (the filter's bias)."""
     scene = light_near_the_floor()
     st = dict(RESTIR, samples=4, bias_correction="NONE")
     off = np.array([render_frame(scene, RenderSettings(**st, seed=s)).passes["Direct"][..., 0] for s in range(6)])
@@ -60,5 +62,5 @@ def test_biased_mode_filter_cuts_outliers():
     on = np.array([r.passes["Direct"][..., 0] for r in runs])
     assert min(r.stats["boiling_dropped"] for r in runs) > 0
     assert np.isfinite(on).all()
-    assert on.var(axis=0).mean() < off.var(axis=0).mean()
+    assert np.quantile(on, 0.99) < 0.9 * np.quantile(off, 0.99)
     assert on.mean() < off.mean()

@@ -2,9 +2,21 @@
 import numpy as np
 import pytest
 
-from restir_engine.core.bsdf import SurfaceParams, eval_bsdf, sample_bsdf
+from restir_engine.core import bsdf
+from restir_engine.core.bsdf import SurfaceParams
 
 N = 400_000
+
+
+# the core keeps vectors as (3, n) rows; these tests read (n, 3) rows
+def eval_bsdf(p, wo, wi):
+    f, pdf = bsdf.eval_bsdf(p, np.ascontiguousarray(wo.T), np.ascontiguousarray(wi.T))
+    return f.T, pdf
+
+
+def sample_bsdf(p, wo, u_lobe, u1, u2):
+    wi, f, pdf = bsdf.sample_bsdf(p, np.ascontiguousarray(wo.T), u_lobe, u1, u2)
+    return wi.T, f.T, pdf
 
 
 def params(n, base, metallic, roughness, f0):

@@ -14,21 +14,22 @@ from restir_engine.core.target import ShadingTerms
 
 
 class _Surf:
-    """Random surfaces: positions in a box, tilted shading normals, mixed diffuse / glossy / metal."""
+    """Random surfaces: positions in a box, tilted shading normals, mixed diffuse / glossy / metal (vectors
+    as (3, n) rows, like the core's)."""
 
     def __init__(self, n, g, diffuse_only=False):
-        self.p = g.uniform(-1, 1, (n, 3)).astype(np.float32)
+        p = g.uniform(-1, 1, (n, 3))
         ng = g.normal(size=(n, 3))
         ng /= np.linalg.norm(ng, axis=1)[:, None]
         ns = ng + 0.2 * g.normal(size=(n, 3))
         ns /= np.linalg.norm(ns, axis=1)[:, None]
-        self.ng, self.ns = ng.astype(np.float32), ns.astype(np.float32)
+        self.p, self.ng, self.ns = (np.ascontiguousarray(a.T, dtype=np.float32) for a in (p, ng, ns))
         self.t, self.bt = orthonormal_basis(self.ns)
-        wo = self.ns + 0.8 * g.normal(size=(n, 3))
+        wo = ns + 0.8 * g.normal(size=(n, 3))
         wo /= np.linalg.norm(wo, axis=1)[:, None]
-        wo_l = to_local(wo.astype(np.float32), self.ns, self.t, self.bt)
-        wo_l[:, 2] = np.maximum(wo_l[:, 2], 1e-4)
-        self.wo_l = (wo_l / np.linalg.norm(wo_l, axis=1)[:, None]).astype(np.float32)
+        wo_l = to_local(np.ascontiguousarray(wo.T, dtype=np.float32), self.ns, self.t, self.bt)
+        wo_l[2] = np.maximum(wo_l[2], 1e-4)
+        self.wo_l = (wo_l / np.linalg.norm(wo_l, axis=0)).astype(np.float32)
         kind = g.integers(0, 1 if diffuse_only else 3, n)
         base = g.uniform(0.05, 0.95, (n, 3)).astype(np.float32)
         self.params = SurfaceParams.from_material(base, (kind == 2).astype(np.float32),
@@ -44,20 +45,20 @@ def test_packed_target_matches_the_bsdf_model(diffuse_only):
     g = np.random.default_rng(3)
     n = 4000
     surf = _Surf(n, g, diffuse_only)
+    nl = g.normal(size=(3, n))
     pts = light_tiles.LightPoints(np.zeros(n, np.int32), np.zeros(n, np.float32), np.zeros(n, np.float32),
-                                  g.uniform(-2, 2, (n, 3)).astype(np.float32), np.zeros((n, 3), np.float32),
-                                  g.uniform(0, 5, (n, 3)).astype(np.float32), np.ones(n, np.float32),
+                                  g.uniform(-2, 2, (3, n)).astype(np.float32),
+                                  (nl / np.linalg.norm(nl, axis=0)).astype(np.float32),
+                                  g.uniform(0, 5, (3, n)).astype(np.float32), np.ones(n, np.float32),
                                   g.random(n) < 0.5, np.full(n, -1, np.int32))
-    nl = g.normal(size=(n, 3))
-    pts.normal[:] = nl / np.linalg.norm(nl, axis=1)[:, None]
     terms = ShadingTerms.of_surfaces(surf)
     assert terms.glossy != diffuse_only
     p_hat, pdf = terms.evaluate(light_tiles.PackedPoints.of(pts.packed()))
     d = pts.pos - surf.p
-    dist = np.linalg.norm(d, axis=1)
-    wi = (d / dist[:, None]).astype(np.float32)
-    cos_l = -np.einsum("ij,ij->i", wi, pts.normal)
-    le = np.where(((cos_l > 0) | pts.two_sided)[:, None], pts.le, 0.0).astype(np.float32)
+    dist = np.linalg.norm(d, axis=0)
+    wi = (d / dist).astype(np.float32)
+    cos_l = -(wi * pts.normal).sum(axis=0)
+    le = np.where((cos_l > 0) | pts.two_sided, pts.le, 0.0).astype(np.float32)
     ref_p, _f, _g, ref_pdf = shading_value(surf, wi, le, dist.astype(np.float32), cos_l.astype(np.float32))
     assert (ref_p > 0).mean() > 0.2 and (ref_p == 0).mean() > 0.2  # both cases exercised
     np.testing.assert_allclose(p_hat, ref_p, rtol=2e-3, atol=1e-6 * ref_p.max())

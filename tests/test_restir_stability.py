@@ -164,11 +164,13 @@ def test_thousands_of_tiny_lights():
     w = r.passes["Reservoir UCW"]
     assert np.isfinite(w).all() and (w >= 0).all() and w.mean() > 0
     assert r.history.res.M.max() <= 10.0
-    # the Direct pass: the lights seen directly only add pixel-coverage noise, the same for both renderers
+    # the Direct pass: the lights seen directly only add pixel-coverage noise, the same for both renderers.
+    # Per-seed standard deviations (measured over 30-60 seeds): ReSTIR ~55, path tracer ~90 on a mean of
+    # ~1950; 10 + 24 seeds give se ~25, well inside the 2 % (39) the test needs to see a 10 % error.
     a = np.array([render_frame(scene, RenderSettings(**{**RESTIR, "samples": 2, "seed": s})).passes["Direct"].mean()
                   for s in range(10)])
     b = np.array([render_frame(scene, RenderSettings(samples=2, max_bounces=0, seed=100 + s)).passes["Direct"].mean()
-                  for s in range(10)])
+                  for s in range(24)])
     se = np.sqrt(a.var(ddof=1) / len(a) + b.var(ddof=1) / len(b))
     assert se < 0.02 * b.mean()
     assert abs(a.mean() - b.mean()) < 5 * se, (a.mean(), b.mean(), se)

@@ -3,6 +3,8 @@
 ``embreex``'s ``EmbreeScene.run`` is a single-threaded loop over rtcIntersect1/rtcOccluded1
 that releases the GIL, so chunks of rays run concurrently on a shared thread pool.
 ``tnear`` is fixed at 0 by embreex: callers must offset origins (see :func:`offset_origin`).
+Rays are (3, n) rows like every vector of the core; each call transposes them into the (n, 3) arrays
+``EmbreeScene.run`` reads.
 """
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from .profile import add_embree_seconds
-from .sampling import dot, norm, row_max
+from .sampling import dot, norm, vmax
 
 CHUNK_RAYS = 32768  # rays per Embree call: large enough to amortize the call, small for load balance
 
@@ -48,17 +50,17 @@ def pool() -> ThreadPoolExecutor:
 
 
 def offset_origin(p: np.ndarray, ng: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """Move points off their surface along the geometric normal, to the side ``direction`` leaves by.
-
-    The offset scales with the coordinate magnitude (float32 spacing) so it works at any scene scale.
-    """
-    side = np.where(dot(ng, direction) >= 0.0, 1.0, -1.0).astype(np.float32)
-    mag = np.maximum(row_max(np.abs(p)), np.float32(1.0))
-    return (p + ng * (side * mag * np.float32(1e-4))[:, None]).astype(np.float32, copy=False)
+    """Move points p (3, n) off their surface along the geometric normal ng (3, n), to the side ``direction``
+    (3, n) leaves by. The offset scales with the coordinate magnitude (float32 spacing), so it works at any
+    scene scale."""
+    side = np.where(dot(ng, direction) >= 0.0, np.float32(1.0), np.float32(-1.0))
+    mag = np.maximum(vmax(np.abs(p)), np.float32(1.0))
+    return (p + ng * (side * mag * np.float32(1e-4))).astype(np.float32, copy=False)
 
 
 def shadow_rays(p: np.ndarray, ng: np.ndarray, light_pos: np.ndarray, wi: np.ndarray, dist: np.ndarray):
-    """Origins, unit directions and tmax of shadow rays from surface points p towards light points.
+    """Origins (3, n), unit directions (3, n) and tmax (n,) of shadow rays from surface points p towards light
+    points.
 
     The direction and length are recomputed from the *offset* origin: at grazing angles the offset
     along the normal changes the distance to the light's plane by far more than any epsilon, so a
@@ -70,11 +72,11 @@ def shadow_rays(p: np.ndarray, ng: np.ndarray, light_pos: np.ndarray, wi: np.nda
     if finite.all():
         d = light_pos - o
         ln = norm(d)
-        d /= np.maximum(ln, np.float32(1e-30))[:, None]
+        d /= np.maximum(ln, np.float32(1e-30))
         return o, d.astype(np.float32, copy=False), (ln * np.float32(1.0 - 1e-4)).astype(np.float32, copy=False)
-    d = np.where(finite[:, None], light_pos - o, wi)
+    d = np.where(finite, light_pos - o, wi)
     ln = norm(d)
-    d = d / np.maximum(ln, 1e-30)[:, None]
+    d = d / np.maximum(ln, 1e-30)
     far = np.where(finite, ln * (1.0 - 1e-4), 1e30)
     return o, d.astype(np.float32), far.astype(np.float32)
 
@@ -113,14 +115,14 @@ class Accel:
         return [(s, min(n, s + CHUNK_RAYS)) for s in range(0, n, CHUNK_RAYS)]
 
     def intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
-        """Closest hit of each ray (origins/directions (n, 3) float32; directions need not be unit,
+        """Closest hit of each ray (origins/directions (3, n) float32 rows; directions need not be unit,
         ``t`` is then in units of the direction length)."""
-        n = len(origins)
+        n = origins.shape[1]
         hits = Hits(n)
         if self._scene is None or n == 0:
             return hits
-        o = np.ascontiguousarray(origins, dtype=np.float32)
-        d = np.ascontiguousarray(directions, dtype=np.float32)
+        o = np.ascontiguousarray(origins.T, dtype=np.float32)  # Embree reads (n, 3) rays
+        d = np.ascontiguousarray(directions.T, dtype=np.float32)
         far = None if tmax is None else np.ascontiguousarray(tmax, dtype=np.float32)
 
         def work(span):
@@ -139,13 +141,13 @@ class Accel:
         return hits
 
     def occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
-        """True where something lies on the segment origin + t*direction, 0 < t < tmax."""
-        n = len(origins)
+        """True where something lies on the segment origin + t*direction, 0 < t < tmax (rays as (3, n) rows)."""
+        n = origins.shape[1]
         out = np.zeros(n, dtype=bool)
         if self._scene is None or n == 0:
             return out
-        o = np.ascontiguousarray(origins, dtype=np.float32)
-        d = np.ascontiguousarray(directions, dtype=np.float32)
+        o = np.ascontiguousarray(origins.T, dtype=np.float32)
+        d = np.ascontiguousarray(directions.T, dtype=np.float32)
         far = np.ascontiguousarray(tmax, dtype=np.float32)
 
         def work(span):

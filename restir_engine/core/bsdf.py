@@ -1,8 +1,8 @@
 """Lambert diffuse + GGX specular BSDF, vectorized.
 
-All directions are in the local shading frame (z = shading normal), unit length,
-``wo`` towards the viewer, ``wi`` towards the light. ``eval`` returns f (n, 3) without the
-cosine, pdfs are in solid-angle measure.
+All directions are (3, n) rows (x, y, z) in the local shading frame (z = shading normal), unit length,
+``wo`` towards the viewer, ``wi`` towards the light; colours are (3, n) rows (R, G, B). ``eval`` returns
+f (3, n) without the cosine; pdfs are in solid-angle measure.
 
 Model (an approximation of the Principled BSDF):
   diffuse  = base·(1-metallic)/π · (1 - F_d(cos_o))      F_d: Schlick with the dielectric f0
@@ -28,13 +28,18 @@ INV_PI = np.float32(1.0 / np.pi)
 
 
 def luminance(rgb: np.ndarray) -> np.ndarray:
-    """Rec. 709 luminance of scene-linear RGB rows (..., 3)."""
+    """Rec. 709 luminance of scene-linear RGB in the last axis (..., 3)."""
     return np.float32(0.2126) * rgb[..., 0] + np.float32(0.7152) * rgb[..., 1] + np.float32(0.0722) * rgb[..., 2]
+
+
+def luminance_rows(rgb: np.ndarray) -> np.ndarray:
+    """Rec. 709 luminance of scene-linear RGB as (3, ...) rows."""
+    return np.float32(0.2126) * rgb[0] + np.float32(0.7152) * rgb[1] + np.float32(0.0722) * rgb[2]
 
 
 @dataclass
 class SurfaceParams:
-    """Per-hit (or per-material) BSDF parameters: diffuse (n, 3), f0 (n, 3), f0_dielectric (n,),
+    """Per-hit (or per-material) BSDF parameters: diffuse (3, n), f0 (3, n) (RGB rows), f0_dielectric (n,),
     alpha (n,), p_spec (n,) probability of sampling the specular lobe, spec_on (n,) 1 where a specular
     lobe exists (0 for Diffuse BSDF)."""
 
@@ -45,26 +50,37 @@ class SurfaceParams:
     p_spec: np.ndarray
     spec_on: np.ndarray
 
-    def take(self, rows: np.ndarray) -> "SurfaceParams":
-        if isinstance(rows, np.ndarray) and rows.dtype != bool:
-            return SurfaceParams(np.take(self.diffuse, rows, axis=0), np.take(self.f0, rows, axis=0),
-                                 self.f0_dielectric[rows], self.alpha[rows], self.p_spec[rows], self.spec_on[rows])
-        return SurfaceParams(self.diffuse[rows], self.f0[rows], self.f0_dielectric[rows], self.alpha[rows],
-                             self.p_spec[rows], self.spec_on[rows])
+    def take(self, idx) -> "SurfaceParams":
+        """Parameters of entries ``idx`` (index array or slice)."""
+        if isinstance(idx, slice):
+            return SurfaceParams(self.diffuse[:, idx], self.f0[:, idx], self.f0_dielectric[idx], self.alpha[idx],
+                                 self.p_spec[idx], self.spec_on[idx])
+        return SurfaceParams(np.take(self.diffuse, idx, axis=1), np.take(self.f0, idx, axis=1),
+                             self.f0_dielectric[idx], self.alpha[idx], self.p_spec[idx], self.spec_on[idx])
+
+    def assign(self, idx, other: "SurfaceParams") -> None:
+        """self[idx] = other (every field)."""
+        self.diffuse[:, idx] = other.diffuse
+        self.f0[:, idx] = other.f0
+        for name in ("f0_dielectric", "alpha", "p_spec", "spec_on"):
+            getattr(self, name)[idx] = getattr(other, name)
 
     @staticmethod
     def from_material(base: np.ndarray, metallic: np.ndarray, roughness: np.ndarray, f0_d: np.ndarray):
-        m = np.clip(metallic, 0, 1)[:, None]
-        f0 = (f0_d[:, None] * (1 - m) + base * m).astype(np.float32)
+        """From base colours (m, 3) (scene-linear RGB, as the material table stores them), metallic,
+        roughness and the dielectric f0 (m,)."""
+        base = np.asarray(base, np.float32).T
+        m = np.clip(metallic, 0, 1)
+        f0 = (f0_d * (1 - m) + base * m).astype(np.float32)
         diffuse = (base * (1 - m)).astype(np.float32)
         alpha = np.maximum(np.clip(roughness, 0, 1) ** 2, ALPHA_MIN).astype(np.float32)
-        ws = luminance(f0)
-        wd = luminance(diffuse) * (1 - f0_d)
+        ws = luminance_rows(f0)
+        wd = luminance_rows(diffuse) * (1 - f0_d)
         tot = ws + wd
         p = np.where(tot > 0, ws / np.maximum(tot, 1e-12), 0.0)
         both = (ws > 0) & (wd > 0)
         p = np.where(both, np.clip(p, 0.1, 0.9), p).astype(np.float32)
-        spec_on = (f0.max(axis=1) > 0).astype(np.float32)
+        spec_on = (f0.max(axis=0) > 0).astype(np.float32)
         return SurfaceParams(diffuse, f0, f0_d.astype(np.float32), alpha, p, spec_on)
 
 
@@ -172,14 +188,14 @@ def smith_lambda(alpha, cos):
 def view_albedo(p: SurfaceParams, wo: np.ndarray) -> np.ndarray:
     """GGX directional albedo E(μo, α) (n,) of the view directions: depends on wo only, so callers that
     evaluate many wi for the same wo compute it once and pass it to :func:`eval_bsdf`."""
-    return ggx_albedo(p.alpha, np.clip(wo[:, 2], 0, 1))
+    return ggx_albedo(p.alpha, np.clip(wo[2], 0, 1))
 
 
 @dataclass
 class ViewTerms:
     """The factors of f and its pdf that depend on the view direction only, per surface (n): computed once
     and reused by every wi evaluated there (next-event estimation, BSDF sampling, shading).
-    kd (n, 3) = diffuse (1 - F_d(cos θ_o)) / π; spec_a, spec_b (n, 3) = f0 · c, (1 - f0) · c with c the
+    kd (3, n) = diffuse (1 - F_d(cos θ_o)) / π; spec_a, spec_b (3, n) = f0 · c, (1 - f0) · c with c the
     energy compensation 1 + f0 (1 - E)/E (so the specular lobe is D G / (4 cos θ_o cos θ_i) · (spec_a + c⁵
     spec_b), c⁵ = (1 - ωo·h)⁵); alpha, alpha2, lam_o = Λ(ωo), co = cos θ_o, spec_on, p_spec (n,)."""
 
@@ -196,26 +212,26 @@ class ViewTerms:
 
     @staticmethod
     def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None) -> "ViewTerms":
-        co = wo[:, 2]
+        co = wo[2]
         # a lobe with f0 = 0 does not exist (Diffuse BSDF): no Fresnel split, no grazing specular
         fd = np.where(p.f0_dielectric > 0, 1.0 - schlick(p.f0_dielectric, co), np.float32(1.0))
         e = view_albedo(p, wo) if albedo is None else albedo
-        comp = 1.0 + p.f0 * ((1.0 - e) / e)[:, None]
-        return ViewTerms(p.diffuse * (fd * INV_PI)[:, None], p.f0 * comp, (1.0 - p.f0) * comp, p.alpha,
+        comp = 1.0 + p.f0 * ((1.0 - e) / e)
+        return ViewTerms(p.diffuse * (fd * INV_PI), p.f0 * comp, (1.0 - p.f0) * comp, p.alpha,
                          p.alpha * p.alpha, smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec,
                          bool((p.spec_on > 0).any() or (p.p_spec > 0).any()))
 
 
 def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
-    """f (n, 3) and pdf (n,) (solid angle) of unit directions wi at surfaces with view terms ``v``. The half
+    """f (3, n) and pdf (n,) (solid angle) of unit directions wi (3, n) at surfaces with view terms ``v``. The half
     vector h = (wo + wi)/|wo + wi| enters only through cos θ_h = (cos θ_o + cos θ_i)/|wo + wi| and
     wo·h = (1 + wo·wi)/|wo + wi|, with |wo + wi|² = 2 + 2 wo·wi."""
     co = v.co
-    ci = wi[:, 2]
+    ci = wi[2]
     valid = (co > 0) & (ci > 0)
     if not v.glossy:
         pdf = np.maximum(ci, np.float32(0.0)) * INV_PI * valid
-        return (v.kd * valid[:, None]).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
+        return (v.kd * valid).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
     wdw = dot(wo, wi)
     hinv = 1.0 / np.sqrt(np.maximum(2.0 + 2.0 * wdw, np.float32(1e-24)))
     cos_h = np.clip((co + ci) * hinv, 0, 1)
@@ -226,22 +242,22 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     c = np.clip(1.0 - odh, 0.0, 1.0)
     c5 = (c * c) * (c * c) * c
     s = v.spec_on * d * g / np.maximum(4.0 * co * ci, np.float32(1e-12))
-    f = v.kd + s[:, None] * v.spec_a + (s * c5)[:, None] * v.spec_b
-    f *= valid[:, None]
+    f = v.kd + s * v.spec_a + (s * c5) * v.spec_b
+    f *= valid
     pdf = (1 - v.p_spec) * np.maximum(ci, 0) * INV_PI + v.p_spec * (d * cos_h / (4.0 * odh))
     pdf *= valid
     return f.astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
 
 
 def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray, albedo: np.ndarray | None = None):
-    """f (n, 3) and pdf (n,) of sampling wi given wo, both unit vectors (``albedo``: :func:`view_albedo`, if
+    """f (3, n) and pdf (n,) of sampling wi given wo, both unit (3, n) vectors (``albedo``: :func:`view_albedo`, if
     known). For many wi at the same surfaces build :class:`ViewTerms` once and call :func:`eval_view`."""
     return eval_view(ViewTerms.of(p, wo, albedo), wo, wi)
 
 
 def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.ndarray, u2: np.ndarray,
                 albedo: np.ndarray | None = None, view: ViewTerms | None = None):
-    """Sample wi; returns wi (n, 3), f (n, 3), pdf (n,) (the mixture pdf, so MIS-ready). ``albedo``: see
+    """Sample wi; returns wi (3, n), f (3, n), pdf (n,) (the mixture pdf, so MIS-ready). ``albedo``: see
     :func:`eval_bsdf`; ``view``: the surfaces' :class:`ViewTerms` if known."""
     spec = np.flatnonzero(u_lobe < p.p_spec)
     wi = cosine_hemisphere(u1, u2)
@@ -252,14 +268,14 @@ def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.nda
         cos_t = 1.0 / np.sqrt(1.0 + tan2)
         sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
         phi = 2 * np.pi * uu2
-        h = np.empty((spec.size, 3), np.float32)
-        h[:, 0] = sin_t * np.cos(phi)
-        h[:, 1] = sin_t * np.sin(phi)
-        h[:, 2] = cos_t
-        o = np.take(wo, spec, axis=0)
-        wi[spec] = 2.0 * dot(o, h)[:, None] * h - o
+        h = np.empty((3, spec.size), np.float32)
+        h[0] = sin_t * np.cos(phi)
+        h[1] = sin_t * np.sin(phi)
+        h[2] = cos_t
+        o = np.take(wo, spec, axis=1)
+        wi[:, spec] = 2.0 * dot(o, h) * h - o
     f, pdf = eval_view(ViewTerms.of(p, wo, albedo) if view is None else view, wo, wi)
-    ok = (pdf > 0) & (wi[:, 2] > 0)
-    f *= ok[:, None]
+    ok = (pdf > 0) & (wi[2] > 0)
+    f *= ok
     pdf *= ok
     return wi, f, pdf

@@ -44,18 +44,18 @@ def _clip_planes_affine(cam: Camera):
 
 
 def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray):
-    """Rays through raster points (x, y): origins on the near clip plane (n, 3), unit directions
-    (n, 3) and the distance to the far clip plane (n,)."""
+    """Rays through raster points (x, y): origins on the near clip plane (3, n), unit directions
+    (3, n) and the distance to the far clip plane (n,)."""
     planes = _clip_planes_affine(cam)
     if planes is not None:  # float32 affine maps (the near plane's position error stays below 1e-6 relative)
         nx = (2.0 / cam.width) * x.astype(np.float32) - 1.0
         ny = (2.0 / cam.height) * y.astype(np.float32) - 1.0
-        near, far = planes.astype(np.float32)
+        near, far = planes.astype(np.float32)[:, :, :, None]  # (3 terms, 3 coords, 1) each
         span = far - near
-        o = near[0] + nx[:, None] * near[1] + ny[:, None] * near[2]
-        d = span[0] + nx[:, None] * span[1] + ny[:, None] * span[2]
-        length = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2])
-        d /= np.maximum(length, np.float32(1e-30))[:, None]
+        o = near[0] + nx * near[1] + ny * near[2]
+        d = span[0] + nx * span[1] + ny * span[2]
+        length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        d /= np.maximum(length, np.float32(1e-30))
         return o.astype(np.float32, copy=False), d.astype(np.float32, copy=False), length.astype(np.float32)
     nx = (2.0 * x / cam.width - 1.0).astype(np.float64)
     ny = (2.0 * y / cam.height - 1.0).astype(np.float64)
@@ -68,21 +68,21 @@ def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray):
     d = far_w - near_w
     length = np.linalg.norm(d, axis=1)
     d = d / np.maximum(length, 1e-30)[:, None]
-    return near_w.astype(np.float32), d.astype(np.float32), length.astype(np.float32)
+    return (np.ascontiguousarray(near_w.T, dtype=np.float32), np.ascontiguousarray(d.T, dtype=np.float32),
+            length.astype(np.float32))
 
 
 def project(cam: Camera, points: np.ndarray):
-    """Raster coordinates (n, 2) of world points seen by ``cam`` (x right, y up, full-resolution pixels)
-    and their planar depth along the camera axis (n,); depth <= 0 means behind the camera. The matrices
-    are combined in float64, the points transformed in float32."""
+    """Raster coordinates (n, 2) of world points (3, n) seen by ``cam`` (x right, y up, full-resolution
+    pixels) and their planar depth along the camera axis (n,); depth <= 0 means behind the camera. The
+    matrices are combined in float64, the points transformed in float32."""
     w2c = np.linalg.inv(cam.cam_to_world.astype(np.float64))
     clip = (np.linalg.inv(cam.ndc_to_cam.astype(np.float64)) @ w2c).astype(np.float32)
     zrow = w2c[2].astype(np.float32)
-    p = np.asarray(points, np.float32)
-    x, y, z = p[:, 0], p[:, 1], p[:, 2]
+    x, y, z = (np.asarray(points[i], np.float32) for i in range(3))
     h = [clip[i, 0] * x + clip[i, 1] * y + clip[i, 2] * z + clip[i, 3] for i in (0, 1, 3)]
     w = np.where(np.abs(h[2]) > 1e-12, h[2], np.float32(1e-12))
-    raster = np.empty((len(p), 2), np.float32)
+    raster = np.empty((len(x), 2), np.float32)
     raster[:, 0] = (h[0] / w + 1) * np.float32(0.5 * cam.width)
     raster[:, 1] = (h[1] / w + 1) * np.float32(0.5 * cam.height)
     depth = -(zrow[0] * x + zrow[1] * y + zrow[2] * z + zrow[3])

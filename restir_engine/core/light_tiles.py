@@ -24,8 +24,8 @@ AUTO_FACTOR = 8.0       # AUTO: use tiles when candidates per pass exceed this m
 
 @dataclass
 class LightPoints:
-    """SoA light points (n,): light int32, b1, b2 float32, pos (n, 3), normal (n, 3) unit geometric
-    normal, le (n, 3) radiance leaving the front face (W·sr⁻¹·m⁻², scene-linear; spot cones not
+    """SoA light points (n,): light int32, b1, b2 float32, pos (3, n), normal (3, n) unit geometric
+    normal, le (3, n) radiance leaving the front face (W·sr⁻¹·m⁻², scene-linear; spot cones not
     applied), pdf (n,) area measure (m⁻²), two_sided bool, spot_tri int32 (lamp triangle with a
     spot cone, else -1). ``block``: the packed (11, n) form when it was built first (see :meth:`packed`)."""
 
@@ -50,9 +50,9 @@ class LightPoints:
         if self.block is not None:
             return self.block
         out = np.empty((11, len(self.light)), np.float32)
-        out[0:3] = self.pos.T
-        out[3:6] = self.normal.T
-        out[6:9] = self.le.T
+        out[0:3] = self.pos
+        out[3:6] = self.normal
+        out[6:9] = self.le
         out[9] = self.pdf
         out[10] = self.two_sided
         return out
@@ -79,7 +79,7 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> L
     gathers from the table's (3, n_tri) corner, edge, normal and radiance rows)."""
     n = len(light)
     if lights.n_tri == 0:  # no triangle lights: every point is an empty placeholder
-        z3 = np.zeros((n, 3), np.float32)
+        z3 = np.zeros((3, n), np.float32)
         return LightPoints(np.full(n, -1, np.int32), np.zeros(n, np.float32), np.zeros(n, np.float32), z3, z3.copy(),
                            z3.copy(), np.zeros(n, np.float32), np.zeros(n, bool), np.full(n, -1, np.int32))
     light = light.astype(np.intp)
@@ -95,10 +95,10 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> L
     if lights.any_textured:
         tex = np.flatnonzero(lights.tri_textured[light])
         if tex.size:
-            blk[6:9, tex] = lights.radiance_of(light[tex], b1[tex], b2[tex], None).T
+            blk[6:9, tex] = lights.radiance_of(light[tex], b1[tex], b2[tex], None)
     np.take(lights.tri_pdf_area, light, out=blk[9])
     blk[10] = lights.tri_two_sided[light]
-    return LightPoints(light.astype(np.int32), b1, b2, blk[0:3].T, blk[3:6].T, blk[6:9].T, blk[9], blk[10] > 0,
+    return LightPoints(light.astype(np.int32), b1, b2, blk[0:3], blk[3:6], blk[6:9], blk[9], blk[10] > 0,
                        lights.spot_lamp_tri(light), block=blk)
 
 

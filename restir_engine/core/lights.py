@@ -13,40 +13,44 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bsdf import luminance
-from .sampling import AliasTable, barycentric, dot, norm, orthonormal_basis, row_max, take_rows, uniform_triangle
+from .sampling import AliasTable, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
 from .scene import Lamps, MaterialTable, Scene, TriangleSet
 from .textures import apply_texture, mean_color
 
 def triangle_geometry(verts: np.ndarray):
-    """Unit geometric normals (winding order) and areas of (n, 3, 3) triangles."""
+    """Unit geometric normals (winding order) (n, 3) and areas (n,) of (n, 3, 3) triangles."""
     c = np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0])
-    ln = norm(c)
+    ln = np.sqrt(c[:, 0] * c[:, 0] + c[:, 1] * c[:, 1] + c[:, 2] * c[:, 2])
     ng = c / np.maximum(ln, 1e-30)[:, None]
     return ng.astype(np.float32), (0.5 * ln).astype(np.float32)
 
 
 def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarray,
                      b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
-    """Emitted radiance (n, 3), W·sr⁻¹·m⁻², at barycentrics (b1, b2) of triangles ``tri``."""
+    """Emitted radiance (3, n) rows, W·sr⁻¹·m⁻², at barycentrics (b1, b2) of triangles ``tri``."""
     mat = tris.material[tri]
-    le = take_rows(materials.emission, mat)
+    le = np.take(materials.emission, mat, axis=0)
     if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
-        uv = barycentric(tris.uvs[tri], b1, b2)
+        c = np.take(tris.uvs, tri, axis=0)
+        uv = c[:, 0] * (1.0 - b1 - b2)[:, None] + c[:, 1] * b1[:, None] + c[:, 2] * b2[:, None]
         le = apply_texture(le, materials.emit_tex[mat], uv, materials.textures)
-    return le
+    return np.ascontiguousarray(le.T, dtype=np.float32)
 
 
 def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Spot cone attenuation (n,) of lamp triangles seen from points p (Cycles' smoothstep blend)."""
+    """Spot cone attenuation (n,) of lamp triangles seen from points p ((3, n) rows; Cycles' smoothstep
+    blend)."""
     cos_cut = lamps.spot_cos[lamp_tri]
     out = np.ones(len(lamp_tri), np.float32)
-    spot = cos_cut > -1.5
-    if spot.any():
-        d = p[spot] - lamps.spot_center[lamp_tri[spot]]
-        d /= np.maximum(norm(d), 1e-30)[:, None]
-        t = dot(d, lamps.spot_axis[lamp_tri[spot]])
-        sm = lamps.spot_smooth[lamp_tri[spot]]
-        x = np.where(sm > 0, (t - cos_cut[spot]) / np.maximum(sm, 1e-12), np.where(t > cos_cut[spot], 1.0, 0.0))
+    spot = np.flatnonzero(cos_cut > -1.5)
+    if spot.size:
+        tri = lamp_tri[spot]
+        d = np.take(p, spot, axis=1) - lamps.spot_center[tri].T
+        d /= np.maximum(norm(d), 1e-30)
+        t = dot(d, lamps.spot_axis[tri].T)
+        sm = lamps.spot_smooth[tri]
+        cut = cos_cut[spot]
+        x = np.where(sm > 0, (t - cut) / np.maximum(sm, 1e-12), np.where(t > cut, 1.0, 0.0))
         x = np.clip(x, 0.0, 1.0)
         out[spot] = x * x * (3 - 2 * x)
     return out
@@ -54,9 +58,9 @@ def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray
 
 @dataclass
 class LightSample:
-    """Per shading point: unit direction wi (n, 3), distance (n,) (inf for suns), radiance Le (n, 3)
+    """Per shading point (n): unit direction wi (3, n), distance (n,) (inf for suns), radiance Le (3, n)
     arriving along -wi, pdf (n,) in solid angle (selection included; 0 = no light), delta (n,) bool,
-    pos (n, 3) the sampled point on a triangle light (unused for suns)."""
+    pos (3, n) the sampled point on a triangle light (unused for suns)."""
 
     pos: np.ndarray
     wi: np.ndarray
@@ -67,8 +71,8 @@ class LightSample:
 
     @staticmethod
     def zeros(n: int) -> "LightSample":
-        return LightSample(np.zeros((n, 3), np.float32), np.zeros((n, 3), np.float32), np.zeros(n, np.float32),
-                           np.zeros((n, 3), np.float32), np.zeros(n, np.float32), np.zeros(n, bool))
+        return LightSample(np.zeros((3, n), np.float32), np.zeros((3, n), np.float32), np.zeros(n, np.float32),
+                           np.zeros((3, n), np.float32), np.zeros(n, np.float32), np.zeros(n, bool))
 
 
 class LightTable:
@@ -138,27 +142,30 @@ class LightTable:
         return self.sel_pdf_area[light] * (dist * dist / np.maximum(np.abs(cos_light), np.float32(1e-8)))
 
     def triangle_points(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, p: np.ndarray):
-        """Points (b1, b2) of triangle lights ``light`` as light samples for receivers p (n, 3): position,
+        """Points (b1, b2) of triangle lights ``light`` as light samples for receivers p (3, n): position,
         unit direction from p, distance, cos at the light, radiance arriving at p (zero from a back face of a
         one-sided emitter, spot cones applied) and the solid-angle pdf of :meth:`sample` (0 where no light
         arrives)."""
         q, w, dl, cos_l, rad = self.point_towards(light, b1, b2, p)
         pd = self.tri_pdf_solid_angle(light, dl, cos_l)
-        ok = (row_max(rad) > 0) & np.isfinite(pd)
-        return q, w, dl, cos_l, np.where(ok[:, None], rad, np.float32(0.0)), np.where(ok, pd, np.float32(0.0))
+        ok = (vmax(rad) > 0) & np.isfinite(pd)
+        rad *= ok
+        return q, w, dl, cos_l, rad, pd * ok
 
     def point_towards(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, p: np.ndarray):
-        """Triangle light ``light`` at barycentrics (b1, b2) seen from points p (n, 3): the light point
-        (n, 3), unit direction wi from p (n, 3), distance (n,), cos at the light (n,) and the radiance
-        arriving at p (n, 3) (zero from a back face of a one-sided emitter, spot cones applied)."""
-        q = barycentric(take_rows(self.tri_verts, light), b1, b2)
+        """Triangle light ``light`` at barycentrics (b1, b2) seen from points p (3, n): the light point
+        (3, n), unit direction wi from p (3, n), distance (n,), cos at the light (n,) and the radiance
+        arriving at p (3, n) (zero from a back face of a one-sided emitter, spot cones applied)."""
+        q = cols(self.rows_v0, light)
+        q += cols(self.rows_e1, light) * b1
+        q += cols(self.rows_e2, light) * b2
         d = q - p
         dl = norm(d)
-        w = d / np.maximum(dl, np.float32(1e-30))[:, None]
-        cos_l = -dot(w, take_rows(self.tri_normal, light))
+        w = d / np.maximum(dl, np.float32(1e-30))
+        cos_l = -dot(w, cols(self.rows_normal, light))
         facing = ((cos_l > 0) | self.tri_two_sided[light]) & (dl > 0) & (np.abs(cos_l) > 1e-8)
         le = self.radiance_of(light, b1, b2, p)
-        le *= facing[:, None]
+        le *= facing
         return q, w, dl, cos_l, le
 
     def tri_only_pdf_area(self, light: np.ndarray) -> np.ndarray:
@@ -166,10 +173,10 @@ class LightTable:
         return self.tri_pdf_area[light]
 
     def radiance_of(self, light: np.ndarray, b1, b2, p_receiver: np.ndarray) -> np.ndarray:
-        """Radiance (n, 3) leaving triangle light ``light`` at (b1, b2) towards p_receiver,
+        """Radiance (3, n) leaving triangle light ``light`` at (b1, b2) towards p_receiver (3, n),
         before the sidedness test (spot cones included unless p_receiver is None)."""
         scene = self.scene
-        out = take_rows(self.tri_le, light)
+        out = cols(self.rows_le, light)
         if self.any_textured:
             tex = np.flatnonzero(self.tri_textured[light])
             if tex.size:
@@ -178,13 +185,13 @@ class LightTable:
                 for sel, tris, ids, offset in ((geo, scene.geometry, self.geom_ids, 0),
                                                (~geo, scene.lamps.tris, self.lamp_ids, self.n_geom)):
                     if sel.any():
-                        out[tex[sel]] = emitted_radiance(tris, scene.materials, ids[lt[sel] - offset],
-                                                         b1[tex[sel]], b2[tex[sel]])
+                        out[:, tex[sel]] = emitted_radiance(tris, scene.materials, ids[lt[sel] - offset],
+                                                            b1[tex[sel]], b2[tex[sel]])
         if p_receiver is not None and self.any_spots:
             lm = np.flatnonzero(light >= self.n_geom)
             if lm.size:
                 t = self.lamp_ids[light[lm] - self.n_geom]
-                out[lm] *= spot_factor(scene.lamps, t, p_receiver[lm])[:, None]
+                out[:, lm] *= spot_factor(scene.lamps, t, np.take(p_receiver, lm, axis=1))
         return out
 
     def spot_lamp_tri(self, light: np.ndarray) -> np.ndarray:
@@ -200,56 +207,56 @@ class LightTable:
         return out
 
     def sample(self, p: np.ndarray, u: np.ndarray) -> LightSample:
-        """Pick one light per point p (n, 3) with power-proportional probability and a point on it.
-        ``u`` is (n, 4) uniforms."""
-        n = len(p)
+        """Pick one light per point p (3, n) with power-proportional probability and a point on it.
+        ``u`` is (4, n) uniforms."""
+        n = p.shape[1]
         out = LightSample.zeros(n)
-        pos, wi, dist, le, pdf, delta = out.pos, out.wi, out.dist, out.le, out.pdf, out.delta
         if self.alias is None or n == 0:
             return out
-        light = self.alias.sample(u[:, 0], u[:, 1])
-        if self.n_sun == 0:  # triangle lights only: no row selections
-            b1, b2 = uniform_triangle(u[:, 2], u[:, 3])
+        light = self.alias.sample(u[0], u[1])
+        if self.n_sun == 0:  # triangle lights only: no column selections
+            b1, b2 = uniform_triangle(u[2], u[3])
             out.pos, out.wi, out.dist, _cos, out.le, out.pdf = self.triangle_points(light, b1, b2, p)
             return out
-        tri = light < self.n_tri
-        if tri.any():
-            b1, b2 = uniform_triangle(u[tri, 2], u[tri, 3])
-            pos[tri], wi[tri], dist[tri], _cos, le[tri], pdf[tri] = self.triangle_points(light[tri], b1, b2, p[tri])
-        sun = ~tri
-        if sun.any():
-            self._sun_sample(light[sun] - self.n_tri, self.alias.pdf[light[sun]], u[sun], sun, wi, dist, le, pdf, delta)
+        tri = np.flatnonzero(light < self.n_tri)
+        if tri.size:
+            b1, b2 = uniform_triangle(u[2, tri], u[3, tri])
+            pos, wi, dist, _cos, le, pdf = self.triangle_points(light[tri], b1, b2, np.take(p, tri, axis=1))
+            out.pos[:, tri], out.wi[:, tri], out.dist[tri], out.le[:, tri], out.pdf[tri] = pos, wi, dist, le, pdf
+        sun = np.flatnonzero(light >= self.n_tri)
+        if sun.size:
+            self._sun_sample(light[sun] - self.n_tri, self.alias.pdf[light[sun]], u[:, sun], sun, out)
         return out
 
     def sample_suns(self, n: int, u: np.ndarray) -> LightSample:
         """One sun per point, chosen by power among suns only (ReSTIR's companion to resampled
-        triangle lights). ``u`` is (n, 4) uniforms; all samples are flagged ``delta`` (no MIS)."""
+        triangle lights). ``u`` is (4, n) uniforms; all samples are flagged ``delta`` (no MIS)."""
         out = LightSample.zeros(n)
         if self.sun_alias is not None and n:
-            s = self.sun_alias.sample(u[:, 0], u[:, 1])
-            self._sun_sample(s, self.sun_alias.pdf[s], u, np.ones(n, bool), out.wi, out.dist, out.le, out.pdf,
-                             out.delta)
+            s = self.sun_alias.sample(u[0], u[1])
+            self._sun_sample(s, self.sun_alias.pdf[s], u, np.arange(n), out)
         return out
 
-    def _sun_sample(self, s, p_sel, u, sun, wi, dist, le, pdf, delta):
-        """Fill rows ``sun`` of the output arrays with a direction in sun ``s``'s cone."""
+    def _sun_sample(self, s, p_sel, u, cols_out, out: LightSample):
+        """Fill columns ``cols_out`` of ``out`` with directions in suns ``s``'s cones (u: (4, k) uniforms)."""
         lamps = self.scene.lamps
-        axis = lamps.sun_dir[s]
+        axis = lamps.sun_dir[s].T.astype(np.float32)
         cmax = lamps.sun_cos[s]
         is_delta = cmax >= 1.0 - 1e-9
         # uniform direction in the cone around the sun axis
-        cos_t = 1.0 - u[:, 2] * (1.0 - cmax)
+        cos_t = 1.0 - u[2] * (1.0 - cmax)
         sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
-        phi = 2 * np.pi * u[:, 3]
+        phi = 2 * np.pi * u[3]
         t, b = orthonormal_basis(axis)
-        dvec = (t * (sin_t * np.cos(phi))[:, None] + b * (sin_t * np.sin(phi))[:, None] + axis * cos_t[:, None])
+        dvec = t * (sin_t * np.cos(phi)) + b * (sin_t * np.sin(phi)) + axis * cos_t
         solid = 2 * np.pi * (1.0 - cmax)
         # radiance of a disc of half-angle a whose cosine-weighted integral is the irradiance E
         sin2 = np.maximum(1.0 - cmax * cmax, 1e-30)
-        rad = lamps.sun_irradiance[s] / (np.pi * sin2)[:, None]
-        wi[sun] = np.where(is_delta[:, None], axis, dvec)
-        dist[sun] = np.inf
+        irr = lamps.sun_irradiance[s].T
+        rad = irr / (np.pi * sin2)
+        out.wi[:, cols_out] = np.where(is_delta, axis, dvec)
+        out.dist[cols_out] = np.inf
         # for a delta sun store Le·(1/p_sel) with pdf = p_sel and flag delta: the estimator divides by pdf
-        le[sun] = np.where(is_delta[:, None], lamps.sun_irradiance[s], rad)
-        pdf[sun] = np.where(is_delta, p_sel, p_sel / np.maximum(solid, 1e-30))
-        delta[sun] = True  # suns are never hit by BSDF rays: no MIS
+        out.le[:, cols_out] = np.where(is_delta, irr, rad)
+        out.pdf[cols_out] = np.where(is_delta, p_sel, p_sel / np.maximum(solid, 1e-30))
+        out.delta[cols_out] = True  # suns are never hit by BSDF rays: no MIS

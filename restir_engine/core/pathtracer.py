@@ -25,14 +25,15 @@ from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
 from .bsdf import SurfaceParams, eval_view, ggx_albedo_rows, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
-from .sampling import dot, norm, row_max, rows_finite, take_rows, to_local, to_world
+from .sampling import cols, dot, norm, to_local, to_world, vfinite, vmax
 from .scene import Scene
 from .surface import Surface
 
 
 @dataclass
 class TraceContext:
-    """Everything a chunk needs, built once per frame (reused while the scene content is unchanged)."""
+    """Everything a chunk needs, built once per frame (reused while the scene content is unchanged).
+    Per-triangle data the path tracer gathers is kept as rows (structure of arrays)."""
 
     scene: Scene
     geom_accel: Accel
@@ -42,10 +43,13 @@ class TraceContext:
     lamp_ng: np.ndarray
     material_params: SurfaceParams  # per material, untextured (gathered per hit)
     max_bounces: int
-    material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α (bsdf.ggx_albedo_rows)
-    geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     rr_start: int = 3
     film_transparent: bool = False
+    material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α (bsdf.ggx_albedo_rows)
+    geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
+    geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
+    geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
+    lamp_ng_rows: np.ndarray = None     # (3, n_lamp) lamp_ng as rows
 
 
 def power_heuristic(a, b):
@@ -54,27 +58,30 @@ def power_heuristic(a, b):
 
 
 def _sanitize(x: np.ndarray) -> np.ndarray:
-    return np.where(np.isfinite(x), x, 0.0).astype(np.float32)
+    """``x`` with non-finite values set to 0 (in place)."""
+    bad = ~np.isfinite(x)
+    if bad.any():
+        x[bad] = 0.0
+    return x
 
 
 def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
-    """Radiance collected from the nearest lamp hit by rays ``sel`` (front faces only), and the
-    solid-angle light pdf of that point for MIS."""
+    """Radiance (3, k) collected from the nearest lamp hit by rays ``sel`` (front faces only), and the
+    solid-angle light pdf (k,) of that point for MIS."""
     prim = lh.prim[sel]
     t = lh.t[sel]
-    cos_l = -dot(take_rows(d, sel), take_rows(ctx.lamp_ng, prim))
+    cos_l = -dot(cols(d, sel), cols(ctx.lamp_ng_rows, prim))
     lamps = ctx.scene.lamps
     le = emitted_radiance(lamps.tris, ctx.scene.materials, prim, lh.u[sel], lh.v[sel])
-    le *= spot_factor(lamps, prim, take_rows(o, sel))[:, None]
-    le = np.where((cos_l > 0)[:, None], le, 0.0)
+    le *= spot_factor(lamps, prim, cols(o, sel)) * (cos_l > 0)
     light = ctx.lights.lamp_to_light[prim]
     pdf = np.where(light >= 0, ctx.lights.tri_pdf_solid_angle(np.maximum(light, 0), t, cos_l), 0.0)
-    return le.astype(np.float32), pdf.astype(np.float32)
+    return le, pdf.astype(np.float32)
 
 
 @dataclass
 class PrimaryHits:
-    """Camera rays through n raster points: emission seen directly (n, 3), alpha (n,), the rows that hit
+    """Camera rays through n raster points: emission seen directly (3, n), alpha (n,), the rows that hit
     geometry (k,) and their surfaces (surface.Surface, k)."""
 
     emitted: np.ndarray
@@ -88,7 +95,7 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray) -> PrimaryHits:
     cam = ctx.scene.camera
     n = len(x)
     o, d, tmax = camera_mod.generate_rays(cam, x, y)
-    emitted = np.zeros((n, 3), np.float32)
+    emitted = np.zeros((3, n), np.float32)
     alpha = np.ones(n, np.float32)
     hits = ctx.geom_accel.intersect(o, d, tmax)
     alive = hits.prim >= 0
@@ -97,40 +104,39 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray) -> PrimaryHits:
         sel = np.flatnonzero((lh.prim >= 0) & (lh.t < hits.t))
         sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
         if sel.size:
-            emitted[sel] += _lamp_emission(ctx, lh, o, d, sel)[0]
+            emitted[:, sel] += _lamp_emission(ctx, lh, o, d, sel)[0]
     miss = ~alive
     if ctx.film_transparent:
         alpha[miss] = 0.0
     else:
-        emitted[miss] += ctx.scene.world_radiance
+        emitted += ctx.scene.world_radiance.astype(np.float32)[:, None] * miss
     rows = np.flatnonzero(alive)
-    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], take_rows(o, rows), take_rows(d, rows),
-                   hits.t[rows])
-    emitted[rows] += surf.emission(ctx)
+    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
+    emitted[:, rows] += surf.emission(ctx)
     return PrimaryHits(_sanitize(emitted), alpha, rows, surf)
 
 
 def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None) -> np.ndarray:
     """Next-event estimation at surfaces s (n): one light sample each, MIS-weighted against BSDF sampling
-    (delta lights weight 1), one shadow ray. Radiance (n, 3), times ``throughput`` (n, 3) if given."""
-    n = len(s.p)
-    out = np.zeros((n, 3), np.float32)
+    (delta lights weight 1), one shadow ray. Radiance (3, n), times ``throughput`` (3, n) if given."""
+    n = len(s)
+    out = np.zeros((3, n), np.float32)
     if ctx.lights.empty or n == 0:
         return out
-    ls = ctx.lights.sample(s.p, rng.random((n, 4), dtype=np.float32))
+    ls = ctx.lights.sample(s.p, rng.random((4, n), dtype=np.float32))
     wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
     f, pdf_b = eval_view(s.view, s.wo_l, wi_l)
-    w = np.where(ls.delta, 1.0, power_heuristic(ls.pdf, pdf_b))
-    contrib = f * (np.abs(wi_l[:, 2]) * w / np.maximum(ls.pdf, 1e-30))[:, None] * ls.le
+    w = np.where(ls.delta, np.float32(1.0), power_heuristic(ls.pdf, pdf_b))
+    contrib = f * ls.le
+    contrib *= np.abs(wi_l[2]) * w / np.maximum(ls.pdf, np.float32(1e-30))
     if throughput is not None:
         contrib *= throughput
-    live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (row_max(contrib) > 0))
+    live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (vmax(contrib) > 0))
     if live.size:
-        so, sd, far = shadow_rays(take_rows(s.p, live), take_rows(s.ng, live), take_rows(ls.pos, live),
-                                  take_rows(ls.wi, live), ls.dist[live])
-        vis = ~ctx.geom_accel.occluded(so, sd, far)
-        lv = live[vis]
-        out[lv] = _sanitize(take_rows(contrib, lv))
+        so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), cols(ls.pos, live), cols(ls.wi, live),
+                                  ls.dist[live])
+        lv = live[~ctx.geom_accel.occluded(so, sd, far)]
+        out[:, lv] = _sanitize(cols(contrib, lv))
     return out
 
 
@@ -142,43 +148,45 @@ def needs_continuation(ctx: TraceContext, direct_resampled: bool) -> bool:
 
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
                    first_ray=None):
-    """Continue paths from primary surfaces s (n). Returns (direct (n, 3): the first BSDF ray's emitter hits
-    (MIS-weighted; none when ``direct_resampled``) and the world it escapes to; indirect (n, 3): bounces
+    """Continue paths from primary surfaces s (n). Returns (direct (3, n): the first BSDF ray's emitter hits
+    (MIS-weighted; none when ``direct_resampled``) and the world it escapes to; indirect (3, n): bounces
     1..max_bounces). ``first_ray`` (restir.di.BsdfRay): a BSDF sample already traced from s, used as the
     first ray instead of drawing a new one."""
-    n = len(s.p)
-    direct = np.zeros((n, 3), np.float32)
-    indirect = np.zeros((n, 3), np.float32)
+    n = len(s)
+    direct = np.zeros((3, n), np.float32)
+    indirect = np.zeros((3, n), np.float32)
     idx = np.arange(n)
-    throughput = np.ones((n, 3), np.float32)
+    throughput = np.ones((3, n), np.float32)
     lamps = ctx.scene.lamps
+    world = ctx.scene.world_radiance.astype(np.float32)[:, None]
     for bounce in range(ctx.max_bounces + 1):
         target = direct if bounce == 0 else indirect
         if bounce > 0:
-            target[idx] += next_event(ctx, s, rng, throughput)
+            target[:, idx] += next_event(ctx, s, rng, throughput)
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -------
         if bounce == 0 and first_ray is not None:
             rows, wi_l, f, pdf = first_ray.rows, first_ray.wi_l, first_ray.f, first_ray.pdf
             o, d, hits = first_ray.o, first_ray.d, first_ray.hits
         else:
-            u = rng.random((len(idx), 3), dtype=np.float32)
-            wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[:, 0], u[:, 1], u[:, 2], view=s.view)
+            u = rng.random((3, len(idx)), dtype=np.float32)
+            wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[0], u[1], u[2], view=s.view)
             wi = to_world(wi_l, s.ns, s.t, s.bt)
-            wi /= np.maximum(norm(wi), 1e-12)[:, None]
+            wi /= np.maximum(norm(wi), np.float32(1e-12))
             rows = np.flatnonzero((pdf > 0) & (dot(wi, s.ng) > 0))
-            wi_l, f, pdf, d = take_rows(wi_l, rows), take_rows(f, rows), pdf[rows], take_rows(wi, rows)
-            o, hits = offset_origin(take_rows(s.p, rows), take_rows(s.ng, rows), d), None
-        thr = take_rows(throughput, rows) * f * (wi_l[:, 2] / np.maximum(pdf, 1e-30))[:, None]
-        ok = rows_finite(thr)
+            wi_l, f, pdf, d = cols(wi_l, rows), cols(f, rows), pdf[rows], cols(wi, rows)
+            o, hits = offset_origin(cols(s.p, rows), cols(s.ng, rows), d), None
+        thr = cols(throughput, rows) * f
+        thr *= wi_l[2] / np.maximum(pdf, np.float32(1e-30))
+        ok = vfinite(thr)
         if bounce + 1 >= ctx.rr_start:
-            q = np.clip(row_max(thr), 0.05, 1.0)
+            q = np.clip(vmax(thr), 0.05, 1.0)
             ok &= rng.random(len(rows), dtype=np.float32) < q
-            thr /= q[:, None]
+            thr /= q
         keep = np.flatnonzero(ok)
         if keep.size == 0:
             break
-        idx, throughput, prev_pdf = idx[rows[keep]], take_rows(thr, keep), pdf[keep]
-        o, d = take_rows(o, keep), take_rows(d, keep)
+        idx, throughput, prev_pdf = idx[rows[keep]], cols(thr, keep), pdf[keep]
+        o, d = cols(o, keep), cols(d, keep)
         if hits is None:
             hits = ctx.geom_accel.intersect(o, d)
         else:
@@ -190,12 +198,11 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             sel = np.flatnonzero((lh.prim >= 0) & (lh.t < hits.t))
             if sel.size:
                 le, pl = _lamp_emission(ctx, lh, o, d, sel)
-                w = power_heuristic(prev_pdf[sel], pl)
-                target[idx[sel]] += _sanitize(take_rows(throughput, sel) * le * w[:, None])
+                target[:, idx[sel]] += _sanitize(cols(throughput, sel) * le * power_heuristic(prev_pdf[sel], pl))
         hit = hits.prim >= 0
         esc = np.flatnonzero(~hit)
         if esc.size:  # film transparency affects camera rays only
-            target[idx[esc]] += _sanitize(take_rows(throughput, esc) * ctx.scene.world_radiance)
+            target[:, idx[esc]] += _sanitize(cols(throughput, esc) * world)
         hsel = np.flatnonzero(hit)
         if hsel.size == 0:
             break
@@ -206,16 +213,14 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             if em.size:
                 hs = hsel[em]
                 le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
-                cos_l = -dot(take_rows(d, hs), take_rows(ctx.geom_ng, hp[em]))
-                two = ctx.lights.tri_two_sided[light[em]]
-                le = np.where(((cos_l > 0) | two)[:, None], le, 0.0)
+                cos_l = -dot(cols(d, hs), cols(ctx.geom_ng_rows, hp[em]))
+                le *= (cos_l > 0) | ctx.lights.tri_two_sided[light[em]]
                 pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
-                w = power_heuristic(prev_pdf[hs], pl)
-                target[idx[hs]] += _sanitize(take_rows(throughput, hs) * le * w[:, None])
+                target[:, idx[hs]] += _sanitize(cols(throughput, hs) * le * power_heuristic(prev_pdf[hs], pl))
         if bounce == ctx.max_bounces:
             break
-        idx, throughput = idx[hsel], take_rows(throughput, hsel)
-        s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], take_rows(o, hsel), take_rows(d, hsel), hits.t[hsel])
+        idx, throughput = idx[hsel], cols(throughput, hsel)
+        s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], cols(o, hsel), cols(d, hsel), hits.t[hsel])
     return direct, indirect
 
 
@@ -232,20 +237,20 @@ def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     vector = np.zeros((len(x), 4), np.float32)
     hit = np.flatnonzero(hits.prim >= 0)
     if hit.size:
-        s = Surface(ctx, hits.prim[hit], hits.u[hit], hits.v[hit], o[hit], d[hit], hits.t[hit])
-        depth[hit] = np.einsum("ij,j->i", s.p - camera_mod.position(cam), camera_mod.forward(cam))
-        normal[hit] = s.ns
+        s = Surface(ctx, hits.prim[hit], hits.u[hit], hits.v[hit], cols(o, hit), cols(d, hit), hits.t[hit])
+        depth[hit] = dot(s.p - camera_mod.position(cam)[:, None], camera_mod.forward(cam)[:, None])
+        normal[hit] = s.ns.T
         motion = ctx.scene.motion
         inst = ctx.scene.geometry.instance
         if motion is not None and inst is not None:
             here = np.stack([x[hit], y[hit]], axis=1)
-            for which, cols, sign in (("prev", slice(0, 2), 1.0), ("next", slice(2, 4), -1.0)):
+            for which, which_cols, sign in (("prev", slice(0, 2), 1.0), ("next", slice(2, 4), -1.0)):
                 other_cam = motion.camera_prev if which == "prev" else motion.camera_next
                 if other_cam is None:
                     continue
                 moved = motion.moved_points(s.p, inst[s.prim], which)
                 raster, _z = camera_mod.project(other_cam, moved)
-                vector[hit, cols] = sign * (raster - here)
+                vector[hit, which_cols] = sign * (raster - here)
     return depth, normal, np.where(np.isfinite(vector), vector, 0.0).astype(np.float32)
 
 
@@ -265,4 +270,6 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         lights=LightTable(scene, max(radius, 1e-3)), geom_ng=geom_ng, lamp_ng=lamp_ng,
                         material_params=params, max_bounces=int(max(0, max_bounces)),
                         film_transparent=film_transparent, material_albedo=ggx_albedo_rows(params.alpha),
-                        geom_flat=flat)
+                        geom_flat=flat, geom_ng_rows=np.ascontiguousarray(geom_ng.T),
+                        geom_normal_rows=np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32),
+                        lamp_ng_rows=np.ascontiguousarray(lamp_ng.T))

@@ -372,12 +372,12 @@ class FrameRenderer:
         flat = {k: a.reshape(len(a) * a.shape[1], -1) if a.ndim == 3 else a.reshape(-1) for k, a in self.acc.items()}
 
         def add(c: _Chunk):
-            flat["emit"][c.pixels] += c.hits.emitted
+            flat["emit"][c.pixels] += c.hits.emitted.T
             flat["alpha"][c.pixels] += c.hits.alpha
             pix = c.pixels[c.hits.rows]
-            flat["direct"][pix] += c.direct
+            flat["direct"][pix] += c.direct.T
             if c.indirect is not None:
-                flat["indirect"][pix] += c.indirect
+                flat["indirect"][pix] += c.indirect.T
             if resampled:
                 flat["res_m"][pix] += c.res.M
                 flat["res_w"][pix] += c.res.W

@@ -143,14 +143,16 @@ class Motion:
     camera_next: object = None
 
     def moved_points(self, points: np.ndarray, instance: np.ndarray, which: str) -> np.ndarray:
-        """World positions (n, 3) that surface points on ``instance`` have in the 'prev' or 'next' frame."""
+        """World positions (3, n) that surface points (3, n) on ``instance`` have in the 'prev' or 'next'
+        frame."""
         other = self.prev if which == "prev" else self.next
         if len(other) == 0:  # no instances: nothing moves
             return points.astype(np.float32)
         instance = np.clip(instance, 0, len(other) - 1)
         xform = np.einsum("nij,njk->nik", other, np.linalg.inv(self.current))[instance]  # other · current⁻¹
         p = points.astype(np.float64)
-        return (np.einsum("nij,nj->ni", xform[:, :3, :3], p) + xform[:, :3, 3]).astype(np.float32)
+        out = np.einsum("nij,jn->in", xform[:, :3, :3], p) + xform[:, :3, 3].T
+        return out.astype(np.float32)
 
 
 @dataclass

@@ -23,6 +23,7 @@ import numpy as np
 from .bsdf import schlick, smith_lambda, view_albedo
 from .light_tiles import PackedPoints, light_points
 from .lights import spot_factor
+from .sampling import to_world
 
 LUM = np.array([0.2126, 0.7152, 0.0722], np.float32)
 INV_PI = np.float32(1.0 / np.pi)
@@ -51,25 +52,25 @@ class ShadingTerms:
         """Terms of surfaces ``surf`` (a surface.Surface: p, ng, ns, wo, wo_l, params), written into ``out``
         ((27, n) float32, e.g. a slice of a frame's block) when given."""
         prm = surf.params
-        packed = np.empty((WIDTH, len(surf.p)), np.float32) if out is None else out
-        packed[LAYOUT["p"]] = surf.p.T
-        packed[LAYOUT["ng"]] = surf.ng.T
-        packed[LAYOUT["ns"]] = surf.ns.T
+        packed = np.empty((WIDTH, surf.p.shape[1]), np.float32) if out is None else out
+        packed[LAYOUT["p"]] = surf.p
+        packed[LAYOUT["ng"]] = surf.ng
+        packed[LAYOUT["ns"]] = surf.ns
         # wo in the bent frame: the local view vector back in world space (wo·ns = cos θ_o exactly)
         wl = surf.wo_l
-        packed[LAYOUT["wo"]] = (surf.t * wl[:, 0:1] + surf.bt * wl[:, 1:2] + surf.ns * wl[:, 2:3]).T
-        co = wl[:, 2]
+        packed[LAYOUT["wo"]] = to_world(wl, surf.ns, surf.t, surf.bt)
+        co = wl[2]
         packed[LAYOUT["co"]] = co
         fd = np.where(prm.f0_dielectric > 0, 1.0 - schlick(prm.f0_dielectric, co), 1.0)
-        packed[LAYOUT["kd"]] = (prm.diffuse * (fd * INV_PI)[:, None] * LUM).T
+        packed[LAYOUT["kd"]] = prm.diffuse * (fd * INV_PI) * LUM[:, None]
         packed[LAYOUT["spec_on"]] = prm.spec_on
         packed[LAYOUT["p_spec"]] = prm.p_spec
         packed[LAYOUT["alpha"]] = prm.alpha
         packed[LAYOUT["alpha2"]] = prm.alpha * prm.alpha
         e = surf.albedo if getattr(surf, "albedo", None) is not None else view_albedo(prm, wl)
-        comp = 1.0 + prm.f0 * ((1.0 - e) / e)[:, None]
-        packed[LAYOUT["a"]] = (prm.f0 * comp * LUM).T
-        packed[LAYOUT["b"]] = ((1.0 - prm.f0) * comp * LUM).T
+        comp = 1.0 + prm.f0 * ((1.0 - e) / e)
+        packed[LAYOUT["a"]] = prm.f0 * comp * LUM[:, None]
+        packed[LAYOUT["b"]] = (1.0 - prm.f0) * comp * LUM[:, None]
         packed[LAYOUT["lam_o"]] = smith_lambda(prm.alpha, co)
         return ShadingTerms(packed)
 
@@ -239,7 +240,7 @@ def with_spots(pts: PackedPoints, spot_tri: np.ndarray, lamps, receivers: np.nda
         return pts
     rec = np.broadcast_to(receivers, (3,) + spot_tri.shape)
     le = pts.le.copy()
-    f = spot_factor(lamps, spot_tri[spot], np.stack([rec[i][spot] for i in range(3)], axis=1))
+    f = spot_factor(lamps, spot_tri[spot], np.stack([rec[i][spot] for i in range(3)]))
     for i in range(3):
         le[i][spot] *= f
     return PackedPoints(pts.pos, pts.normal, le, pts.pdf, pts.two_sided)

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..accel import offset_origin, shadow_rays
-from ..bsdf import ViewTerms, eval_view, luminance, sample_bsdf
+from ..bsdf import ViewTerms, eval_view, luminance_rows, sample_bsdf
 from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
-from ..sampling import dot, row_max, take_rows, to_local, to_world, uniform_ints
+from ..sampling import cols, dot, norm, to_local, to_world, uniform_ints, vmax
 from ..target import FramePoints, with_spots
 from .reservoir import Reservoirs, Stream
 
@@ -136,7 +136,7 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     All light candidates are weighed first and one is selected per surface in proportion to its weight (the
     same distribution as streaming them one at a time). Returns (DIReservoirs, BsdfRay or None): the first
     BSDF candidate's ray when ``keep_bsdf_ray``."""
-    n = len(surf.p)
+    n = len(surf)
     lights = ctx.lights
     m_l = cfg.light_candidates if lights.tri_alias is not None else 0
     m_b = cfg.bsdf_candidates if lights.n_tri else 0
@@ -163,16 +163,16 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     first_ray = None
     lamps = ctx.scene.lamps
     for j in range(max(m_b, 1 if keep_bsdf_ray else 0)):
-        u = rng.random((n, 3), dtype=np.float32)
-        wi_l, f, p_b = sample_bsdf(surf.params, surf.wo_l, u[:, 0], u[:, 1], u[:, 2], view=surf.view)
-        wi = to_world(wi_l, surf.ns, surf.t, surf.bt).astype(np.float32)
-        wi /= np.maximum(np.sqrt(dot(wi, wi)), 1e-12)[:, None]
+        u = rng.random((3, n), dtype=np.float32)
+        wi_l, f, p_b = sample_bsdf(surf.params, surf.wo_l, u[0], u[1], u[2], view=surf.view)
+        wi = to_world(wi_l, surf.ns, surf.t, surf.bt).astype(np.float32, copy=False)
+        wi /= np.maximum(norm(wi), np.float32(1e-12))
         live = np.flatnonzero((p_b > 0) & (dot(wi, surf.ng) > 0))
-        o = offset_origin(surf.p[live], surf.ng[live], wi[live])
-        d = wi[live]
+        d = cols(wi, live)
+        o = offset_origin(cols(surf.p, live), cols(surf.ng, live), d)
         hits = ctx.geom_accel.intersect(o, d)
         if j == 0 and keep_bsdf_ray:
-            first_ray = BsdfRay(live, wi_l[live], f[live], p_b[live], o, d, hits)
+            first_ray = BsdfRay(live, cols(wi_l, live), cols(f, live), p_b[live], o, d, hits)
         if j >= m_b or live.size == 0:
             continue
         candidates = []
@@ -199,52 +199,55 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
 
 
 def shading_value(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l: np.ndarray):
-    """Target p̂ (n,), f (n, 3), geometry term G (n,) and the BSDF pdf in area measure (n,) of light points
-    in directions wi (world) at distances dist (the exact RGB model of bsdf.py)."""
+    """Target p̂ (n,), f (3, n), geometry term G (n,) and the BSDF pdf in area measure (n,) of light points
+    in directions wi (3, n) (world) at distances dist (the exact RGB model of bsdf.py)."""
     wi_l = to_local(wi, surf.ns, surf.t, surf.bt)
     view = surf.view if hasattr(type(surf), "view") else ViewTerms.of(surf.params, surf.wo_l)
     f, pdf_b = eval_view(view, surf.wo_l, wi_l)
     ok = (dot(wi, surf.ng) > 0) & (dist > 0)
     to_area = np.abs(cos_l) / np.maximum(dist * dist, 1e-30)
-    g = np.abs(wi_l[:, 2]) * to_area
-    p_hat = np.where(ok, luminance(f * le) * g, 0.0).astype(np.float32)
+    g = np.abs(wi_l[2]) * to_area
+    p_hat = (luminance_rows(f * le) * g * ok).astype(np.float32, copy=False)
     return p_hat, f, np.where(ok, g, 0.0).astype(np.float32), np.where(ok, pdf_b * to_area, 0.0).astype(np.float32)
 
 
 def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
-    """Direct radiance (n, 3) at the surfaces: each reservoir's sample with one shadow ray, plus one
+    """Direct radiance (3, n) at the surfaces: each reservoir's sample with one shadow ray, plus one
     light-sampled sun."""
-    n = len(surf.p)
-    out = np.zeros((n, 3), np.float32)
+    n = len(surf)
+    out = np.zeros((3, n), np.float32)
     lights = ctx.lights
     live = res.has_sample() & (res.W > 0)
     rays = []  # (rows, contributions, origins, directions, tmax): one Embree call for both kinds
     if live.any():  # every row at once (empty reservoirs contribute zero): no row subsets to copy
         q, wi, dist, cos_l, le = lights.point_towards(np.maximum(res.light, 0), res.b1, res.b2, surf.p)
         _p, f, g, _pb = shading_value(surf, wi, le, dist, cos_l)
-        contrib = f * le * (g * res.W * live)[:, None]
-        go = np.flatnonzero(row_max(contrib) > 0)
+        contrib = f * le
+        contrib *= g * res.W * live
+        go = np.flatnonzero(vmax(contrib) > 0)
         if go.size:
-            rays.append((go, take_rows(contrib, go), *shadow_rays(take_rows(surf.p, go), take_rows(surf.ng, go),
-                                                                  take_rows(q, go), take_rows(wi, go), dist[go])))
+            rays.append((go, cols(contrib, go), *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(q, go),
+                                                             cols(wi, go), dist[go])))
     if lights.sun_alias is not None:
-        ls = lights.sample_suns(n, rng.random((n, 4), dtype=np.float32))
+        ls = lights.sample_suns(n, rng.random((4, n), dtype=np.float32))
         wi_l = to_local(ls.wi, surf.ns, surf.t, surf.bt)
         f, _pb = eval_view(surf.view, surf.wo_l, wi_l)
         ok = (dot(ls.wi, surf.ng) > 0) & (ls.pdf > 0)
-        contrib = f * ls.le * (np.abs(wi_l[:, 2]) / np.maximum(ls.pdf, 1e-30) * ok)[:, None]
-        go = np.flatnonzero(row_max(contrib) > 0)
+        contrib = f * ls.le
+        contrib *= np.abs(wi_l[2]) / np.maximum(ls.pdf, 1e-30) * ok
+        go = np.flatnonzero(vmax(contrib) > 0)
         if go.size:
-            rays.append((go, take_rows(contrib, go), *shadow_rays(take_rows(surf.p, go), take_rows(surf.ng, go),
-                                                                  take_rows(ls.pos, go), take_rows(ls.wi, go),
-                                                                  ls.dist[go])))
+            rays.append((go, cols(contrib, go), *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(ls.pos, go),
+                                                             cols(ls.wi, go), ls.dist[go])))
     if rays:
-        _rows, _c, o, d, far = (np.concatenate(parts) for parts in zip(*rays))
+        o = np.concatenate([r[2] for r in rays], axis=1)
+        d = np.concatenate([r[3] for r in rays], axis=1)
+        far = np.concatenate([r[4] for r in rays])
         visible = ~ctx.geom_accel.occluded(o, d, far)
         start = 0
         for rows, contrib, *_ in rays:  # rows are unique within each kind
             vis = visible[start:start + len(rows)]
-            out[rows[vis]] += contrib[vis]
+            out[:, rows[vis]] += contrib[:, vis]
             start += len(rows)
     bad = ~np.isfinite(out)
     if bad.any():

@@ -199,7 +199,7 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
 
     n = len(rows)
     prev_gb = hist.gbuf
-    p_now = gb.terms.p[:, rows].T
+    p_now = np.take(gb.terms.p, rows, axis=1)
     p_then = p_now if motion is None else motion.moved_points(p_now, gb.instance[rows], "prev")
     raster, depth_then = project(hist.camera, p_then)
     x0, y0, w, h = hist.camera.window
