@@ -341,10 +341,12 @@ class FrameRenderer:
                 now = space.prepare(res) if st.bias_correction == "UNBIASED" else None
                 had = hist.had_light
                 possible = None if had is None else (lambda rows: had[np.maximum(res.light[rows], 0)])
-                parts = list(pool().map(lambda a: (a[1], reuse.temporal_reuse(
-                    space, gb, res, now, hist, prepared, a[1], st.confidence_cap, st.bias_correction, motion,
-                    rng(st.seed, st.frame, s, STREAM_TEMPORAL, a[0]), possible)), enumerate(spans)))
-                del prepared, now
+                jobs = [(rows, (space, gb, res, now, hist, prepared, rows, st.confidence_cap, st.bias_correction,
+                                motion, rng(st.seed, st.frame, s, STREAM_TEMPORAL, i), possible))
+                        for i, rows in enumerate(spans)]
+                del prepared, now  # released with the jobs once merged
+                parts = list(pool().map(_run_job(reuse.temporal_reuse), jobs))
+                del jobs
                 res = _gather(space.kind, parts, len(gb))
                 del parts
         if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode
@@ -354,10 +356,12 @@ class FrameRenderer:
         for k in range(self.spatial.passes if self.spatial.neighbors else 0):
             with clock.stage("spatial"):
                 prepared = space.prepare(res)
-                parts = list(pool().map(lambda a: (a[1], reuse.spatial_reuse(
-                    space, gb, res, prepared, a[1], self.spatial, rng(st.seed, st.frame, s, STREAM_SPATIAL + k, a[0]))),
-                    enumerate(spans)))
-                del prepared
+                jobs = [(rows, (space, gb, res, prepared, rows, self.spatial,
+                                rng(st.seed, st.frame, s, STREAM_SPATIAL + k, i)))
+                        for i, rows in enumerate(spans)]
+                del prepared  # released with the jobs once merged
+                parts = list(pool().map(_run_job(reuse.spatial_reuse), jobs))
+                del jobs
                 res = _gather(space.kind, parts, len(gb))
                 del parts
         if s == 0:  # the next frame's history; confidence at most the cap, so no reused M ever exceeds it
@@ -422,6 +426,11 @@ def _finite(a: np.ndarray) -> np.ndarray:
     if bad.any():
         a[bad] = 0.0
     return a
+
+
+def _run_job(fn):
+    """A pool task running ``fn(*args)`` for a (rows, args) job and returning (rows, result)."""
+    return lambda job: (job[0], fn(*job[1]))
 
 
 def _gather(kind, parts, n: int):
