@@ -182,7 +182,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         settings = settings_from_scene(scene)
         settings.samples = 1
         settings.data_passes = False  # the viewport shows Combined only
-        settings.tile_pixels = 4096  # small tiles: the view reacts quickly to navigation
+        settings.tile_pixels = 16384  # small chunks: a stop request is seen within one chunk of one stage
         self._viewport.set_scene(core_scene, settings)
         self._viewport.set_view(cam, self._view_key(context, w, h))
 

@@ -41,7 +41,7 @@ from .scene import Scene
 from .target import WIDTH, ShadingTerms
 
 INTEGRATORS = ("PATH", "RESTIR")
-CHUNK_PIXELS = 16384  # pixels per chunk of work (its working set stays in the 4 MB L2 of a core)
+CHUNK_PIXELS = 32768  # pixels per chunk of work (measured: scripts/benchmark_stages.py --tile-sweep)
 
 
 class Cancelled(Exception):
