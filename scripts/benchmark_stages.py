@@ -109,36 +109,43 @@ def warm_up():
 
 
 def chart(results, before, path):
+    """Stacked bars of the stages per run, beside the earlier code's total (it had no stage split) when a
+    'before' file exists."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     names = [r["name"] for r in results]
-    series = [("after", results)] + ([("before", [before.get(n) for n in names])] if before else [])
     stages = list(STAGES) + ["other"]
     colors = plt.get_cmap("tab10").colors
-    fig, ax = plt.subplots(figsize=(10, 5))
-    width = 0.8 / len(series)
-    for si, (label, rows) in enumerate(series):
-        xs = np.arange(len(names)) + si * width
-        bottom = np.zeros(len(names))
-        for ki, st in enumerate(stages):
-            vals = np.array([(r or {}).get("stages", {}).get(st, {}).get("wall_s", 0.0) for r in rows])
-            if label == "before":  # earlier code may not split stages: its total frame time as one bar
-                vals = np.array([r["frame_s"] if (r and st == "other" and not r.get("stages")) else v
-                                 for r, v in zip(rows, vals)])
-            ax.bar(xs, vals, width, bottom=bottom, color=colors[ki % 10], alpha=1.0 if label == "after" else 0.45,
-                   label=st if si == 0 else None, edgecolor="black" if label == "before" else None)
-            bottom += vals
-        for x, r in zip(xs, rows):
-            if r:
-                ax.text(x, r["frame_s"] * 1.01, f"{r['frame_s']:.2f}s\n{label}\nE {100 * r['embree_share']:.0f}%",
+    fig, ax = plt.subplots(figsize=(11, 5.5))
+    width = 0.38 if before else 0.6
+    xs = np.arange(len(names))
+    bottom = np.zeros(len(names))
+    for ki, st in enumerate(stages):
+        vals = np.array([r["stages"].get(st, {}).get("wall_s", 0.0) for r in results])
+        ax.bar(xs, vals, width, bottom=bottom, color=colors[ki % 10], label=st)
+        bottom += vals
+    top = max(r["frame_s"] for r in results)
+    for x, r in zip(xs, results):
+        ax.text(x, r["frame_s"] + 0.01 * top, f"{r['frame_s']:.2f} s\nE {100 * r['embree_share']:.0f}%",
+                ha="center", va="bottom", fontsize=7)
+    if before:
+        prev = [before.get(n) for n in names]
+        vals = np.array([p["frame_s"] if p else 0.0 for p in prev])
+        ax.bar(xs + width, vals, width, color="lightgrey", edgecolor="black", hatch="//",
+               label="before (total; no stage split)")
+        top = max(top, vals.max())
+        for x, p in zip(xs, prev):
+            if p:
+                ax.text(x + width, p["frame_s"] + 0.01 * top, f"{p['frame_s']:.2f} s\nE {100 * p['embree_share']:.0f}%",
                         ha="center", va="bottom", fontsize=7)
-    ax.set_xticks(np.arange(len(names)) + 0.4 - width / 2)
+    ax.set_ylim(0, top * 1.2)
+    ax.set_xticks(xs + (width / 2 if before else 0))
     ax.set_xticklabels(names, rotation=15, fontsize=8)
     ax.set_ylabel("seconds per frame (640x360, 1 sample, steady state)")
-    ax.set_title("Frame time by stage (E = Embree share of the 2 cores)")
-    ax.legend(fontsize=8, ncol=4)
+    ax.set_title("Frame time by stage (E = Embree's share of the 2 cores)")
+    ax.legend(fontsize=8, ncol=4, loc="upper right")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 

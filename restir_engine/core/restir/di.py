@@ -122,7 +122,8 @@ def _light_candidates(ctx, terms, rng, tiles, m_l: int, m_b: int, px, py):
         den = m_l * pts.pdf if p_b is None else m_l * pts.pdf + m_b * p_b
         np.maximum(den, np.float32(1e-30), out=den)
         wk = np.divide(p_hat, den, out=den)
-        wk[~np.isfinite(wk)] = 0.0
+        if not np.isfinite(wk).all():  # a light point on the surface itself: p̂ overflows
+            wk[~np.isfinite(wk)] = 0.0
         w[k0:k1] = wk
         p_hats[k0:k1] = p_hat
     return w, p_hats, points, pick
