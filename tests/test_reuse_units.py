@@ -199,3 +199,17 @@ def test_history_remap_when_lights_switch():
     assert new.had_light.tolist() == [True, True, False]
     assert res.W.tolist() == [1, 1, 1, 1]  # the original history is untouched
     assert hist.remapped(Lights(("other",), np.array([0, 1]), (4, 0), 2)) is None  # other triangles: no map
+
+
+def test_reuse_over_a_slice_equals_reuse_over_its_indices(monkeypatch):
+    """The renderer hands reuse contiguous chunks as slices (views instead of gathers): same output."""
+    monkeypatch.setattr(reuse, "neighbor_offsets", lambda k, r, rng, n: np.tile(np.array([[[1.0, 0.0]]], F), (n, k, 1)))
+    space = TableSpace([[5, 5, 5], [5, 2, 1], [5, 4, 3]])
+    res = reservoirs([0, 1, 2], [1, 1, 1], [0.5, 1.5, 2.0], [5, 2, 3])
+    gb = _gbuffer([1.2, 1.0, 1.05])
+    cfg = reuse.SpatialSettings(neighbors=1, radius=1.0, passes=1, bias_correction="UNBIASED")
+    for seed in range(20):
+        a = reuse.spatial_reuse(space, gb, res, space.prepare(res), np.arange(3), cfg, np.random.default_rng(seed))
+        b = reuse.spatial_reuse(space, gb, res, space.prepare(res), slice(0, 3), cfg, np.random.default_rng(seed))
+        for name in IdSamples.fields():
+            assert np.array_equal(getattr(a, name), getattr(b, name)), name

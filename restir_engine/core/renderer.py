@@ -358,8 +358,9 @@ class FrameRenderer:
         return gb
 
     def _spans(self, n: int):
+        """Chunks of the frame's n surfaces as slices (reuse reads a chunk's own data as views)."""
         step = max(64, int(self.settings.tile_pixels))
-        return [np.arange(a, min(n, a + step)) for a in range(0, n, step)]
+        return [slice(a, min(n, a + step)) for a in range(0, n, step)]
 
     def _reuse(self, gb: GBuffer, res, s: int):
         """Temporal (first pass of a frame, with a history), boiling filter, spatial passes; makes the next

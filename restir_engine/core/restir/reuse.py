@@ -138,12 +138,24 @@ class SpatialSettings:
     bias_correction: str = "UNBIASED"
 
 
+def _indices(rows) -> np.ndarray:
+    """``rows`` (index array or slice with start and stop) as an index array."""
+    return np.arange(rows.start, rows.stop) if isinstance(rows, slice) else rows
+
+
+def _columns(a: np.ndarray, rows) -> np.ndarray:
+    """Columns ``rows`` of a (k, n) block: a view for a slice, a gather otherwise."""
+    return a[:, rows] if isinstance(rows, slice) else np.take(a, rows, axis=1)
+
+
 def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: SpatialSettings,
                   rng: np.random.Generator) -> Reservoirs:
     """One spatial pass for surfaces ``rows`` of the G-buffer ``gb`` (restir.gbuffer.GBuffer): merge up to
     ``cfg.neighbors`` similar neighbours' reservoirs of ``res`` (the whole frame; ``prepared`` =
-    ``space.prepare(res)``) into each surface's own. Returns the new reservoirs of ``rows``."""
-    n = len(rows)
+    ``space.prepare(res)``) into each surface's own. Returns the new reservoirs of ``rows`` (an index array,
+    or a slice: then the surface's own data are views, not gathers)."""
+    ids = _indices(rows)
+    n = len(ids)
     unbiased = cfg.bias_correction == "UNBIASED"
     me = gb.terms.take(rows)
     pix = gb.pix[rows]
@@ -151,7 +163,7 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
     offs = neighbor_offsets(cfg.neighbors, cfg.radius, rng, n)
     canonical = res.take(rows)
     own = space.gather(prepared, rows) if unbiased else None
-    depth_c, ns_c = gb.depth[rows], np.take(gb.normals, rows, axis=1)
+    depth_c, ns_c = gb.depth[rows], _columns(gb.normals, rows)
     own_ok = canonical.has_sample()
     has = res.has_sample()
     neighbours, taken = [], []
@@ -162,12 +174,12 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
         q = gb.slot[np.where(inside, qy * gb.width + qx, pix)]
         # a neighbour outside the window or without a surface, the pixel itself or one already merged would
         # be a correlated duplicate (biased): skip it
-        ok = inside & (q >= 0) & (q != rows)
+        ok = inside & (q >= 0) & (q != ids)
         for q_prev in taken:
             ok &= q != q_prev
-        q = np.where(ok, q, rows)
+        q = np.where(ok, q, ids)
         ok &= similar(depth_c, gb.depth[q], ns_c, np.take(gb.normals, q, axis=1))
-        q = np.where(ok, q, rows)
+        q = np.where(ok, q, ids)
         taken.append(q)
         m_q = res.M[q] * ok
         if not ok.any():
@@ -197,9 +209,9 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     the current sample (a light switched on since): its target there is zero for the MIS weights."""
     from ..camera import project
 
-    n = len(rows)
+    n = len(_indices(rows))
     prev_gb = hist.gbuf
-    p_now = np.take(gb.terms.p, rows, axis=1)
+    p_now = _columns(gb.terms.p, rows)
     p_then = p_now if motion is None else motion.moved_points(p_now, gb.instance[rows], "prev")
     raster, depth_then = project(hist.camera, p_then)
     x0, y0, w, h = hist.camera.window
@@ -209,8 +221,7 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     q = prev_gb.slot[np.where(inside, py * w + px, 0)]
     ok = inside & (q >= 0)
     q = np.where(ok, q, 0)
-    ok &= similar(depth_then, prev_gb.depth[q], np.take(gb.normals, rows, axis=1),
-                  np.take(prev_gb.normals, q, axis=1))
+    ok &= similar(depth_then, prev_gb.depth[q], _columns(gb.normals, rows), np.take(prev_gb.normals, q, axis=1))
     ok &= prev_gb.material[q] == gb.material[rows]
     canonical = res.take(rows)
     prev = hist.res
