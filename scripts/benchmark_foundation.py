@@ -75,11 +75,11 @@ def bench_rays(scene, repeat):
     yy, xx = np.mgrid[0:h, 0:w]
     o, d, tmax = camera_mod.generate_rays(cam, (xx.ravel() + 0.5).astype(np.float32), (yy.ravel() + 0.5).astype(np.float32))
     accel = Accel(scene.geometry.verts)
-    n = len(o)
+    n = o.shape[1]  # rays are (3, n) rows
     tmin_wrap, _, _ = best_of(lambda: accel.intersect(o, d, tmax), repeat)
     # direct embreex: one single-threaded call on one wrapper-sized chunk, scaled to rays/s
     from restir_engine.core.accel import CHUNK_RAYS
-    oc, dc = o[:CHUNK_RAYS].copy(), d[:CHUNK_RAYS].copy()
+    oc, dc = np.ascontiguousarray(o[:, :CHUNK_RAYS].T), np.ascontiguousarray(d[:, :CHUNK_RAYS].T)
     tmin_direct, _, _ = best_of(lambda: accel._scene.run(oc, dc, output=1), repeat)
     direct_rps = len(oc) / tmin_direct
     wrap_rps = n / tmin_wrap
