@@ -50,17 +50,20 @@ def light_near_the_floor(width=32):
 
 
 def test_biased_mode_filter_cuts_outliers():
-    """1/M with temporal + spatial reuse under a small light close to the floor: with the filter the upper
-    tail of the pixel values falls (the 99th percentile over pixels and seeds: 0.34 -> 0.27 here; the
-    per-pixel variance, dominated by a few pixels right under the light that the filter keeps, changes by
-    about 1 % and is not a usable criterion), and the image only gets darker (the filter's bias)."""
+    """1/M with temporal + spatial reuse under a small light close to the floor: with the filter fewer pixels
+    reach the unfiltered renders' top 1 % (measured over 24 seeds in two noise patterns: 171 and 179 against
+    246, ratio 0.70 ± 0.04; a binomial spread of ±13 puts the 0.85 bound 2.6 sd away), and the image only gets
+    darker (the filter's bias). The per-pixel variance is no criterion: it is dominated by a few pixels right
+    under the light whose weight stays below 5x their block's mean, and changes by a few per cent either way."""
     scene = light_near_the_floor()
     st = dict(RESTIR, samples=4, bias_correction="NONE")
-    off = np.array([render_frame(scene, RenderSettings(**st, seed=s)).passes["Direct"][..., 0] for s in range(6)])
+    seeds = range(24)
+    off = np.array([render_frame(scene, RenderSettings(**st, seed=s)).passes["Direct"][..., 0] for s in seeds])
     runs = [render_frame(scene, RenderSettings(**st, seed=s, boiling_filter=True, boiling_threshold=5.0))
-            for s in range(6)]
+            for s in seeds]
     on = np.array([r.passes["Direct"][..., 0] for r in runs])
     assert min(r.stats["boiling_dropped"] for r in runs) > 0
     assert np.isfinite(on).all()
-    assert np.quantile(on, 0.99) < 0.9 * np.quantile(off, 0.99)
+    top = np.quantile(off, 0.99)
+    assert (on > top).sum() < 0.85 * (off > top).sum(), ((on > top).sum(), (off > top).sum())
     assert on.mean() < off.mean()

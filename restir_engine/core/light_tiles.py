@@ -74,9 +74,10 @@ class PackedPoints:
         return PackedPoints(block[0:3], block[3:6], block[6:9], block[9], block[10] > 0)
 
 
-def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> LightPoints:
+def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out: np.ndarray | None = None) -> LightPoints:
     """The points (b1, b2) of triangle lights ``light`` of a lights.LightTable, built in packed form (column
-    gathers from the table's (3, n_tri) corner, edge, normal and radiance rows)."""
+    gathers from the table's (3, n_tri) corner, edge, normal and radiance rows), into ``out`` ((11, n)) if
+    given."""
     n = len(light)
     if lights.n_tri == 0:  # no triangle lights: every point is an empty placeholder
         z3 = np.zeros((3, n), np.float32)
@@ -85,7 +86,7 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> L
     light = light.astype(np.intp)
     b1 = np.asarray(b1, np.float32)
     b2 = np.asarray(b2, np.float32)
-    blk = np.empty((11, n), np.float32)
+    blk = np.empty((11, n), np.float32) if out is None else out
     pos = blk[0:3]
     np.take(lights.rows_v0, light, axis=1, out=pos)
     pos += np.take(lights.rows_e1, light, axis=1) * b1

@@ -27,7 +27,7 @@ import numpy as np
 
 from . import camera as camera_mod
 from . import pathtracer
-from .accel import in_worker, pool
+from .accel import in_worker, pool, thread_count
 from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
 from .context_cache import context_for
@@ -267,7 +267,7 @@ class FrameRenderer:
         clock = self.clock
         x0, y0, w, h = self.ctx.scene.camera.window
         npix = w * h
-        step = max(64, int(st.tile_pixels))
+        step = _chunk_size(npix, st.tile_pixels)
         chunks = [_Chunk(i, np.arange(a, min(npix, a + step))) for i, a in enumerate(range(0, npix, step))]
         resampled = self.candidates is not None
         reusing = self.method == "RESTIR"
@@ -359,7 +359,7 @@ class FrameRenderer:
 
     def _spans(self, n: int):
         """Chunks of the frame's n surfaces as slices (reuse reads a chunk's own data as views)."""
-        step = max(64, int(self.settings.tile_pixels))
+        step = _chunk_size(n, self.settings.tile_pixels)
         return [slice(a, min(n, a + step)) for a in range(0, n, step)]
 
     def _reuse(self, gb: GBuffer, res, s: int):
@@ -468,6 +468,16 @@ def _finite(a: np.ndarray) -> np.ndarray:
     if bad.any():
         a[bad] = 0.0
     return a
+
+
+def _chunk_size(n: int, target: int) -> int:
+    """Items per chunk near ``target`` such that the chunk count is a multiple of the pool's threads (7 chunks
+    on 2 threads leave one core idle for the last one)."""
+    target = max(64, int(target))
+    threads = thread_count()
+    count = max(1, -(-n // target))
+    count = -(-count // threads) * threads
+    return max(64, -(-n // count))
 
 
 def _run_job(fn):

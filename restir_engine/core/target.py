@@ -22,6 +22,7 @@ import numpy as np
 
 from .bsdf import schlick, smith_lambda, view_albedo
 from .light_tiles import PackedPoints, light_points
+from .accel import in_worker, pool
 from .lights import spot_factor
 from .sampling import to_world
 
@@ -250,11 +251,22 @@ class FramePoints:
     """The light points of a frame of reservoirs (empty reservoirs hold an arbitrary point), packed as
     (11, n) for column gathers by neighbouring pixels, with their spot lamp triangles (None: no spots)."""
 
+    CHUNK = 65536  # points per pool task
+
     def __init__(self, lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray):
-        pts = light_points(lights, np.maximum(light, 0), b1, b2)
-        self.rows = pts.packed()
-        self.spot_tri = pts.spot_tri if pts.has_spots else None
+        n = len(light)
         self.lamps = lights.scene.lamps
+        if lights.n_tri == 0 or n <= self.CHUNK or in_worker():
+            pts = light_points(lights, np.maximum(light, 0), b1, b2)
+            self.rows = pts.packed()
+            self.spot_tri = pts.spot_tri if pts.has_spots else None
+            return
+        self.rows = np.empty((11, n), np.float32)
+        spans = [slice(a, min(n, a + self.CHUNK)) for a in range(0, n, self.CHUNK)]
+        parts = list(pool().map(lambda sl: light_points(lights, np.maximum(light[sl], 0), b1[sl], b2[sl],
+                                                        out=self.rows[:, sl]).spot_tri, spans))
+        spot_tri = np.concatenate(parts)
+        self.spot_tri = spot_tri if (spot_tri >= 0).any() else None
 
     def points(self, q) -> PackedPoints:
         """Points of reservoirs ``q`` (index array or slice), spot cones not applied."""
