@@ -132,7 +132,7 @@ def test_spatial_reuse_merges_the_neighbour_and_skips_rejected_ones(monkeypatch)
     """Every pixel's neighbour is the pixel to its right (fixed offsets): pixel 0 is rejected by depth
     (20 % apart), pixel 2's neighbour lies outside the window; pixel 1 merges pixel 2 exactly as
     :func:`reuse.merge` says."""
-    monkeypatch.setattr(reuse, "neighbor_offsets", lambda k, r, rng, n: np.tile(np.array([[[1.0, 0.0]]], F), (n, k, 1)))
+    monkeypatch.setattr(reuse, "neighbor_offsets", lambda k, r, rng, n: np.tile(np.array([[[1.0], [0.0]]], F), (k, 1, n)))
     table = [[5, 5, 5],   # p̂ at surface 0 of samples 0, 1, 2
              [5, 2, 1],   # surface 1: its own sample 1 has p̂ 2, the neighbour's sample 2 has p̂ 1
              [5, 4, 3]]   # surface 2: p̂_q(y_c) = 4, p̂_q(y_q) = 3
@@ -203,7 +203,7 @@ def test_history_remap_when_lights_switch():
 
 def test_reuse_over_a_slice_equals_reuse_over_its_indices(monkeypatch):
     """The renderer hands reuse contiguous chunks as slices (views instead of gathers): same output."""
-    monkeypatch.setattr(reuse, "neighbor_offsets", lambda k, r, rng, n: np.tile(np.array([[[1.0, 0.0]]], F), (n, k, 1)))
+    monkeypatch.setattr(reuse, "neighbor_offsets", lambda k, r, rng, n: np.tile(np.array([[[1.0], [0.0]]], F), (k, 1, n)))
     space = TableSpace([[5, 5, 5], [5, 2, 1], [5, 4, 3]])
     res = reservoirs([0, 1, 2], [1, 1, 1], [0.5, 1.5, 2.0], [5, 2, 3])
     gb = _gbuffer([1.2, 1.0, 1.05])
@@ -213,3 +213,14 @@ def test_reuse_over_a_slice_equals_reuse_over_its_indices(monkeypatch):
         b = reuse.spatial_reuse(space, gb, res, space.prepare(res), slice(0, 3), cfg, np.random.default_rng(seed))
         for name in IdSamples.fields():
             assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+def test_neighbour_offsets_fill_the_disc():
+    """Offsets (k, 2, n): inside the radius, every pixel's k offsets at the spiral's radii, pixels rotated
+    differently."""
+    offs = reuse.neighbor_offsets(5, 30.0, np.random.default_rng(0), 1000)
+    assert offs.shape == (5, 2, 1000)
+    r = np.hypot(offs[:, 0], offs[:, 1])
+    np.testing.assert_allclose(r, (30.0 * np.sqrt((np.arange(5) + 0.5) / 5))[:, None] * np.ones((1, 1000)), rtol=1e-5)
+    angle = np.arctan2(offs[0, 1], offs[0, 0])
+    assert np.histogram(angle, bins=8, range=(-np.pi, np.pi))[0].min() > 80  # uniform rotations (expect 125)

@@ -38,17 +38,18 @@ def similar(depth_ref: np.ndarray, depth: np.ndarray, ns_ref: np.ndarray, ns: np
 
 
 def neighbor_offsets(k: int, radius: float, rng: np.random.Generator, n: int) -> np.ndarray:
-    """Per-pixel neighbour offsets (n, k, 2) in pixels: a golden-angle spiral filling the disc of
-    ``radius`` (low discrepancy), rotated by a random angle per pixel and pass (no ring artefacts)."""
+    """Per-pixel neighbour offsets (k, 2, n) in pixels (neighbour, x/y, pixel): a golden-angle spiral filling
+    the disc of ``radius`` (low discrepancy), rotated by a random angle per pixel and pass (no ring
+    artefacts)."""
     j = np.arange(k, dtype=np.float32)
     r = np.float32(radius) * np.sqrt((j + 0.5) / k)
     spiral = j * np.float32(2.39996323)
-    cs, sn = r * np.cos(spiral), r * np.sin(spiral)            # (k,) the spiral before the rotation
-    turn = rng.random((n, 1), dtype=np.float32) * np.float32(2 * np.pi)
-    ct, st = np.cos(turn), np.sin(turn)                         # (n, 1) the rotation of each pixel
-    out = np.empty((n, k, 2), np.float32)
-    out[..., 0] = ct * cs - st * sn                             # r cos(spiral + turn)
-    out[..., 1] = st * cs + ct * sn                             # r sin(spiral + turn)
+    cs, sn = (r * np.cos(spiral))[:, None], (r * np.sin(spiral))[:, None]  # (k, 1) the spiral before the turn
+    turn = rng.random(n, dtype=np.float32) * np.float32(2 * np.pi)
+    ct, st = np.cos(turn), np.sin(turn)                                     # (n,) the rotation of each pixel
+    out = np.empty((k, 2, n), np.float32)
+    out[:, 0] = ct * cs - st * sn                                           # r cos(spiral + turn)
+    out[:, 1] = st * cs + ct * sn                                           # r sin(spiral + turn)
     return out
 
 
@@ -168,8 +169,8 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
     has = res.has_sample()
     neighbours, taken = [], []
     for k in range(cfg.neighbors):
-        qx = np.round(px + offs[:, k, 0]).astype(np.int64)
-        qy = np.round(py + offs[:, k, 1]).astype(np.int64)
+        qx = np.round(px + offs[k, 0]).astype(np.int64)
+        qy = np.round(py + offs[k, 1]).astype(np.int64)
         inside = (qx >= 0) & (qx < gb.width) & (qy >= 0) & (qy < gb.height)
         q = gb.slot[np.where(inside, qy * gb.width + qx, pix)]
         # a neighbour outside the window or without a surface, the pixel itself or one already merged would
