@@ -3,31 +3,56 @@
 
 Usage: python -m restir_engine FILE.blend [-o PATH] [-F FORMAT] [-s N] [-e N] (-a | -f N)
        [--samples N] [--seed N] [--max-bounces N] [--percentage P]
-Output path, format and frame range come from the file unless overridden. Exit status 1 on errors.
+Output path, format and frame range come from the file unless overridden. A bad argument gets one line
+``error: ...`` and exit status 2; an unreadable file, an unknown engine or a failed render exit status 1.
 """
 from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (``error: ...``, exit status 2)."""
+
+    def error(self, message):
+        self.exit(2, f"error: {message}\n")
+
+
+def _at_least(low: int):
+    """An argparse type: an integer not below ``low``."""
+    def check(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be an integer, not {text!r}") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be at least {low}, not {value}")
+        return value
+    return check
+
+
 def parse(argv):
-    p = argparse.ArgumentParser(prog="python -m restir_engine", description=__doc__.split("\n\n")[0])
+    p = _Parser(prog="python -m restir_engine", description=__doc__.split("\n\n")[0])
     p.add_argument("blend", help=".blend file to render")
     p.add_argument("-o", "--render-output", help="output path, '#' = frame digits (as blender -o)")
     p.add_argument("-F", "--render-format", help="image format, e.g. PNG, OPEN_EXR, OPEN_EXR_MULTILAYER, JPEG")
-    p.add_argument("-s", "--frame-start", type=int)
-    p.add_argument("-e", "--frame-end", type=int)
+    p.add_argument("-s", "--frame-start", type=_at_least(0))
+    p.add_argument("-e", "--frame-end", type=_at_least(0))
     g = p.add_mutually_exclusive_group()
     g.add_argument("-a", "--render-anim", action="store_true", help="render the frame range (default)")
-    g.add_argument("-f", "--render-frame", type=int, help="render this one frame")
-    p.add_argument("--samples", type=int)
-    p.add_argument("--seed", type=int)
-    p.add_argument("--max-bounces", type=int)
-    p.add_argument("--percentage", type=int, help="resolution percentage")
+    g.add_argument("-f", "--render-frame", type=_at_least(0), help="render this one frame")
+    p.add_argument("--samples", type=_at_least(1))
+    p.add_argument("--seed", type=_at_least(0))
+    p.add_argument("--max-bounces", type=_at_least(0))
+    p.add_argument("--percentage", type=_at_least(1), help="resolution percentage")
     p.add_argument("--engine", default="RESTIR", help="render engine id (CYCLES for a reference render)")
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    if args.frame_start is not None and args.frame_end is not None and args.frame_end < args.frame_start:
+        p.error(f"frame end {args.frame_end} is before frame start {args.frame_start}")
+    return args
 
 
 def _set_format(scene, fmt: str):
@@ -56,15 +81,37 @@ def main(argv=None) -> int:
     from . import register
     if not hasattr(bpy.types.Scene, "restir"):
         register()
-    bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.blend))
+    try:
+        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.blend))
+    except RuntimeError as exc:
+        reason = str(exc).strip().splitlines()[-1].split("failed: ")[-1]
+        print(f"error: cannot read {args.blend}: {reason}", file=sys.stderr)
+        return 1
     scene = bpy.context.scene
-    scene.render.engine = args.engine
+    try:
+        scene.render.engine = args.engine
+    except TypeError as exc:  # the message lists the registered engines: "... not found in ('A', 'B')"
+        listed = re.search(r"not found in \((.*)\)", str(exc))
+        known = listed.group(1).replace("'", "") if listed else "see Blender's Render Properties"
+        print(f"error: unknown engine {args.engine!r}; available: {known}", file=sys.stderr)
+        return 1
     if args.render_output:
         out = args.render_output
         scene.render.filepath = out if out.startswith("//") else os.path.abspath(out) + ("/" if out.endswith("/") else "")
     if args.render_format:
         _set_format(scene, args.render_format)
-    if args.frame_start is not None:
+    if args.frame_end is not None and args.frame_end < (args.frame_start if args.frame_start is not None
+                                                        else scene.frame_start):
+        print(f"error: frame end {args.frame_end} is before the file's frame start {scene.frame_start}",
+              file=sys.stderr)
+        return 1
+    if args.frame_start is not None and args.frame_end is None and args.frame_start > scene.frame_end:
+        print(f"error: frame start {args.frame_start} is after the file's frame end {scene.frame_end}",
+              file=sys.stderr)
+        return 1
+    if args.frame_start is not None:  # set the end first when moving the range up: Blender clamps start <= end
+        if args.frame_end is not None and args.frame_end > scene.frame_end:
+            scene.frame_end = args.frame_end
         scene.frame_start = args.frame_start
     if args.frame_end is not None:
         scene.frame_end = args.frame_end

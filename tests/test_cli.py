@@ -52,3 +52,31 @@ def test_missing_file_and_missing_camera_fail_cleanly(addon, tmp_path):
     bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
     r = run_cli(str(path), "-f", "1")
     assert r.returncode == 1 and "camera" in r.stderr
+
+
+@pytest.mark.parametrize("args,line", [
+    (["--samples", "-3"], "error: argument --samples: must be at least 1, not -3"),
+    (["--samples", "x"], "error: argument --samples: must be an integer, not 'x'"),
+    (["--max-bounces", "-1"], "error: argument --max-bounces: must be at least 0, not -1"),
+    (["--percentage", "0"], "error: argument --percentage: must be at least 1, not 0"),
+    (["-s", "5", "-e", "2", "-a"], "error: frame end 2 is before frame start 5"),
+])
+def test_bad_arguments_get_one_line_and_status_2(blend, args, line):
+    r = run_cli(str(blend), *args)
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines() == [line]
+
+
+def test_unknown_engine_corrupt_file_and_inverted_range_against_the_file(blend, tmp_path):
+    r = run_cli(str(blend), "--engine", "FOO", "-f", "1")
+    assert r.returncode == 1 and r.stderr.startswith("error: unknown engine 'FOO'; available:")
+    assert "RESTIR" in r.stderr and "CYCLES" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    bad = tmp_path / "corrupt.blend"
+    bad.write_bytes(b"BLENDER-v500" + os.urandom(2000))
+    r = run_cli(str(bad), "-f", "1")
+    assert r.returncode == 1 and r.stderr.strip().splitlines()[-1].startswith(f"error: cannot read {bad}")
+    r = run_cli(str(blend), "-e", "0", "-a")  # the file's range is 1..2
+    assert r.returncode == 1 and "before the file's frame start 1" in r.stderr
+    r = run_cli(str(blend), "-s", "4", "-e", "5", "-o", str(tmp_path / "m_####"), "-F", "PNG", "--samples", "1")
+    assert r.returncode == 0, r.stderr  # a range above the file's: moved, not clamped
+    assert (tmp_path / "m_0004.png").exists() and (tmp_path / "m_0005.png").exists()
