@@ -90,13 +90,6 @@ def schlick(f0, cos):
     return f0 + (1.0 - f0) * c5
 
 
-def _ggx_d(alpha, cos_h):
-    a2 = alpha * alpha
-    c2 = cos_h * cos_h
-    den = c2 * (a2 - 1.0) + 1.0
-    return a2 / (np.pi * den * den)
-
-
 _ALBEDO_TABLE = None
 _TABLE_N = 32
 

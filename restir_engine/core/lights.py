@@ -168,10 +168,6 @@ class LightTable:
         le *= facing
         return q, w, dl, cos_l, le
 
-    def tri_only_pdf_area(self, light: np.ndarray) -> np.ndarray:
-        """Area-measure pdf (m⁻²) of a uniform point of triangle light ``light`` chosen by ``tri_alias``."""
-        return self.tri_pdf_area[light]
-
     def radiance_of(self, light: np.ndarray, b1, b2, p_receiver: np.ndarray) -> np.ndarray:
         """Radiance (3, n) leaving triangle light ``light`` at (b1, b2) towards p_receiver (3, n),
         before the sidedness test (spot cones included unless p_receiver is None)."""

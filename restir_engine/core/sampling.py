@@ -126,11 +126,6 @@ def cols(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
     return np.take(a, idx, axis=1)
 
 
-def take_rows(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
-    """a[idx] along the first axis of an (n, ...) array (np.take: 3-4x faster than fancy indexing of rows)."""
-    return np.take(a, idx, axis=0)
-
-
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Dot products of (3, n) vectors."""
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
