@@ -121,10 +121,9 @@ def test_merge_weights_and_selection(bias):
 def _gbuffer(depth, ns=None, material=(0, 0, 0)):
     """Three surfaces in a 3 x 1 window, surface i at pixel i."""
     n = len(depth)
-    gb = GBuffer(None, np.arange(n), n, 1, np.array(depth, F), np.zeros(n, np.int32),
+    gb = GBuffer(np.arange(n), n, 1, np.array(depth, F), np.zeros(n, np.int32), np.array(material, np.int32),
                  Terms(np.arange(n), np.zeros((3, n))))
     gb.normals = np.tile(np.array([[0], [0], [1]], F), (1, n)) if ns is None else np.array(ns, F)
-    gb.material = np.array(material, np.int32)
     return gb
 
 
@@ -167,7 +166,7 @@ def test_temporal_reuse_caps_confidence_and_rejects_disocclusions():
     space = TableSpace(np.array(table, F))
     res = reservoirs([0, 2, 2], [1, 1, 1], [1.5, 1.0, 1.0], [2, 1, 3])
     prev = reservoirs([1, 3, 3], [50, 5, 5], [2.0, 1.0, 1.0], [3, 1, 1])
-    hist = TemporalHistory(prev_gb.for_history(), prev, cam, ())
+    hist = TemporalHistory(prev_gb, prev, cam, ())
     out = reuse.temporal_reuse(space, gb, res, space.prepare(res), hist, space.prepare(prev), np.arange(3), 20.0,
                                "NONE", None, np.random.default_rng(0))
     assert out.M.tolist() == [21.0, 1.0, 1.0]

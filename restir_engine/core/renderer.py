@@ -351,11 +351,9 @@ class FrameRenderer:
         depth = fwd[0] * rel[0] + fwd[1] * rel[1] + fwd[2] * rel[2]  # planar depth along the camera axis
         inst = self.ctx.scene.geometry.instance
         prim = np.concatenate([sf.prim for sf in surfs])
-        gb = GBuffer(None, np.concatenate([c.pixels[c.hits.rows] for c in chunks]), w, h, depth.astype(np.float32),
-                     inst[prim] if inst is not None else np.zeros(len(prim), np.int32),
-                     ShadingTerms(terms))
-        gb.material = np.concatenate([sf.mat for sf in surfs])
-        return gb
+        return GBuffer(np.concatenate([c.pixels[c.hits.rows] for c in chunks]), w, h, depth.astype(np.float32),
+                       inst[prim] if inst is not None else np.zeros(len(prim), np.int32),
+                       np.concatenate([sf.mat for sf in surfs]), ShadingTerms(terms))
 
     def _spans(self, n: int):
         """Chunks of the frame's n surfaces as slices (reuse reads a chunk's own data as views)."""
@@ -404,7 +402,7 @@ class FrameRenderer:
                 del parts
         if s == 0:  # the next frame's history; confidence at most the cap, so no reused M ever exceeds it
             lights = ctx.lights
-            self.history = TemporalHistory(gb.for_history(), res.replace(M=np.minimum(res.M, st.confidence_cap)),
+            self.history = TemporalHistory(gb, res.replace(M=np.minimum(res.M, st.confidence_cap)),
                                            ctx.scene.camera, lights.signature, st.frame, lights.light_uid,
                                            lights.uid_space)
         return res

@@ -1,8 +1,7 @@
 """The G-buffer of one sample pass: the primary-hit surfaces of the window, compact.
 
-Surface i (surface.Surface rows, only pixels whose camera ray hit something) lies at window pixel pix[i]
-(row-major, row 0 at the bottom); ``slot`` maps a pixel back to its surface (-1: nothing hit). Beside the
-surfaces: planar depth along the camera axis (scene units), material and instance indices, the target
+Surface i (only pixels whose camera ray hit something) lies at window pixel pix[i] (row-major, row 0 at the
+bottom); ``slot`` maps a pixel back to its surface (-1: nothing hit). Per surface: planar depth along the camera axis (scene units), material and instance indices, the target
 function's packed terms (target.ShadingTerms, (27, n)) and their shading-normal rows ``normals`` (3, n)
 for similarity tests."""
 from __future__ import annotations
@@ -13,14 +12,13 @@ from ..target import ShadingTerms
 
 
 class GBuffer:
-    def __init__(self, surf, pix: np.ndarray, width: int, height: int, depth: np.ndarray, instance: np.ndarray,
-                 terms: ShadingTerms):
-        self.surf = surf
+    def __init__(self, pix: np.ndarray, width: int, height: int, depth: np.ndarray, instance: np.ndarray,
+                 material: np.ndarray, terms: ShadingTerms):
         self.pix = pix
         self.width, self.height = width, height
         self.depth = depth
         self.instance = instance
-        self.material = surf.mat if surf is not None else None
+        self.material = material
         self.terms = terms
         self.normals = getattr(terms, "ns", None)
         self.slot = np.full(width * height, -1, np.int64)
@@ -28,10 +26,3 @@ class GBuffer:
 
     def __len__(self) -> int:
         return len(self.pix)
-
-    def for_history(self) -> "GBuffer":
-        """What the next frame's temporal reuse reads (no BSDF parameters or tangent frames)."""
-        out = GBuffer.__new__(GBuffer)
-        out.__dict__.update(self.__dict__)
-        out.surf = None
-        return out

@@ -16,7 +16,7 @@ from .reservoir import Reservoirs
 
 @dataclass
 class TemporalHistory:
-    """The previous frame's G-buffer (``GBuffer.for_history``), its final reservoirs (confidence capped),
+    """The previous frame's G-buffer, its final reservoirs (confidence capped),
     its camera and the light-table signature the reservoirs index into."""
 
     gbuf: GBuffer
