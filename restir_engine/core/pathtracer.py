@@ -25,7 +25,7 @@ from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
 from .bsdf import SurfaceParams, eval_view, ggx_albedo_rows, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
-from .sampling import cols, dot, norm, to_local, to_world, vfinite, vmax
+from .sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
 from .scene import Scene
 from .surface import Surface
 
@@ -55,14 +55,6 @@ class TraceContext:
 def power_heuristic(a, b):
     a2 = a * a
     return np.where(a2 > 0, a2 / np.maximum(a2 + b * b, 1e-30), 0.0).astype(np.float32)
-
-
-def _sanitize(x: np.ndarray) -> np.ndarray:
-    """``x`` with non-finite values set to 0 (in place)."""
-    bad = ~np.isfinite(x)
-    if bad.any():
-        x[bad] = 0.0
-    return x
 
 
 def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
@@ -113,7 +105,7 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray) -> PrimaryHits:
     rows = np.flatnonzero(alive)
     surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
     emitted[:, rows] += surf.emission(ctx)
-    return PrimaryHits(_sanitize(emitted), alpha, rows, surf)
+    return PrimaryHits(finite(emitted), alpha, rows, surf)
 
 
 def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None) -> np.ndarray:
@@ -136,7 +128,7 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), cols(ls.pos, live), cols(ls.wi, live),
                                   ls.dist[live])
         lv = live[~ctx.geom_accel.occluded(so, sd, far)]
-        out[:, lv] = _sanitize(cols(contrib, lv))
+        out[:, lv] = finite(cols(contrib, lv))
     return out
 
 
@@ -198,11 +190,11 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             sel = np.flatnonzero((lh.prim >= 0) & (lh.t < hits.t))
             if sel.size:
                 le, pl = _lamp_emission(ctx, lh, o, d, sel)
-                target[:, idx[sel]] += _sanitize(cols(throughput, sel) * le * power_heuristic(prev_pdf[sel], pl))
+                target[:, idx[sel]] += finite(cols(throughput, sel) * le * power_heuristic(prev_pdf[sel], pl))
         hit = hits.prim >= 0
         esc = np.flatnonzero(~hit)
         if esc.size:  # film transparency affects camera rays only
-            target[:, idx[esc]] += _sanitize(cols(throughput, esc) * world)
+            target[:, idx[esc]] += finite(cols(throughput, esc) * world)
         hsel = np.flatnonzero(hit)
         if hsel.size == 0:
             break
@@ -216,7 +208,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
                 cos_l = -dot(cols(d, hs), cols(ctx.geom_ng_rows, hp[em]))
                 le *= (cos_l > 0) | ctx.lights.tri_two_sided[light[em]]
                 pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
-                target[:, idx[hs]] += _sanitize(cols(throughput, hs) * le * power_heuristic(prev_pdf[hs], pl))
+                target[:, idx[hs]] += finite(cols(throughput, hs) * le * power_heuristic(prev_pdf[hs], pl))
         if bounce == ctx.max_bounces:
             break
         idx, throughput = idx[hsel], cols(throughput, hsel)

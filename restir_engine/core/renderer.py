@@ -37,7 +37,7 @@ from .restir import di, reuse
 from .restir.gbuffer import GBuffer
 from .restir.history import TemporalHistory
 from .sampling import (STREAM_CAMERA, STREAM_INITIAL, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL,
-                       STREAM_TILES, rng)
+                       STREAM_TILES, finite, rng)
 from .scene import Scene
 from .target import WIDTH, ShadingTerms
 
@@ -383,7 +383,7 @@ class FrameRenderer:
                 del prepared, now  # released with the jobs once merged
                 parts = list(pool().map(_run_job(reuse.temporal_reuse), jobs))
                 del jobs
-                res = _gather(space.kind, parts, len(gb))
+                res = space.kind.gather(parts, len(gb))
                 del parts
         if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode
             with clock.stage("boiling"):
@@ -398,7 +398,7 @@ class FrameRenderer:
                 del prepared  # released with the jobs once merged
                 parts = list(pool().map(_run_job(reuse.spatial_reuse), jobs))
                 del jobs
-                res = _gather(space.kind, parts, len(gb))
+                res = space.kind.gather(parts, len(gb))
                 del parts
         if s == 0:  # the next frame's history; confidence at most the cap, so no reused M ever exceeds it
             lights = ctx.lights
@@ -437,7 +437,7 @@ class FrameRenderer:
         out[..., :3] += self.acc["indirect"]
         out[..., :3] *= np.float32(inv)
         np.multiply(self.acc["alpha"], inv, out=out[..., 3], casting="unsafe")
-        return _finite(out)
+        return finite(out)
 
     def passes(self) -> dict:
         """All passes (see :class:`FrameResult`); float32, finite everywhere."""
@@ -446,7 +446,7 @@ class FrameRenderer:
         def mean(key):
             a = self.acc[key]
             out = np.multiply(a, inv, out=np.empty(a.shape, np.float32), casting="unsafe")
-            return _finite(out if out.ndim == 3 else out[..., None])
+            return finite(out if out.ndim == 3 else out[..., None])
 
         jobs = {"Combined": self.combined, "Direct": lambda: mean("direct"), "Indirect": lambda: mean("indirect"),
                 "Emission": lambda: mean("emit")}
@@ -456,16 +456,8 @@ class FrameRenderer:
         run = map if in_worker() else pool().map  # one pass per pool task (inline inside a worker)
         out = dict(zip(jobs, run(lambda job: job(), jobs.values())))
         if self.settings.data_passes:
-            out["Depth"], out["Normal"], out["Vector"] = (_finite(a) for a in self.data_passes())
+            out["Depth"], out["Normal"], out["Vector"] = (finite(a) for a in self.data_passes())
         return out
-
-
-def _finite(a: np.ndarray) -> np.ndarray:
-    """``a`` (float32) with non-finite values set to 0, in place."""
-    bad = ~np.isfinite(a)
-    if bad.any():
-        a[bad] = 0.0
-    return a
 
 
 def _chunk_size(n: int, target: int) -> int:
@@ -481,14 +473,6 @@ def _chunk_size(n: int, target: int) -> int:
 def _run_job(fn):
     """A pool task running ``fn(*args)`` for a (rows, args) job and returning (rows, result)."""
     return lambda job: (job[0], fn(*job[1]))
-
-
-def _gather(kind, parts, n: int):
-    """A frame of n reservoirs of type ``kind`` from (rows, Reservoirs) parts."""
-    out = kind.empty(n)
-    for rows, part in parts:
-        out.assign(rows, part)
-    return out
 
 
 class _Progress:

@@ -126,6 +126,14 @@ def cols(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
     return np.take(a, idx, axis=1)
 
 
+def finite(a: np.ndarray) -> np.ndarray:
+    """``a`` with its non-finite values set to 0, in place (one check when all are finite)."""
+    bad = ~np.isfinite(a)
+    if bad.any():
+        a[bad] = 0.0
+    return a
+
+
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Dot products of (3, n) vectors."""
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]

@@ -255,7 +255,6 @@ class FramePoints:
 
     def __init__(self, lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray):
         n = len(light)
-        self.lamps = lights.scene.lamps
         if lights.n_tri == 0 or n <= self.CHUNK or in_worker():
             pts = light_points(lights, np.maximum(light, 0), b1, b2)
             self.rows = pts.packed()
@@ -272,9 +271,3 @@ class FramePoints:
         """Points of reservoirs ``q`` (index array or slice), spot cones not applied."""
         return PackedPoints.of(np.take(self.rows, q, axis=1) if not isinstance(q, slice) else self.rows[:, q])
 
-    def at(self, q, receivers: np.ndarray) -> PackedPoints:
-        """Points of reservoirs ``q`` as seen from receivers ((3, n); spot cones applied)."""
-        pts = self.points(q)
-        if self.spot_tri is not None:
-            pts = with_spots(pts, self.spot_tri[q], self.lamps, receivers)
-        return pts

@@ -26,7 +26,7 @@ import numpy as np
 from ..accel import offset_origin, shadow_rays
 from ..bsdf import ViewTerms, eval_view, luminance_rows, sample_bsdf
 from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
-from ..sampling import cols, dot, norm, to_local, to_world, uniform_ints, vmax
+from ..sampling import cols, dot, finite, norm, to_local, to_world, uniform_ints, vmax
 from ..target import FramePoints, with_spots
 from .reservoir import Reservoirs, Stream
 
@@ -250,7 +250,4 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
             vis = visible[start:start + len(rows)]
             out[:, rows[vis]] += contrib[:, vis]
             start += len(rows)
-    bad = ~np.isfinite(out)
-    if bad.any():
-        out[bad] = 0.0
-    return out
+    return finite(out)
