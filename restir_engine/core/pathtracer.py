@@ -132,6 +132,32 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
     return out
 
 
+@dataclass
+class BsdfRay:
+    """BSDF-sampled rays leaving surfaces (k of n): the rows of the surfaces whose sample leaves above the
+    geometric surface, local direction (3, k), f (3, k), pdf (k,) (solid angle), offset origins and world
+    directions (3, k), and their closest geometry hits once traced (accel.Hits, or None)."""
+
+    rows: np.ndarray
+    wi_l: np.ndarray
+    f: np.ndarray
+    pdf: np.ndarray
+    o: np.ndarray
+    d: np.ndarray
+    hits: object = None
+
+
+def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
+    """One BSDF sample per surface of s from uniforms u (3, n), kept where it leaves above the surface."""
+    wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[0], u[1], u[2], view=s.view)
+    wi = to_world(wi_l, s.ns, s.t, s.bt)
+    wi /= np.maximum(norm(wi), np.float32(1e-12))
+    rows = np.flatnonzero((pdf > 0) & (dot(wi, s.ng) > 0))
+    d = cols(wi, rows)
+    return BsdfRay(rows, cols(wi_l, rows), cols(f, rows), pdf[rows], offset_origin(cols(s.p, rows), cols(s.ng, rows), d),
+                   d)
+
+
 def needs_continuation(ctx: TraceContext, direct_resampled: bool) -> bool:
     """Whether :func:`continue_paths` has anything to add: bounces, or the first BSDF ray's emitter hits (when
     the direct light is not resampled) or the world it escapes to."""
@@ -142,8 +168,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
                    first_ray=None):
     """Continue paths from primary surfaces s (n). Returns (direct (3, n): the first BSDF ray's emitter hits
     (MIS-weighted; none when ``direct_resampled``) and the world it escapes to; indirect (3, n): bounces
-    1..max_bounces). ``first_ray`` (restir.di.BsdfRay): a BSDF sample already traced from s, used as the
-    first ray instead of drawing a new one."""
+    1..max_bounces). ``first_ray`` (a traced :class:`BsdfRay` from s, e.g. ReSTIR's BSDF candidate) is used as
+    the first ray instead of drawing a new one."""
     n = len(s)
     direct = np.zeros((3, n), np.float32)
     indirect = np.zeros((3, n), np.float32)
@@ -156,17 +182,9 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         if bounce > 0:
             target[:, idx] += next_event(ctx, s, rng, throughput)
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -------
-        if bounce == 0 and first_ray is not None:
-            rows, wi_l, f, pdf = first_ray.rows, first_ray.wi_l, first_ray.f, first_ray.pdf
-            o, d, hits = first_ray.o, first_ray.d, first_ray.hits
-        else:
-            u = rng.random((3, len(idx)), dtype=np.float32)
-            wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[0], u[1], u[2], view=s.view)
-            wi = to_world(wi_l, s.ns, s.t, s.bt)
-            wi /= np.maximum(norm(wi), np.float32(1e-12))
-            rows = np.flatnonzero((pdf > 0) & (dot(wi, s.ng) > 0))
-            wi_l, f, pdf, d = cols(wi_l, rows), cols(f, rows), pdf[rows], cols(wi, rows)
-            o, hits = offset_origin(cols(s.p, rows), cols(s.ng, rows), d), None
+        ray = first_ray if bounce == 0 and first_ray is not None else \
+            sample_rays(s, rng.random((3, len(idx)), dtype=np.float32))
+        rows, wi_l, f, pdf, o, d, hits = ray.rows, ray.wi_l, ray.f, ray.pdf, ray.o, ray.d, ray.hits
         thr = cols(throughput, rows) * f
         thr *= wi_l[2] / np.maximum(pdf, np.float32(1e-30))
         ok = vfinite(thr)

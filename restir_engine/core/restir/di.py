@@ -23,10 +23,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..accel import offset_origin, shadow_rays
-from ..bsdf import ViewTerms, eval_view, luminance_rows, sample_bsdf
+from ..accel import shadow_rays
+from ..bsdf import ViewTerms, eval_view, luminance_rows
 from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
-from ..sampling import cols, dot, finite, norm, to_local, to_world, uniform_ints, vmax
+from ..pathtracer import sample_rays
+from ..sampling import cols, dot, finite, to_local, uniform_ints, vmax
 from ..target import FramePoints, with_spots
 from .reservoir import Reservoirs, Stream
 
@@ -80,21 +81,6 @@ class LightSpace:
         return self.evaluate(terms, self.gather(prepared, idx))
 
 
-@dataclass
-class BsdfRay:
-    """The first BSDF candidate's ray, handed to the path tracer as its first bounce (the same distribution
-    as a fresh BSDF sample): rows of the surfaces it left from, local direction, f, pdf (solid angle),
-    origins, directions and the closest geometry hits."""
-
-    rows: np.ndarray
-    wi_l: np.ndarray
-    f: np.ndarray
-    pdf: np.ndarray
-    o: np.ndarray
-    d: np.ndarray
-    hits: object
-
-
 def _light_candidates(ctx, terms, rng, tiles, m_l: int, m_b: int, px, py):
     """Weights and targets (m_l, n) of the light candidates (from ``tiles`` or the power table), the light
     points they index and the index of each candidate."""
@@ -135,8 +121,9 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
 
     ``terms``: target.ShadingTerms of the surfaces; ``px``, ``py``: their window pixels (pick the light tile).
     All light candidates are weighed first and one is selected per surface in proportion to its weight (the
-    same distribution as streaming them one at a time). Returns (DIReservoirs, BsdfRay or None): the first
-    BSDF candidate's ray when ``keep_bsdf_ray``."""
+    same distribution as streaming them one at a time). Returns (DIReservoirs, pathtracer.BsdfRay or None): the
+    first BSDF candidate's traced ray when ``keep_bsdf_ray`` (the path's first bounce: the same distribution
+    as a fresh BSDF sample)."""
     n = len(surf)
     lights = ctx.lights
     m_l = cfg.light_candidates if lights.tri_alias is not None else 0
@@ -164,16 +151,11 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     first_ray = None
     lamps = ctx.scene.lamps
     for j in range(max(m_b, 1 if keep_bsdf_ray else 0)):
-        u = rng.random((3, n), dtype=np.float32)
-        wi_l, f, p_b = sample_bsdf(surf.params, surf.wo_l, u[0], u[1], u[2], view=surf.view)
-        wi = to_world(wi_l, surf.ns, surf.t, surf.bt).astype(np.float32, copy=False)
-        wi /= np.maximum(norm(wi), np.float32(1e-12))
-        live = np.flatnonzero((p_b > 0) & (dot(wi, surf.ng) > 0))
-        d = cols(wi, live)
-        o = offset_origin(cols(surf.p, live), cols(surf.ng, live), d)
-        hits = ctx.geom_accel.intersect(o, d)
+        ray = sample_rays(surf, rng.random((3, n), dtype=np.float32))
+        live, o, d = ray.rows, ray.o, ray.d
+        hits = ray.hits = ctx.geom_accel.intersect(o, d)
         if j == 0 and keep_bsdf_ray:
-            first_ray = BsdfRay(live, cols(wi_l, live), cols(f, live), p_b[live], o, d, hits)
+            first_ray = ray
         if j >= m_b or live.size == 0:
             continue
         candidates = []
