@@ -87,10 +87,7 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out:
     b1 = np.asarray(b1, np.float32)
     b2 = np.asarray(b2, np.float32)
     blk = np.empty((11, n), np.float32) if out is None else out
-    pos = blk[0:3]
-    np.take(lights.rows_v0, light, axis=1, out=pos)
-    pos += np.take(lights.rows_e1, light, axis=1) * b1
-    pos += np.take(lights.rows_e2, light, axis=1) * b2
+    lights.positions(light, b1, b2, out=blk[0:3])
     np.take(lights.rows_normal, light, axis=1, out=blk[3:6])
     np.take(lights.rows_le, light, axis=1, out=blk[6:9])
     if lights.any_textured:

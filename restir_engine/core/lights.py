@@ -152,13 +152,19 @@ class LightTable:
         rad *= ok
         return q, w, dl, cos_l, rad, pd * ok
 
+    def positions(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """World positions (3, n) of barycentrics (b1, b2) on triangle lights ``light`` (into ``out`` if given):
+        corner 0 plus the two edges, gathered as columns."""
+        q = np.take(self.rows_v0, light, axis=1, out=out)
+        q += cols(self.rows_e1, light) * b1
+        q += cols(self.rows_e2, light) * b2
+        return q
+
     def point_towards(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, p: np.ndarray):
         """Triangle light ``light`` at barycentrics (b1, b2) seen from points p (3, n): the light point
         (3, n), unit direction wi from p (3, n), distance (n,), cos at the light (n,) and the radiance
         arriving at p (3, n) (zero from a back face of a one-sided emitter, spot cones applied)."""
-        q = cols(self.rows_v0, light)
-        q += cols(self.rows_e1, light) * b1
-        q += cols(self.rows_e2, light) * b2
+        q = self.positions(light, b1, b2)
         d = q - p
         dl = norm(d)
         w = d / np.maximum(dl, np.float32(1e-30))

@@ -267,8 +267,7 @@ class FrameRenderer:
         clock = self.clock
         x0, y0, w, h = self.ctx.scene.camera.window
         npix = w * h
-        step = _chunk_size(npix, st.tile_pixels)
-        chunks = [_Chunk(i, np.arange(a, min(npix, a + step))) for i, a in enumerate(range(0, npix, step))]
+        chunks = [_Chunk(i, np.arange(sl.start, sl.stop)) for i, sl in enumerate(self._spans(npix))]
         resampled = self.candidates is not None
         reusing = self.method == "RESTIR"
         chunk_stages = 4 + int(resampled)
@@ -356,7 +355,7 @@ class FrameRenderer:
                        np.concatenate([sf.mat for sf in surfs]), ShadingTerms(terms))
 
     def _spans(self, n: int):
-        """Chunks of the frame's n surfaces as slices (reuse reads a chunk's own data as views)."""
+        """Chunks of n pixels or surfaces as slices (reuse reads a chunk's own data as views)."""
         step = _chunk_size(n, self.settings.tile_pixels)
         return [slice(a, min(n, a + step)) for a in range(0, n, step)]
 
