@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .bsdf import luminance
-from .sampling import AliasTable, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
+from .sampling import AliasTable, barycentric, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
 from .scene import Lamps, MaterialTable, Scene, TriangleSet
 from .textures import apply_texture, mean_color
 
@@ -32,7 +32,7 @@ def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarra
     le = np.take(materials.emission, mat, axis=0)
     if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
         c = np.take(tris.uvs, tri, axis=0)
-        uv = c[:, 0] * (1.0 - b1 - b2)[:, None] + c[:, 1] * b1[:, None] + c[:, 2] * b2[:, None]
+        uv = barycentric(c[:, 0], c[:, 1], c[:, 2], b1[:, None], b2[:, None])  # (n, 2) texture coordinates
         le = apply_texture(le, materials.emit_tex[mat], uv, materials.textures)
     return np.ascontiguousarray(le.T, dtype=np.float32)
 

@@ -155,7 +155,8 @@ def vfinite(a: np.ndarray) -> np.ndarray:
 
 
 def barycentric(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray, b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
-    """Corner values (k, n) each interpolated at barycentrics (b1, b2) -> (k, n)."""
+    """Corner values interpolated at barycentrics (b1, b2), broadcasting: (k, n) rows with (n,) barycentrics,
+    or (n, k) per-corner rows with (n, 1) barycentrics."""
     return c0 * (1.0 - b1 - b2) + c1 * b1 + c2 * b2
 
 

@@ -52,8 +52,7 @@ class Surface:
             textured = np.flatnonzero(mats.base_tex[mat] >= 0)
             if textured.size:  # re-derive the parameters where a texture drives the base colour
                 c = np.take(geom.uvs, prim[textured], axis=0)
-                ut, vt = u[textured][:, None], v[textured][:, None]
-                uv = c[:, 0] * (1.0 - ut - vt) + c[:, 1] * ut + c[:, 2] * vt
+                uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[textured][:, None], v[textured][:, None])  # (k, 2)
                 tm = mat[textured]
                 base = apply_texture(mats.base_color[tm], mats.base_tex[tm], uv, mats.textures)
                 self.params.assign(textured, SurfaceParams.from_material(base, mats.metallic[tm], mats.roughness[tm],
