@@ -104,16 +104,17 @@ def perspective_camera(eye, target, width=48, height=36, fov_y_deg=50.0, near=0.
 
 def regression_room(width=48, height=36) -> Scene:
     """A small room with every feature the integrators branch on: a glossy Principled-like floor, a metal
-    block, diffuse walls (one open side to a grey world), an occluder, three coloured emitters (one tiny and
-    bright) and a sun. Used for fixed-seed before/after image comparisons."""
+    block, diffuse walls with an image texture (one open side to a grey world), an occluder, three coloured
+    emitters (one tiny and bright, one with an emission texture) and a sun. Used for fixed-seed before/after
+    image comparisons."""
     mats = MaterialTable.build([
         {"base_color": (0.6, 0.6, 0.55), "roughness": 0.3, "f0": 0.04},               # 0 glossy floor
-        {"base_color": (0.7, 0.3, 0.2), "roughness": 1.0, "f0": 0.0},                 # 1 diffuse wall
+        {"base_color": (1.0, 1.0, 1.0), "roughness": 1.0, "f0": 0.0, "base_tex": 0},  # 1 textured diffuse wall
         {"base_color": (0.9, 0.8, 0.5), "roughness": 0.2, "metallic": 1.0},            # 2 metal block
-        {"base_color": (0, 0, 0), "f0": 0.0, "emission": (6.0, 5.0, 4.0)},             # 3 warm panel
+        {"base_color": (0, 0, 0), "f0": 0.0, "emission": (6.0, 5.0, 4.0), "emit_tex": 1},  # 3 textured panel
         {"base_color": (0, 0, 0), "f0": 0.0, "emission": (1.0, 2.0, 6.0)},             # 4 blue strip
         {"base_color": (0, 0, 0), "f0": 0.0, "emission": (3000.0, 3000.0, 3000.0)},    # 5 tiny bright
-    ])
+    ], textures=_checker_textures())
     parts = [tris(quad((0, 0, 0), (2, 0, 0), (0, 2, 0)), 0),
              tris(quad((0, 2, 1), (2, 0, 0), (0, 0, 1)), 1),
              tris(quad((-2, 0, 1), (0, 0, 1), (0, 2, 0)), 1),
@@ -128,4 +129,19 @@ def regression_room(width=48, height=36) -> Scene:
     lamps.sun_cos = np.array([np.cos(0.02)], np.float32)
     lamps.sun_irradiance = np.array([[1.5, 1.4, 1.2]], np.float32)
     cam = perspective_camera((0.3, -2.6, 1.3), (0.0, 0.6, 0.5), width, height)
-    return Scene(concat(parts), mats, lamps, cam, world_radiance=np.full(3, 0.2, np.float32))
+    geometry = concat(parts)
+    geometry.uvs = _quad_uvs(len(geometry))
+    return Scene(geometry, mats, lamps, cam, world_radiance=np.full(3, 0.2, np.float32))
+
+
+def _checker_textures():
+    """A 4x4 red/blue checker (wall albedo) and a 2x2 bright/dim pattern (panel emission), scene-linear."""
+    checker = np.where((np.add.outer(np.arange(4), np.arange(4)) % 2)[..., None] == 0, (0.7, 0.3, 0.2), (0.2, 0.3, 0.7))
+    pattern = np.array([[[1.5, 1.5, 1.5], [0.5, 0.5, 0.5]], [[0.5, 0.5, 0.5], [1.5, 1.5, 1.5]]])
+    return [checker.astype(np.float32), pattern.astype(np.float32)]
+
+
+def _quad_uvs(n: int) -> np.ndarray:
+    """UVs of quads built by :func:`quad` (two triangles each) spanning the unit square."""
+    pair = np.array([[[0, 0], [1, 0], [1, 1]], [[0, 0], [1, 1], [0, 1]]], np.float32)
+    return np.tile(pair, (n // 2, 1, 1))
