@@ -215,6 +215,13 @@ class ViewTerms:
                          bool((p.spec_on > 0).any() or (p.p_spec > 0).any()))
 
 
+def view_terms(surf) -> ViewTerms:
+    """The view terms of surfaces: ``surf.view`` when they carry them (surface.Surface computes them once),
+    else computed from ``params``, ``wo_l`` and ``albedo`` (if given)."""
+    v = getattr(surf, "view", None)
+    return v if v is not None else ViewTerms.of(surf.params, surf.wo_l, getattr(surf, "albedo", None))
+
+
 def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     """f (3, n) and pdf (n,) (solid angle) of unit directions wi (3, n) at surfaces with view terms ``v``. The half
     vector h = (wo + wi)/|wo + wi| enters only through cos θ_h = (cos θ_o + cos θ_i)/|wo + wi| and

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import schlick, smith_lambda, view_albedo
+from .bsdf import view_terms
 from .light_tiles import PackedPoints, light_points
 from .accel import in_worker, pool
 from .lights import spot_factor
@@ -60,19 +60,17 @@ class ShadingTerms:
         # wo in the bent frame: the local view vector back in world space (wo·ns = cos θ_o exactly)
         wl = surf.wo_l
         packed[LAYOUT["wo"]] = to_world(wl, surf.ns, surf.t, surf.bt)
-        co = wl[2]
-        packed[LAYOUT["co"]] = co
-        fd = np.where(prm.f0_dielectric > 0, 1.0 - schlick(prm.f0_dielectric, co), 1.0)
-        packed[LAYOUT["kd"]] = prm.diffuse * (fd * INV_PI) * LUM[:, None]
+        # the BSDF's view terms (bsdf.ViewTerms, shared with shading) with the luminance weights folded in
+        v = view_terms(surf)
+        packed[LAYOUT["co"]] = v.co
+        packed[LAYOUT["kd"]] = v.kd * LUM[:, None]
+        packed[LAYOUT["a"]] = v.spec_a * LUM[:, None]
+        packed[LAYOUT["b"]] = v.spec_b * LUM[:, None]
+        packed[LAYOUT["lam_o"]] = v.lam_o
         packed[LAYOUT["spec_on"]] = prm.spec_on
         packed[LAYOUT["p_spec"]] = prm.p_spec
         packed[LAYOUT["alpha"]] = prm.alpha
-        packed[LAYOUT["alpha2"]] = prm.alpha * prm.alpha
-        e = surf.albedo if getattr(surf, "albedo", None) is not None else view_albedo(prm, wl)
-        comp = 1.0 + prm.f0 * ((1.0 - e) / e)
-        packed[LAYOUT["a"]] = prm.f0 * comp * LUM[:, None]
-        packed[LAYOUT["b"]] = (1.0 - prm.f0) * comp * LUM[:, None]
-        packed[LAYOUT["lam_o"]] = smith_lambda(prm.alpha, co)
+        packed[LAYOUT["alpha2"]] = v.alpha2
         return ShadingTerms(packed)
 
     def take(self, idx) -> "ShadingTerms":

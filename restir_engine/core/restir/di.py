@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..accel import shadow_rays
-from ..bsdf import ViewTerms, eval_view, luminance_rows
+from ..bsdf import eval_view, luminance_rows, view_terms
 from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
 from ..pathtracer import sample_rays
 from ..sampling import cols, dot, finite, to_local, uniform_ints, vmax
@@ -185,8 +185,7 @@ def shading_value(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l:
     """Target p̂ (n,), f (3, n), geometry term G (n,) and the BSDF pdf in area measure (n,) of light points
     in directions wi (3, n) (world) at distances dist (the exact RGB model of bsdf.py)."""
     wi_l = to_local(wi, surf.ns, surf.t, surf.bt)
-    view = surf.view if hasattr(type(surf), "view") else ViewTerms.of(surf.params, surf.wo_l)
-    f, pdf_b = eval_view(view, surf.wo_l, wi_l)
+    f, pdf_b = eval_view(view_terms(surf), surf.wo_l, wi_l)
     ok = (dot(wi, surf.ng) > 0) & (dist > 0)
     to_area = np.abs(cos_l) / np.maximum(dist * dist, 1e-30)
     g = np.abs(wi_l[2]) * to_area
