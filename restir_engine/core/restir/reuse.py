@@ -166,7 +166,6 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
     own = space.gather(prepared, rows) if unbiased else None
     depth_c, ns_c = gb.depth[rows], _columns(gb.normals, rows)
     own_ok = canonical.has_sample()
-    has = res.has_sample()
     neighbours, taken = [], []
     for k in range(cfg.neighbors):
         qx = np.round(px + offs[k, 0]).astype(np.int64)
@@ -187,7 +186,7 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
             z = np.zeros(n, np.float32)
             neighbours.append(Neighbour(res, q, ok, m_q, z, z))
             continue
-        pc = space.target(me, prepared, q) * (ok & has[q])
+        pc = space.target(me, prepared, q) * (ok & (res.key[q] >= 0))
         pq = None
         if unbiased:
             pq = space.evaluate(gb.terms.take(q), own) * (ok & own_ok)
@@ -227,7 +226,7 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     canonical = res.take(rows)
     prev = hist.res
     m_prev = np.minimum(prev.M[q], np.float32(confidence_cap) * np.maximum(canonical.M, np.float32(1.0))) * ok
-    use = ok & prev.has_sample()[q]
+    use = ok & (prev.key[q] >= 0)
     pc = np.zeros(n, np.float32)
     if use.any():
         pc = space.target(gb.terms.take(rows), prepared_prev, q) * use
