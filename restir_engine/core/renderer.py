@@ -233,22 +233,21 @@ class FrameRenderer:
         """fn(item) for every item on the pool; raises _Stopped when ``stop`` asks to stop part-way."""
         if len(items) <= 1:
             out = [fn(it) for it in items]
-        else:
-            futures = {pool().submit(fn, it): i for i, it in enumerate(items)}
-            out = [None] * len(items)
-            pending = set(futures)
-            while pending:
-                done, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
-                for f in done:
-                    out[futures[f]] = f.result()
-                if stop.should_stop and stop.should_stop():
-                    for f in pending:
-                        f.cancel()
-                    wait(pending)
-                    raise _Stopped
-                stop.advance(len(done))
-        if len(items) <= 1:
             stop.advance(len(items))
+            return out
+        futures = {pool().submit(fn, it): i for i, it in enumerate(items)}
+        out = [None] * len(items)
+        pending = set(futures)
+        while pending:
+            done, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
+            for f in done:
+                out[futures[f]] = f.result()
+            if stop.should_stop and stop.should_stop():
+                for f in pending:
+                    f.cancel()
+                wait(pending)
+                raise _Stopped
+            stop.advance(len(done))
         return out
 
     def sample_pass(self, progress=None, should_stop=None) -> bool:
@@ -270,7 +269,8 @@ class FrameRenderer:
         chunks = [_Chunk(i, np.arange(sl.start, sl.stop)) for i, sl in enumerate(self._spans(npix))]
         resampled = self.candidates is not None
         reusing = self.method == "RESTIR"
-        chunk_stages = 4 + int(resampled)
+        # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
+        chunk_stages = 4 + int(resampled) + (int(self.spatial.passes) + 1 if reusing else 0)
         stop = _Progress(progress, should_stop, len(chunks) * chunk_stages)
         ctx = self.ctx
 
@@ -326,7 +326,7 @@ class FrameRenderer:
                 for c in chunks:
                     res.assign(c.surfaces, c.res)
                     c.res = None  # the frame's array holds them now
-            res = self._reuse(gb, res, s)
+            res = self._reuse(gb, res, s, stop)
             for c in chunks:
                 c.res = res.take(c.surfaces)
 
@@ -359,9 +359,9 @@ class FrameRenderer:
         step = _chunk_size(n, self.settings.tile_pixels)
         return [slice(a, min(n, a + step)) for a in range(0, n, step)]
 
-    def _reuse(self, gb: GBuffer, res, s: int):
+    def _reuse(self, gb: GBuffer, res, s: int, stop):
         """Temporal (first pass of a frame, with a history), boiling filter, spatial passes; makes the next
-        frame's history. Returns the frame's final reservoirs."""
+        frame's history. Returns the frame's final reservoirs (raises _Stopped when asked to stop)."""
         st = self.settings
         clock = self.clock
         spans = self._spans(len(gb))
@@ -380,7 +380,7 @@ class FrameRenderer:
                                 motion, rng(st.seed, st.frame, s, STREAM_TEMPORAL, i), possible))
                         for i, rows in enumerate(spans)]
                 del prepared, now  # released with the jobs once merged
-                parts = list(pool().map(_run_job(reuse.temporal_reuse), jobs))
+                parts = self._map(_run_job(reuse.temporal_reuse), jobs, stop)
                 del jobs
                 res = space.kind.gather(parts, len(gb))
                 del parts
@@ -395,7 +395,7 @@ class FrameRenderer:
                                 rng(st.seed, st.frame, s, STREAM_SPATIAL + k, i)))
                         for i, rows in enumerate(spans)]
                 del prepared  # released with the jobs once merged
-                parts = list(pool().map(_run_job(reuse.spatial_reuse), jobs))
+                parts = self._map(_run_job(reuse.spatial_reuse), jobs, stop)
                 del jobs
                 res = space.kind.gather(parts, len(gb))
                 del parts
