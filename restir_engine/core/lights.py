@@ -212,14 +212,14 @@ class LightTable:
         """Pick one light per point p (3, n) with power-proportional probability and a point on it.
         ``u`` is (4, n) uniforms."""
         n = p.shape[1]
-        out = LightSample.zeros(n)
         if self.alias is None or n == 0:
-            return out
+            return LightSample.zeros(n)
         light = self.alias.sample(u[0], u[1])
         if self.n_sun == 0:  # triangle lights only: no column selections
             b1, b2 = uniform_triangle(u[2], u[3])
-            out.pos, out.wi, out.dist, _cos, out.le, out.pdf = self.triangle_points(light, b1, b2, p)
-            return out
+            pos, wi, dist, _cos, le, pdf = self.triangle_points(light, b1, b2, p)
+            return LightSample(pos, wi, dist, le, pdf, np.zeros(n, bool))
+        out = LightSample.zeros(n)
         tri = np.flatnonzero(light < self.n_tri)
         if tri.size:
             b1, b2 = uniform_triangle(u[2, tri], u[3, tri])
