@@ -88,7 +88,7 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out:
     b2 = np.asarray(b2, np.float32)
     blk = np.empty((11, n), np.float32) if out is None else out
     lights.positions(light, b1, b2, out=blk[0:3])
-    np.take(lights.rows_normal, light, axis=1, out=blk[3:6])
+    lights.normals(light, b1, b2, out=blk[3:6])
     np.take(lights.rows_le, light, axis=1, out=blk[6:9])
     if lights.any_textured:
         tex = np.flatnonzero(lights.tri_textured[light])
@@ -101,9 +101,13 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out:
 
 
 def sample_points(lights, u: np.ndarray) -> LightPoints:
-    """Points from the triangle-light power table (``u``: (n, 4) uniforms)."""
+    """Points from the surface-light power table (``u``: (n, 4) uniforms), uniform in area on each light
+    (triangles: barycentrics; spheres: sphere coordinates, uniform in area for uniform (b1, b2))."""
     light = lights.tri_alias.sample(u[:, 0], u[:, 1]).astype(np.int32)
     b1, b2 = uniform_triangle(u[:, 2], u[:, 3])
+    if lights.any_sphere:
+        sph = np.flatnonzero(lights.sphere_r[light] > 0)
+        b1[sph], b2[sph] = u[sph, 2], u[sph, 3]
     return light_points(lights, light, b1, b2)
 
 

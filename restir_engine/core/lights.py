@@ -1,8 +1,12 @@
 """One light table over every emitter, with power-proportional selection.
 
-Entries, in order: emissive scene triangles, Blender lamp triangles (non-occluding) and suns
-(distant lights). Triangle lights are sampled uniformly in
-area; the returned pdf is converted to solid angle: p_ω = p_select · (1/A) · d² / |cos θ_light|.
+Entries, in order: emissive scene triangles, Blender lamps (non-occluding: area-light triangles, and point/spot
+spheres, one entry per sphere) and suns (distant lights). Everything before the suns is a "surface light" whose
+points (light, b1, b2) are barycentrics on a triangle, or on a sphere z = 1 - 2 b1, φ = 2π b2 around its centre
+(uniform in area for uniform (b1, b2)). Next-event estimation (:meth:`LightTable.sample`) samples a triangle
+uniformly in area, p_ω = p_select · (1/A) · d² / |cos θ_light|, and a sphere uniformly in the cone it subtends
+from the receiver (as Cycles), p_ω = p_select / (2π (1 - cos θ_max)): no sample lands on its far side.
+Light points for resampling (light_tiles.sample_points) are uniform in area on both kinds.
 Suns are sampled uniformly in their cone and are handled by light sampling only (a BSDF ray
 that escapes never collects a sun), which keeps the MIS estimator unbiased.
 """
@@ -14,6 +18,40 @@ import numpy as np
 
 from .bsdf import luminance
 from .sampling import AliasTable, barycentric, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
+
+EMPTY = np.zeros(0, np.int64)
+
+
+def sphere_direction(b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
+    """Unit vectors (3, n) float32 of sphere coordinates (b1, b2): z = 1 - 2 b1, φ = 2π b2 (uniform in area for
+    uniform (b1, b2))."""
+    b1 = np.asarray(b1, np.float32)
+    out = np.empty((3, len(b1)), np.float32)
+    rxy = np.multiply(b1, np.float32(1.0) - b1)
+    np.maximum(rxy, 0.0, out=rxy)
+    np.sqrt(rxy, out=rxy)
+    rxy *= np.float32(2.0)  # sqrt(1 - z²), accurate near the poles
+    phi = np.multiply(np.asarray(b2, np.float32), np.float32(2.0 * np.pi))
+    np.cos(phi, out=out[0])
+    out[0] *= rxy
+    np.sin(phi, out=out[1])
+    out[1] *= rxy
+    np.multiply(b1, np.float32(-2.0), out=out[2])
+    out[2] += np.float32(1.0)
+    return out
+
+
+def sphere_coords(unit: np.ndarray):
+    """Sphere coordinates (b1, b2) of unit vectors (3, n) (inverse of :func:`sphere_direction`)."""
+    b1 = np.clip(0.5 * (1.0 - unit[2]), 0.0, 1.0)
+    b2 = np.mod(np.arctan2(unit[1], unit[0]) / (2.0 * np.pi), 1.0)
+    return b1.astype(np.float32), b2.astype(np.float32)
+
+
+def one_minus_cos_cone(r2_over_d2: np.ndarray) -> np.ndarray:
+    """1 - cos θ_max of the cone a sphere subtends, from (r/d)² < 1, without cancellation (float64)."""
+    x = np.asarray(r2_over_d2, np.float64)
+    return x / (1.0 + np.sqrt(np.maximum(0.0, 1.0 - x)))
 from .scene import Lamps, MaterialTable, Scene, TriangleSet
 from .textures import apply_texture, mean_color
 
@@ -84,12 +122,23 @@ class LightTable:
         emit_scale = np.where(mats.emit_tex >= 0, tex_mean[np.maximum(mats.emit_tex, 0)] if len(tex_mean) else 0.0, 1.0)
         mat_power_density = emit_lum * emit_scale * np.where(mats.two_sided_emission, 2.0, 1.0) * np.pi
         g_idx = np.flatnonzero(mat_power_density[geom.material] > 0) if len(geom) else np.zeros(0, np.int64)
-        l_idx = np.flatnonzero(mat_power_density[lamps.tris.material] > 0) if len(lamps.tris) else np.zeros(0, np.int64)
+        # lamp entries: area-light triangles, and the first proxy triangle of each point/spot sphere
+        first_of_sphere = (lamps.sphere_first < 0) | (lamps.sphere_first == np.arange(len(lamps.sphere_first)))
+        l_idx = np.flatnonzero((mat_power_density[lamps.tris.material] > 0) & first_of_sphere) if len(lamps.tris) \
+            else np.zeros(0, np.int64)
         self.geom_ids = g_idx
         self.lamp_ids = l_idx
         self.tri_verts = np.concatenate([geom.verts[g_idx], lamps.tris.verts[l_idx]]).astype(np.float32)
         self.tri_normal, self.tri_area = triangle_geometry(self.tri_verts) if len(self.tri_verts) else (
             np.zeros((0, 3), np.float32), np.zeros(0, np.float32))
+        # spheres: radius (0 = a triangle light), centre as corner 0 with zero edges, area 4πr²
+        self.sphere_r = np.concatenate([np.zeros(len(g_idx), np.float32), lamps.sphere_radius[l_idx]]).astype(np.float32)
+        sph = np.flatnonzero(self.sphere_r > 0)
+        self.any_sphere = bool(sph.size)
+        if sph.size:
+            self.tri_verts[sph] = lamps.spot_center[l_idx[sph - len(g_idx)]][:, None, :]
+            self.tri_normal[sph] = 0.0
+            self.tri_area[sph] = 4.0 * np.pi * self.sphere_r[sph] ** 2
         tri_mat = np.concatenate([geom.material[g_idx], lamps.tris.material[l_idx]]).astype(np.int64)
         self.tri_two_sided = mats.two_sided_emission[tri_mat] if len(tri_mat) else np.zeros(0, bool)
         # (3, n_tri) rows for column gathers: corner 0, edges to corners 1 and 2, unit normal (light_tiles)
@@ -117,6 +166,8 @@ class LightTable:
         self.geom_to_light[g_idx] = np.arange(len(g_idx))
         self.lamp_to_light = np.full(len(lamps.tris), -1, np.int64)
         self.lamp_to_light[l_idx] = len(g_idx) + np.arange(len(l_idx))
+        proxy = np.flatnonzero(lamps.sphere_first >= 0) if len(lamps.tris) else EMPTY
+        self.lamp_to_light[proxy] = self.lamp_to_light[lamps.sphere_first[proxy]]  # every proxy triangle: its sphere
         self.alias = AliasTable(power) if (power > 0).any() else None
         # separate tables for ReSTIR: triangle lights are resampled, suns are light-sampled on their own
         self.tri_alias = AliasTable(power[:self.n_tri]) if (power[:self.n_tri] > 0).any() else None
@@ -127,6 +178,8 @@ class LightTable:
             else np.zeros(self.n_tri, np.float32)
         self.tri_pdf_area = (self.tri_alias.pdf / area).astype(np.float32) if self.tri_alias is not None \
             else np.zeros(self.n_tri, np.float32)
+        self.sel_pdf = self.alias.pdf[:self.n_tri].astype(np.float64) if self.alias is not None \
+            else np.zeros(self.n_tri)
         self.scene = scene
         # stable ids across frames: scene triangle index, or len(scene triangles) + lamp triangle index
         self.light_uid = np.concatenate([g_idx, len(geom) + l_idx]).astype(np.int64)
@@ -138,27 +191,85 @@ class LightTable:
         return self.alias is None
 
     def tri_pdf_solid_angle(self, light: np.ndarray, dist: np.ndarray, cos_light: np.ndarray) -> np.ndarray:
-        """Solid-angle pdf with which :meth:`sample` would pick this point of triangle light ``light``."""
+        """Solid-angle pdf with which :meth:`sample` would pick this point of triangle light ``light`` (a
+        sphere's pdf depends on the receiver: :meth:`pdf_solid_angle`)."""
         return self.sel_pdf_area[light] * (dist * dist / np.maximum(np.abs(cos_light), np.float32(1e-8)))
 
-    def triangle_points(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, p: np.ndarray):
-        """Points (b1, b2) of triangle lights ``light`` as light samples for receivers p (3, n): position,
-        unit direction from p, distance, cos at the light, radiance arriving at p (zero from a back face of a
-        one-sided emitter, spot cones applied) and the solid-angle pdf of :meth:`sample` (0 where no light
-        arrives)."""
-        q, w, dl, cos_l, rad = self.point_towards(light, b1, b2, p)
-        pd = self.tri_pdf_solid_angle(light, dl, cos_l)
-        ok = (vmax(rad) > 0) & np.isfinite(pd)
-        rad *= ok
-        return q, w, dl, cos_l, rad, pd * ok
+    def pdf_solid_angle(self, light: np.ndarray, receiver: np.ndarray, dist: np.ndarray,
+                        cos_light: np.ndarray) -> np.ndarray:
+        """Solid-angle pdf (n,) with which :meth:`sample` picks the point of surface light ``light`` at distance
+        ``dist`` and light cosine ``cos_light`` from ``receiver`` (3, n): triangles by area, spheres by cone."""
+        pdf = self.tri_pdf_solid_angle(light, dist, cos_light)
+        sph = self._spheres(light)
+        if sph.size:
+            pdf[sph] = self._cone_pdf(light[sph], np.take(receiver, sph, axis=1), dist[sph], cos_light[sph])
+        return pdf
+
+    def _spheres(self, light: np.ndarray) -> np.ndarray:
+        """Positions in ``light`` of sphere lights."""
+        return np.flatnonzero(self.sphere_r[light] > 0) if self.any_sphere else EMPTY
+
+    def _cone_pdf(self, light, receiver, dist, cos_light):
+        """Cone-sampling pdf (solid angle) of spheres ``light`` from receivers (3, k); receivers inside a sphere
+        sample it by area."""
+        c = np.take(self.rows_v0, light, axis=1).astype(np.float64) - receiver
+        d2 = np.einsum("ij,ij->j", c, c)
+        r = self.sphere_r[light].astype(np.float64)
+        x = r * r / np.maximum(d2, 1e-300)
+        inside = x >= 1.0
+        cone = self.sel_pdf[light] / (2.0 * np.pi * np.where(inside, 1.0, one_minus_cos_cone(x)))
+        area = self.sel_pdf_area[light] * dist * dist / np.maximum(np.abs(cos_light), 1e-8)
+        return np.where(inside, area, cone).astype(np.float32)
+
+    def sphere_hits(self, light: np.ndarray, o: np.ndarray, d: np.ndarray, tmax: np.ndarray):
+        """Rays o + t d ((3, k) rows, unit d) against spheres ``light``: distance t (k,) of the first crossing
+        in (0, tmax) (inf = none), sphere coordinates (b1, b2) of that point and cos θ there (between -d and the
+        outward normal)."""
+        c = np.take(self.rows_v0, light, axis=1).astype(np.float64)
+        oc = o.astype(np.float64) - c
+        r = self.sphere_r[light].astype(np.float64)
+        dd = d.astype(np.float64)
+        b = np.einsum("ij,ij->j", oc, dd)
+        # discriminant from the closest approach (accurate for small far spheres): r² - |oc - b d|²
+        perp = oc - b * dd
+        disc = r * r - np.einsum("ij,ij->j", perp, perp)
+        root = np.sqrt(np.maximum(disc, 0.0))
+        t0, t1 = -b - root, -b + root
+        t = np.where(t0 > 1e-7 * (1 + np.abs(b)), t0, t1)  # the near crossing, or the far one from inside
+        ok = (disc >= 0) & (t > 0) & (t < tmax)
+        t = np.where(ok, t, np.inf)
+        n = (oc + np.where(ok, t, 0.0) * dd) / r
+        n /= np.maximum(np.sqrt(np.einsum("ij,ij->j", n, n)), 1e-300)
+        b1, b2 = sphere_coords(n)
+        cos_l = -np.einsum("ij,ij->j", n, dd)
+        return t.astype(np.float32), b1, b2, cos_l.astype(np.float32)
 
     def positions(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """World positions (3, n) of barycentrics (b1, b2) on triangle lights ``light`` (into ``out`` if given):
-        corner 0 plus the two edges, gathered as columns."""
+        """World positions (3, n) of points (b1, b2) on surface lights ``light`` (into ``out`` if given):
+        corner 0 plus the two edges, gathered as columns (a sphere: its centre plus r times the direction)."""
         q = np.take(self.rows_v0, light, axis=1, out=out)
+        sph = self._spheres(light)
+        if sph.size == len(light) and sph.size:  # spheres only (point lamps): no edges to add
+            q += self.sphere_r[light] * sphere_direction(b1, b2)
+            return q
         q += cols(self.rows_e1, light) * b1
         q += cols(self.rows_e2, light) * b2
+        if sph.size:
+            q[:, sph] += self.sphere_r[light[sph]] * sphere_direction(b1[sph], b2[sph])
         return q
+
+    def normals(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """Unit normals (3, n) of surface lights at points (b1, b2) (into ``out`` if given)."""
+        sph = self._spheres(light)
+        if sph.size == len(light) and sph.size:
+            if out is None:
+                return sphere_direction(b1, b2)
+            out[:] = sphere_direction(b1, b2)
+            return out
+        nrm = np.take(self.rows_normal, light, axis=1, out=out)
+        if sph.size:
+            nrm[:, sph] = sphere_direction(b1[sph], b2[sph])
+        return nrm
 
     def point_towards(self, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, p: np.ndarray):
         """Triangle light ``light`` at barycentrics (b1, b2) seen from points p (3, n): the light point
@@ -168,7 +279,7 @@ class LightTable:
         d = q - p
         dl = norm(d)
         w = d / np.maximum(dl, np.float32(1e-30))
-        cos_l = -dot(w, cols(self.rows_normal, light))
+        cos_l = -dot(w, self.normals(light, b1, b2))
         facing = ((cos_l > 0) | self.tri_two_sided[light]) & (dl > 0) & (np.abs(cos_l) > 1e-8)
         le = self.radiance_of(light, b1, b2, p)
         le *= facing
@@ -215,20 +326,56 @@ class LightTable:
         if self.alias is None or n == 0:
             return LightSample.zeros(n)
         light = self.alias.sample(u[0], u[1])
-        if self.n_sun == 0:  # triangle lights only: no column selections
-            b1, b2 = uniform_triangle(u[2], u[3])
-            pos, wi, dist, _cos, le, pdf = self.triangle_points(light, b1, b2, p)
+        if self.n_sun == 0:  # surface lights only: no column selections
+            pos, wi, dist, le, pdf = self._surface_sample(light, u[2], u[3], p)
             return LightSample(pos, wi, dist, le, pdf, np.zeros(n, bool))
         out = LightSample.zeros(n)
         tri = np.flatnonzero(light < self.n_tri)
         if tri.size:
-            b1, b2 = uniform_triangle(u[2, tri], u[3, tri])
-            pos, wi, dist, _cos, le, pdf = self.triangle_points(light[tri], b1, b2, np.take(p, tri, axis=1))
+            pos, wi, dist, le, pdf = self._surface_sample(light[tri], u[2, tri], u[3, tri], np.take(p, tri, axis=1))
             out.pos[:, tri], out.wi[:, tri], out.dist[tri], out.le[:, tri], out.pdf[tri] = pos, wi, dist, le, pdf
         sun = np.flatnonzero(light >= self.n_tri)
         if sun.size:
             self._sun_sample(light[sun] - self.n_tri, self.alias.pdf[light[sun]], u[:, sun], sun, out)
         return out
+
+    def _surface_sample(self, light, u2, u3, p):
+        """Points on surface lights ``light`` for receivers p (3, n): triangles uniformly in area, spheres in
+        their cone. Returns position, direction, distance, radiance arriving, solid-angle pdf (0: no light)."""
+        b1, b2 = uniform_triangle(u2, u3)
+        sph = self._spheres(light)
+        if sph.size:  # cone sampling; a receiver inside the sphere samples its area
+            b1[sph], b2[sph] = self._cone_sample(light[sph], np.take(p, sph, axis=1), u2[sph], u3[sph])
+        q, w, dl, cos_l, rad = self.point_towards(light, b1, b2, p)
+        pdf = self.pdf_solid_angle(light, p, dl, cos_l)
+        ok = (vmax(rad) > 0) & np.isfinite(pdf)
+        rad *= ok
+        return q, w, dl, rad, pdf * ok
+
+    def _cone_sample(self, light, p, u2, u3):
+        """Sphere coordinates (b1, b2) of the points where directions drawn uniformly in the cone subtended by
+        spheres ``light`` from p (3, k) first meet them (uniform area points for p inside a sphere)."""
+        c = np.take(self.rows_v0, light, axis=1).astype(np.float64)
+        pc = c - p.astype(np.float64)
+        dc = np.sqrt(np.einsum("ij,ij->j", pc, pc))
+        r = self.sphere_r[light].astype(np.float64)
+        x = r * r / np.maximum(dc * dc, 1e-300)
+        inside = x >= 1.0
+        one_minus = u2.astype(np.float64) * one_minus_cos_cone(np.where(inside, 0.0, x))
+        cos_t = 1.0 - one_minus
+        sin_t = np.sqrt(np.maximum(0.0, one_minus * (2.0 - one_minus)))
+        phi = 2.0 * np.pi * u3.astype(np.float64)
+        axis = pc / np.maximum(dc, 1e-300)
+        t, b = orthonormal_basis(axis)
+        w = t * (sin_t * np.cos(phi)) + b * (sin_t * np.sin(phi)) + axis * cos_t
+        # the near crossing of p + s w: s = dc cos θ - sqrt(r² - dc² sin² θ)
+        s = dc * cos_t - np.sqrt(np.maximum(0.0, r * r - (dc * sin_t) ** 2))
+        n = (s * w - pc) / r
+        n /= np.maximum(np.sqrt(np.einsum("ij,ij->j", n, n)), 1e-300)
+        b1, b2 = sphere_coords(n)
+        if inside.any():
+            b1[inside], b2[inside] = u2[inside], u3[inside]
+        return b1, b2
 
     def sample_suns(self, n: int, u: np.ndarray) -> LightSample:
         """One sun per point, chosen by power among suns only (ReSTIR's companion to resampled

@@ -57,17 +57,52 @@ def power_heuristic(a, b):
     return np.where(a2 > 0, a2 / np.maximum(a2 + b * b, 1e-30), 0.0).astype(np.float32)
 
 
+@dataclass
+class LampHits:
+    """Per ray: prim the lamp triangle crossed (-1: none), t, (u, v) barycentrics (sphere coordinates on a
+    point/spot sphere), cos_l between -d and the lamp's normal there."""
+
+    prim: np.ndarray
+    t: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    cos_l: np.ndarray
+
+
+def lamp_hits(ctx: TraceContext, o: np.ndarray, d: np.ndarray, tmax: np.ndarray) -> LampHits:
+    """The nearest lamp each ray (o, d: (3, n) rows) crosses before ``tmax`` (n,). A ray that enters a point/spot
+    sphere's proxy is intersected with the sphere itself."""
+    h = ctx.lamp_accel.intersect(o, d, tmax)
+    lh = LampHits(h.prim, h.t, h.u, h.v, np.zeros(len(h.prim), np.float32))
+    lh.prim[~(lh.t < tmax)] = -1
+    hit = np.flatnonzero(lh.prim >= 0)
+    if hit.size == 0:
+        return lh
+    prim = lh.prim[hit]
+    lh.cos_l[hit] = -dot(cols(d, hit), cols(ctx.lamp_ng_rows, prim))
+    lights = ctx.lights
+    if lights.any_sphere:
+        light = lights.lamp_to_light[prim]
+        sph = np.flatnonzero(lights.sphere_r[np.maximum(light, 0)] * (light >= 0) > 0)
+        if sph.size:
+            rows = hit[sph]
+            t, b1, b2, cos_l = lights.sphere_hits(light[sph], cols(o, rows), cols(d, rows), tmax[rows])
+            lh.t[rows], lh.u[rows], lh.v[rows], lh.cos_l[rows] = t, b1, b2, cos_l
+            lh.prim[rows[~np.isfinite(t)]] = -1  # through the proxy, past the sphere
+    return lh
+
+
 def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
-    """Radiance (3, k) collected from the nearest lamp hit by rays ``sel`` (front faces only), and the
-    solid-angle light pdf (k,) of that point for MIS."""
+    """Radiance (3, k) collected from the nearest lamp hit (:func:`lamp_hits`) by rays ``sel`` (front faces
+    only), and the solid-angle light pdf (k,) of that point for MIS."""
     prim = lh.prim[sel]
     t = lh.t[sel]
-    cos_l = -dot(cols(d, sel), cols(ctx.lamp_ng_rows, prim))
+    cos_l = lh.cos_l[sel]
     lamps = ctx.scene.lamps
     le = emitted_radiance(lamps.tris, ctx.scene.materials, prim, lh.u[sel], lh.v[sel])
     le *= spot_factor(lamps, prim, cols(o, sel)) * (cos_l > 0)
     light = ctx.lights.lamp_to_light[prim]
-    pdf = np.where(light >= 0, ctx.lights.tri_pdf_solid_angle(np.maximum(light, 0), t, cos_l), 0.0)
+    pdf = np.where(light >= 0, ctx.lights.pdf_solid_angle(np.maximum(light, 0), cols(o, sel), t, cos_l), 0.0)
     return le, pdf.astype(np.float32)
 
 
@@ -92,8 +127,8 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray) -> PrimaryHits:
     hits = ctx.geom_accel.intersect(o, d, tmax)
     alive = hits.prim >= 0
     if len(ctx.scene.lamps.tris):  # lamps seen by the camera (those marked visible to camera rays)
-        lh = ctx.lamp_accel.intersect(o, d, np.minimum(hits.t, tmax))
-        sel = np.flatnonzero((lh.prim >= 0) & (lh.t < hits.t))
+        lh = lamp_hits(ctx, o, d, np.minimum(hits.t, tmax))
+        sel = np.flatnonzero(lh.prim >= 0)
         sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
         if sel.size:
             emitted[:, sel] += _lamp_emission(ctx, lh, o, d, sel)[0]
@@ -204,8 +239,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         # emission found by the BSDF ray: lamps in front of the hit, then the hit itself, else the world
         collect = not (bounce == 0 and direct_resampled)
         if collect and len(lamps.tris):
-            lh = ctx.lamp_accel.intersect(o, d, hits.t)
-            sel = np.flatnonzero((lh.prim >= 0) & (lh.t < hits.t))
+            lh = lamp_hits(ctx, o, d, hits.t)
+            sel = np.flatnonzero(lh.prim >= 0)
             if sel.size:
                 le, pl = _lamp_emission(ctx, lh, o, d, sel)
                 target[:, idx[sel]] += finite(cols(throughput, sel) * le * power_heuristic(prev_pdf[sel], pl))

@@ -84,8 +84,10 @@ class Lamps:
     """Blender Light objects that are not scene geometry: they emit but never occlude (as in Cycles).
 
     tris: emitting triangles (area shapes, spheres for point/spot). Per triangle:
-    spot_center (n, 3), spot_axis (n, 3) unit, spot_cos (n,) cos of the half cone angle
-    (-2 = no cone), spot_smooth (n,) blend width in cosine, camera_visible (n,) bool.
+    spot_center (n, 3) (the centre of a point/spot light), spot_axis (n, 3) unit, spot_cos (n,) cos of the
+    half cone angle (-2 = no cone), spot_smooth (n,) blend width in cosine, camera_visible (n,) bool,
+    sphere_radius (n,) the radius of the sphere a point/spot light's proxy triangles enclose (0 = the triangle
+    itself emits), sphere_first (n,) int32 the first proxy triangle of that lamp (-1 = not a sphere).
     Suns (distant lights): sun_dir (s, 3) unit direction *towards* the sun,
     sun_cos (s,) cos of the half angle (1 = delta), sun_irradiance (s, 3) W·m⁻² on a surface facing it.
     """
@@ -99,6 +101,15 @@ class Lamps:
     sun_dir: np.ndarray
     sun_cos: np.ndarray
     sun_irradiance: np.ndarray
+    sphere_radius: np.ndarray = None
+    sphere_first: np.ndarray = None
+
+    def __post_init__(self):
+        n = len(self.spot_cos)
+        if self.sphere_radius is None:
+            self.sphere_radius = np.zeros(n, np.float32)
+        if self.sphere_first is None:
+            self.sphere_first = np.full(n, -1, np.int32)
 
     @staticmethod
     def empty() -> Lamps:

@@ -3,7 +3,9 @@
   area  (square, rectangle, disk, ellipse): one-sided Lambertian emitter facing local -Z,
         radiance L = P / (π A)  (A: world-space area, object scale included)
   point: sphere of radius r (Radius; 1 mm when 0) emitting L = P / (π A_sphere) = P / (4π² r²),
-        i.e. intensity P / (4π) W/sr in every direction, as Cycles' sphere lights
+        i.e. intensity P / (4π) W/sr in every direction, as Cycles' sphere lights. The core treats it as a
+        true sphere (sampled by the cone it subtends, rays intersect it analytically); its triangles are
+        only a proxy for finding ray hits: an icosphere scaled so that it encloses the sphere
   spot : the point-light sphere with Cycles' cone attenuation smoothstep((cosθ - cos(size/2)) / (blend (1 - cos(size/2))))
   sun  : distant light, irradiance = strength (W/m²) on a surface facing it, cone of the sun's angle
 Colours multiply the power; everything is scene-linear RGB.
@@ -15,7 +17,7 @@ import numpy as np
 from ..core.scene import Lamps, TriangleSet
 
 DISK_SEGMENTS = 48
-SPHERE_LEVEL = 3  # 1280 triangles per point/spot light: projected area within ±0.07% of a sphere
+SPHERE_LEVEL = 1  # 80 proxy triangles per point/spot light (hits are then found on the true sphere)
 MIN_RADIUS = 1e-3
 
 
@@ -37,7 +39,15 @@ def _icosphere(level: int) -> np.ndarray:
     return tris
 
 
-_SPHERE = _icosphere(SPHERE_LEVEL)
+def _enclosing(tris: np.ndarray) -> np.ndarray:
+    """Unit icosphere triangles scaled so that every face lies outside the unit sphere (margin 0.1 %)."""
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    inradius = float(np.einsum("ij,ij->i", n, tris[:, 0]).min())
+    return tris * (1.001 / inradius)
+
+
+_SPHERE = _enclosing(_icosphere(SPHERE_LEVEL))
 
 
 def _area_shape(light) -> np.ndarray:
@@ -115,12 +125,13 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
                 warnings.append(f"Light '{obj.name}': area light spread below 180° is not supported (treated as 180°)")
             radiance = power / (np.pi * area)
             spot = (np.zeros(3), np.zeros(3), -2.0, 0.0)
+            sphere = 0.0
         elif light.type in {"POINT", "SPOT"}:
             r = max(float(light.shadow_soft_size), MIN_RADIUS)
             center = m[:3, 3]
             world = _SPHERE * r + center  # lamps keep their radius whatever the object scale, as in Cycles
-            area = _area(world)
-            radiance = power / (np.pi * area)
+            radiance = power / (np.pi * 4 * np.pi * r * r)
+            sphere = r
             if light.type == "SPOT":
                 axis = -m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-30)
                 cos_half = float(np.cos(float(light.spot_size) / 2))
@@ -132,7 +143,7 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
             continue
         mat = registry.add_row({"name": f"(light {obj.name})", "base_color": (0, 0, 0), "f0": 0.0,
                                 "emission": tuple(radiance), "two_sided_emission": False})
-        parts.append((world.astype(np.float32), mat, spot, visible))
+        parts.append((world.astype(np.float32), mat, spot, visible, sphere))
 
     lamps = Lamps.empty()
     if parts:
@@ -149,6 +160,9 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
         lamps.spot_cos = rep([p[2][2] for p in parts], np.float32)
         lamps.spot_smooth = rep([p[2][3] for p in parts], np.float32)
         lamps.camera_visible = rep([p[3] for p in parts], bool)
+        lamps.sphere_radius = rep([p[4] for p in parts], np.float32)
+        first = np.repeat(np.cumsum([0] + counts[:-1]), counts)
+        lamps.sphere_first = np.where(lamps.sphere_radius > 0, first, -1).astype(np.int32)
     if suns:
         lamps.sun_dir = np.array([s[0] for s in suns], np.float32)
         lamps.sun_cos = np.array([s[1] for s in suns], np.float32)

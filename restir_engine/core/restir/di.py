@@ -26,7 +26,7 @@ import numpy as np
 from ..accel import shadow_rays
 from ..bsdf import eval_view, luminance_rows, view_terms
 from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
-from ..pathtracer import sample_rays
+from ..pathtracer import lamp_hits, sample_rays
 from ..sampling import cols, dot, finite, to_local, uniform_ints, vmax
 from ..target import FramePoints, with_spots
 from .reservoir import Reservoirs, Stream
@@ -162,8 +162,8 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
         hp = np.maximum(hits.prim, 0)
         candidates.append((np.where(hits.prim >= 0, lights.geom_to_light[hp], -1), hits.u, hits.v))
         if len(lamps.tris):
-            lh = ctx.lamp_accel.intersect(o, d, hits.t)
-            lamp_ok = (lh.prim >= 0) & (lh.t < hits.t)
+            lh = lamp_hits(ctx, o, d, hits.t)
+            lamp_ok = lh.prim >= 0
             candidates.append((np.where(lamp_ok, lights.lamp_to_light[np.maximum(lh.prim, 0)], -1), lh.u, lh.v))
         for light, cu, cv in candidates:
             sel = np.flatnonzero(light >= 0)
