@@ -22,6 +22,10 @@ LAST_FRAME_STATS: dict = {}
 # only by the next frame (a jump drops it) and only if resolution and light table still match.
 _TEMPORAL_HISTORY: dict = {}
 
+# What the automatic choices picked in the last render of each scene (by name), for the Sampling panel:
+# {"direct_method", "direct_reason", "coverage_samples", "coverage_reason"}.
+LAST_CHOICES: dict = {}
+
 
 def settings_from_scene(scene) -> RenderSettings:
     s = scene.restir
@@ -34,13 +38,15 @@ def settings_from_scene(scene) -> RenderSettings:
                           light_tiles=s.light_tiles, light_tile_count=int(s.light_tile_count),
                           light_tile_size=int(s.light_tile_size), boiling_filter=bool(s.boiling_filter),
                           boiling_threshold=float(s.boiling_threshold),
+                          coverage_samples=0 if s.coverage_samples == "AUTO" else int(s.coverage_samples),
                           film_transparent=bool(scene.render.film_transparent))
 
 
 def with_data_passes(settings: RenderSettings, view_layer) -> RenderSettings:
     """``settings`` computing Depth/Normal/Vector only when the view layer writes one of them."""
     wanted = bool(view_layer.use_pass_z or view_layer.use_pass_normal or view_layer.use_pass_vector)
-    return replace(settings, data_passes=wanted)
+    reservoirs = bool(view_layer.restir.use_pass_reservoir_m or view_layer.restir.use_pass_reservoir_ucw)
+    return replace(settings, data_passes=wanted, reservoir_passes=reservoirs)
 
 
 def scene_problems(core_scene, light_count: int) -> list[str]:
@@ -93,15 +99,17 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         view_layer = depsgraph.view_layer
         t0 = time.perf_counter()
         settings = with_data_passes(settings_from_scene(scene), view_layer)
-        wants_temporal = settings.integrator == "RESTIR" and settings.direct_method == "RESTIR" and settings.temporal_reuse
+        # AUTO may resolve to ReSTIR (known once the scene is exported): keep and preroll its history too
+        wants_temporal = settings.integrator == "RESTIR" and settings.direct_method in ("RESTIR", "AUTO") and \
+            settings.temporal_reuse
         key = (scene.name, view_layer.name)
         prev = _TEMPORAL_HISTORY.pop(key, None)
         history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None
         # a chunk of an animation render that starts without history prerolls; a still does not (its
         # sample passes are independent, and only animations carry history from frame to frame)
         if wants_temporal and history is None and self.is_animation and scene.restir.preroll_frames > 0:
-            history = self._preroll(depsgraph, settings, int(scene.restir.preroll_frames))
-            if history is None:  # cancelled
+            history, cancelled = self._preroll(depsgraph, settings, int(scene.restir.preroll_frames))
+            if cancelled:
                 return
         self.update_stats("ReSTIR", "Exporting scene")
         try:
@@ -134,6 +142,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):
             self.report({"WARNING"}, msg)
         self._write(result.passes, core_scene.camera.window, scene, view_layer)
+        LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
+                                                                  "coverage_samples", "coverage_reason")}
         LAST_FRAME_STATS.clear()
         LAST_FRAME_STATS.update(export_seconds=t_export, core_seconds=result.seconds, samples=result.samples_done,
                                 frame=scene.frame_current, cancelled=result.cancelled, **result.stats)
@@ -143,26 +153,29 @@ class RestirRenderEngine(bpy.types.RenderEngine):
     def _preroll(self, depsgraph, settings, count: int):
         """Render the first sample pass of frames F-count .. F-1 (not written): the history travels through
         each frame's first pass, so this builds exactly the history a sequential render has at frame F (same
-        seeds) at one pass per frame. Returns the history, or None when cancelled."""
+        seeds) at one pass per frame. Returns (history or None, whether the user cancelled)."""
         scene = depsgraph.scene
         frame = scene.frame_current
         history = None
         try:  # whatever happens, the scene goes back to frame F (an unrestored frame crashes Blender)
             for f in range(frame - count, frame):
                 if self.test_break():
-                    return None
+                    return None, True
                 self.update_stats("ReSTIR", f"Preroll frame {f} for frame {frame}")
                 self.frame_set(f, subframe=0.0)
                 try:
                     core = export_scene(depsgraph, self.camera_override)
                     neighbour_frames(self, depsgraph, core, self.camera_override, need_next=False)
-                    history = render_frame(core, replace(settings, samples=1, frame=f, data_passes=False),
-                                           history=history).history
+                    result = render_frame(core, replace(settings, samples=1, frame=f, data_passes=False),
+                                          history=history)
+                    if result.stats["direct_method"] != "RESTIR":  # AUTO chose a method without history
+                        return None, False
+                    history = result.history
                 except (ExportError, Cancelled):
                     history = None
         finally:
             self.frame_set(frame, subframe=0.0)
-        return history
+        return history, False
 
     # -- viewport (Rendered shading) ----------------------------------------------------------
     def view_update(self, context, depsgraph):

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 def has_reservoirs(scene) -> bool:
     s = scene.restir
-    return s.integrator == "RESTIR" and s.direct_method in ("RIS", "RESTIR")
+    return s.integrator == "RESTIR" and s.direct_method in ("AUTO", "RIS", "RESTIR")  # AUTO resamples when asked
 
 
 PASSES = (

@@ -29,12 +29,25 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
     direct_method: EnumProperty(
         name="Direct Method",
         description="How the ReSTIR integrator estimates direct light at the first hit",
-        items=[("LIGHT_SAMPLING", "Light Sampling", "Baseline: one light sample and one BSDF sample combined by MIS", 0),
+        items=[("AUTO", "Auto", "Light sampling where the scene has a few lights, ReSTIR where resampling pays "
+                "(chosen per frame from the light count, measured; the choice and its reason show below)", 3),
+               ("LIGHT_SAMPLING", "Light Sampling", "Baseline: one light sample and one BSDF sample combined by MIS", 0),
                ("RIS", "RIS", "Resampled importance sampling: pick one of many light and BSDF candidates by the "
                 "unshadowed contribution, then trace one shadow ray (unbiased)", 1),
                ("RESTIR", "ReSTIR", "RIS, then reuse of the previous frame's reservoirs (temporal) "
                 "and of neighbouring pixels' (spatial)", 2)],
-        default="RESTIR", update=_update_passes)
+        default="AUTO", update=_update_passes)
+    coverage_samples: EnumProperty(
+        name="Pixel Coverage",
+        description="Camera rays per pixel for the emission seen directly (lamps, emissive surfaces, the world): "
+                    "the pixel is split into strata, the lighting is shaded at one ray and the emission averaged "
+                    "over one ray per stratum, so small bright emitters and their edges converge faster",
+        items=[("AUTO", "Auto", "4 rays per pixel where the camera can see emitters, else 1", 0),
+               ("1", "1 Ray", "One camera ray per pixel and sample", 1),
+               ("4", "4 Rays", "2 x 2 strata", 4),
+               ("9", "9 Rays", "3 x 3 strata", 9),
+               ("16", "16 Rays", "4 x 4 strata", 16)],
+        default="AUTO")
     light_candidates: IntProperty(name="Light Candidates", description="Light samples per pixel resampled by RIS",
                                   default=CandidateSettings.light_candidates, min=0, soft_max=256)
     bsdf_candidates: IntProperty(name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",

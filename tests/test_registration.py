@@ -28,7 +28,7 @@ def test_settings_defaults(addon):
     try:
         s = scene.restir
         assert (s.samples, s.seed, s.max_bounces, s.integrator) == (16, 0, 4, "RESTIR")
-        assert (s.direct_method, s.light_candidates, s.bsdf_candidates) == ("RESTIR", 32, 1)
+        assert (s.direct_method, s.light_candidates, s.bsdf_candidates, s.coverage_samples) == ("AUTO", 32, 1, "AUTO")
         assert (s.light_tiles, s.light_tile_count, s.light_tile_size) == ("AUTO", 128, 1024)
         assert (s.temporal_reuse, s.confidence_cap, s.spatial_neighbors, s.spatial_radius, s.bias_correction) == (
             True, 20.0, 5, 30.0, "UNBIASED")

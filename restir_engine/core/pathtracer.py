@@ -120,27 +120,46 @@ class PrimaryHits:
 def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray) -> PrimaryHits:
     """Camera rays through raster points (x, y) (window pixels + jitter, y up)."""
     cam = ctx.scene.camera
-    n = len(x)
     o, d, tmax = camera_mod.generate_rays(cam, x, y)
+    hits = ctx.geom_accel.intersect(o, d, tmax)
+    emitted, alpha = _seen(ctx, o, d, tmax, hits)
+    rows = np.flatnonzero(hits.prim >= 0)
+    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
+    return PrimaryHits(emitted, alpha, rows, surf)
+
+
+def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
+    """What camera rays through raster points (x, y) see emitted (3, n) and their alpha (n,): the part of
+    :func:`primary` that needs no surface (extra rays per pixel for pixel coverage)."""
+    o, d, tmax = camera_mod.generate_rays(ctx.scene.camera, x, y)
+    return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax))
+
+
+def _seen(ctx: TraceContext, o, d, tmax, hits):
+    """Emission (3, n) camera rays meet first: visible lamps in front of the hit, emissive surfaces, the world
+    where nothing is hit (unless the film is transparent); alpha (n,) 0 where nothing is hit on a transparent
+    film."""
+    n = len(hits.prim)
     emitted = np.zeros((3, n), np.float32)
     alpha = np.ones(n, np.float32)
-    hits = ctx.geom_accel.intersect(o, d, tmax)
-    alive = hits.prim >= 0
     if len(ctx.scene.lamps.tris):  # lamps seen by the camera (those marked visible to camera rays)
         lh = lamp_hits(ctx, o, d, np.minimum(hits.t, tmax))
         sel = np.flatnonzero(lh.prim >= 0)
         sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
         if sel.size:
             emitted[:, sel] += _lamp_emission(ctx, lh, o, d, sel)[0]
-    miss = ~alive
+    miss = hits.prim < 0
     if ctx.film_transparent:
         alpha[miss] = 0.0
     else:
         emitted += ctx.scene.world_radiance.astype(np.float32)[:, None] * miss
-    rows = np.flatnonzero(alive)
-    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
-    emitted[:, rows] += surf.emission(ctx)
-    return PrimaryHits(finite(emitted), alpha, rows, surf)
+    if ctx.lights.n_geom:  # emissive surfaces (mesh emission is two-sided by default)
+        prim = np.maximum(hits.prim, 0)
+        em = np.flatnonzero((hits.prim >= 0) & (ctx.lights.geom_to_light[prim] >= 0))
+        if em.size:
+            emitted[:, em] += emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em],
+                                               hits.v[em])
+    return finite(emitted), alpha
 
 
 def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None) -> np.ndarray:

@@ -1,7 +1,10 @@
 """Per-frame orchestration: a sample pass as named stages over the whole window, chunks on the thread pool.
 
 Stages of a sample pass (each timed by a profile.StageClock when one is given):
-  primary   camera rays, emission seen directly, the G-buffer (every integrator)
+  primary   camera rays, emission seen directly, the G-buffer (every integrator); with pixel coverage
+            (``coverage_samples`` > 1) the pixel is split into that many strata: the surface is shaded at one
+            ray in a random stratum, the emission seen directly (and alpha) is averaged over one ray per stratum
+            (both are unbiased estimates of the box-filtered pixel)
   initial   ReSTIR/RIS: light tiles, target terms and initial resampling (light + BSDF candidates)
   paths     the first vertex's BSDF ray and bounces 1..max_bounces (pathtracer.continue_paths); it needs no
             reservoir, so it runs before reuse and the first BSDF candidate's ray it takes over is freed early
@@ -31,13 +34,14 @@ from .accel import in_worker, pool, thread_count
 from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
 from .context_cache import context_for
+from .direct_choice import choose_direct_method
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
 from .profile import NullClock
 from .restir import di, reuse
 from .restir.gbuffer import GBuffer
 from .restir.history import TemporalHistory
 from .sampling import (STREAM_CAMERA, STREAM_INITIAL, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL,
-                       STREAM_TILES, finite, rng)
+                       STREAM_TILES, finite, rng, uniform_ints)
 from .scene import Scene
 from .target import WIDTH, ShadingTerms
 
@@ -60,7 +64,8 @@ class RenderSettings:
     max_bounces: int = 4
     frame: int = 0
     integrator: str = "PATH"
-    direct_method: str = "RIS"  # with integrator RESTIR: "LIGHT_SAMPLING" (NEE + MIS), "RIS" or "RESTIR"
+    direct_method: str = "RIS"  # with integrator RESTIR: "AUTO", "LIGHT_SAMPLING" (NEE + MIS), "RIS" or "RESTIR"
+    reservoir_passes: bool = False  # a reservoir pass is wanted (AUTO then resamples: direct_choice)
     light_candidates: int = di.CandidateSettings.light_candidates
     bsdf_candidates: int = di.CandidateSettings.bsdf_candidates
     spatial_neighbors: int = reuse.SpatialSettings.neighbors
@@ -77,7 +82,23 @@ class RenderSettings:
     film_transparent: bool = False
     data_passes: bool = True  # Depth, Normal and Vector (one more ray per pixel and frame); off when not written
     tile_pixels: int = CHUNK_PIXELS  # pixels per chunk of work (smaller: finer progress and cancellation)
+    coverage_samples: int = 0  # camera rays per pixel for the emission seen directly: 1, 4, 9, 16 ...; 0 = automatic
 
+
+def coverage_samples(setting: int, lights, lamps) -> tuple[int, str]:
+    """Strata per pixel for the emission seen directly (a square number) and why: ``setting`` rounded down to a
+    square, or when 0 (automatic) AUTO_COVERAGE where the camera can see emitters (emissive surfaces or lamps
+    visible to camera rays), 1 elsewhere (measured: docs/RESULTS.md, "Pixel coverage")."""
+    if setting > 0:
+        g = max(1, int(np.sqrt(setting + 1e-9)))
+        return g * g, "set by the user"
+    visible = lights.n_geom > 0 or bool(len(lamps.tris) and lamps.camera_visible.any())
+    if visible:
+        return AUTO_COVERAGE, "emitters can be seen directly"
+    return 1, "no emitter can be seen directly"
+
+
+AUTO_COVERAGE = 4
 
 @dataclass
 class FrameResult:
@@ -157,10 +178,15 @@ class FrameRenderer:
         self.clock = clock or NullClock()
         self.candidates = None  # di.CandidateSettings when the direct light is resampled
         self.method = "PATH"
+        self.method_reason = "path tracer"
+        if settings.integrator == "RESTIR" and settings.direct_method not in di.DIRECT_METHODS:
+            raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {di.DIRECT_METHODS}")
+        self.ctx, self.context_reused = context_for(scene, settings.max_bounces, settings.film_transparent,
+                                                    pathtracer.build_context)
         if settings.integrator == "RESTIR":
-            if settings.direct_method not in di.DIRECT_METHODS:
-                raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {di.DIRECT_METHODS}")
-            self.method = settings.direct_method
+            self.method, self.method_reason = settings.direct_method, "set by the user"
+            if self.method == "AUTO":
+                self.method, self.method_reason = choose_direct_method(self.ctx.lights, settings.reservoir_passes)
             tiles = TileSettings(settings.light_tiles, settings.light_tile_count, settings.light_tile_size)
             if tiles.mode not in TILE_MODES:
                 raise ValueError(f"unknown light tile mode {tiles.mode!r}; available: {TILE_MODES}")
@@ -172,9 +198,9 @@ class FrameRenderer:
             self.spatial = reuse.SpatialSettings(max(0, settings.spatial_neighbors),
                                                  max(1.0, float(settings.spatial_radius)),
                                                  max(0, settings.spatial_passes), settings.bias_correction)
-        self.ctx, self.context_reused = context_for(scene, settings.max_bounces, settings.film_transparent,
-                                                    pathtracer.build_context)
         self.space = di.LightSpace(self.ctx.lights)
+        self.coverage, self.coverage_reason = coverage_samples(settings.coverage_samples, self.ctx.lights,
+                                                               self.ctx.scene.lamps)
         self.build_seconds = time.perf_counter() - t0
         self.set_camera(scene.camera)
         if history is not None and history.fits(scene.camera):
@@ -274,11 +300,28 @@ class FrameRenderer:
         stop = _Progress(progress, should_stop, len(chunks) * chunk_stages)
         ctx = self.ctx
 
+        strata = self.coverage
+
         def primary(c: _Chunk):
-            j = rng(st.seed, st.frame, s, STREAM_CAMERA, c.index).random((len(c.pixels), 2), dtype=np.float32)
-            x = (x0 + c.pixels % w).astype(np.float32) + j[:, 0]
-            y = (y0 + c.pixels // w).astype(np.float32) + j[:, 1]
-            c.hits = pathtracer.primary(ctx, x, y)
+            r = rng(st.seed, st.frame, s, STREAM_CAMERA, c.index)
+            j = r.random((len(c.pixels), 2), dtype=np.float32)
+            px = (x0 + c.pixels % w).astype(np.float32)
+            py = (y0 + c.pixels // w).astype(np.float32)
+            if strata == 1:
+                c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
+                return
+            # the shaded ray in a random stratum (uniform over the pixel), one more ray in each other stratum
+            g = int(round(np.sqrt(strata)))
+            k0 = uniform_ints(r, strata, len(c.pixels))
+            c.hits = pathtracer.primary(ctx, px + ((k0 % g).astype(np.float32) + j[:, 0]) / g,
+                                        py + ((k0 // g).astype(np.float32) + j[:, 1]) / g)
+            k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
+            jj = r.random((2,) + k.shape, dtype=np.float32)
+            em, al = pathtracer.seen_emission(ctx, (px + ((k % g).astype(np.float32) + jj[0]) / g).ravel(),
+                                              (py + ((k // g).astype(np.float32) + jj[1]) / g).ravel())
+            inv = np.float32(1.0 / strata)
+            c.hits.emitted = (c.hits.emitted + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
+            c.hits.alpha = (c.hits.alpha + al.reshape(strata - 1, -1).sum(axis=0)) * inv
 
         with clock.stage("primary"):
             self._map(primary, chunks, stop)
@@ -512,7 +555,9 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     ctx = fr.ctx
     stats = {"build_seconds": fr.build_seconds, "light_tiles": fr.used_tiles, "triangles": len(scene.geometry),
              "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun, "boiling_dropped": fr.boiling_dropped,
-             "context_reused": fr.context_reused}
+             "context_reused": fr.context_reused, "coverage_samples": fr.coverage,
+             "direct_method": fr.method, "direct_reason": fr.method_reason,
+             "coverage_reason": fr.coverage_reason}
     if clock is not None:
         stats["stages"] = clock.stages
     return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled, stats, fr.history)

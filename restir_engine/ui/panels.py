@@ -70,20 +70,31 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
         col = layout.column(align=True)
         col.prop(s, "samples")
         col.prop(s, "seed")
+        layout.prop(s, "coverage_samples")
+        last = _last_choices(context.scene)
         if s.integrator == "RESTIR":
             layout.prop(s, "direct_method")
+            if last and (s.direct_method == "AUTO" or s.coverage_samples == "AUTO"):
+                box = layout.box()
+                box.scale_y = 0.8
+                if s.direct_method == "AUTO":
+                    box.label(text=f"Last render: {last['direct_method'].replace('_', ' ').title()}", icon="INFO")
+                    box.label(text=last["direct_reason"])
+                if s.coverage_samples == "AUTO":
+                    box.label(text=f"Pixel coverage: {last['coverage_samples']} "
+                                   f"ray{'s' if last['coverage_samples'] != 1 else ''} ({last['coverage_reason']})")
             col = layout.column(align=True)
-            col.active = s.direct_method in ("RIS", "RESTIR")
+            col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
             col.prop(s, "light_candidates")
             col.prop(s, "bsdf_candidates")
             col = layout.column(align=True)
-            col.active = s.direct_method in ("RIS", "RESTIR")
+            col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
             col.prop(s, "light_tiles")
             sub = col.column(align=True)
             sub.active = s.light_tiles != "OFF"
             sub.prop(s, "light_tile_count")
             sub.prop(s, "light_tile_size")
-            if s.direct_method == "RESTIR":
+            if s.direct_method in ("RESTIR", "AUTO"):
                 col = layout.column(align=True, heading="Temporal Reuse")
                 col.prop(s, "temporal_reuse", text="")
                 sub = col.column()
@@ -102,6 +113,12 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
                 sub = row.row(align=True)
                 sub.active = s.boiling_filter
                 sub.prop(s, "boiling_threshold")
+
+
+def _last_choices(scene):
+    """What the automatic settings picked in this scene's last render (engine.LAST_CHOICES), or None."""
+    from ..engine import LAST_CHOICES
+    return LAST_CHOICES.get(scene.name)
 
 
 class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):
@@ -130,6 +147,8 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl.restir, "use_pass_emission")
         col = layout.column(heading="ReSTIR", align=True)
         col.active = context.scene.restir.integrator == "RESTIR" and context.scene.restir.direct_method != "LIGHT_SAMPLING"
+        if context.scene.restir.direct_method == "AUTO":
+            col.label(text="Auto uses ReSTIR when a reservoir pass is on")
         col.prop(vl.restir, "use_pass_reservoir_m")
         col.prop(vl.restir, "use_pass_reservoir_ucw")
 

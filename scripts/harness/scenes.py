@@ -12,6 +12,7 @@ cache directory on demand (keyed by a hash of this file, so editing a builder re
   interior_gi  a room lit mostly indirectly: an emissive panel aimed at a wall
   animated     camera move + moving occluder + a light that switches off at frame 5 + an object sliding
                away to reveal a lit background (8 frames)
+  default_cube Blender's factory startup scene (cube, point light, grey world): the first F12 a user tries
 """
 from __future__ import annotations
 
@@ -247,6 +248,16 @@ def build_interior_gi(variant="default", size="small"):
     return scene
 
 
+def build_default_cube(variant="default", size="medium"):
+    """The factory startup file as a new user sees it (Principled cube, 1000 W point light of radius 0.1 m,
+    grey world), at the library's sizes."""
+    bpy.ops.wm.read_factory_settings(use_empty=False)
+    scene = bpy.context.scene
+    scene.render.resolution_percentage = 100
+    set_size(scene, size)
+    return scene
+
+
 ANIM_FRAMES = 8
 LIGHT_OFF_FRAME = 5
 
@@ -280,7 +291,7 @@ def build_animated(variant="default", size="small"):
 
 
 BUILDERS = {"cornell": build_cornell, "many_lights": build_many_lights, "glossy": build_glossy,
-            "interior_gi": build_interior_gi, "animated": build_animated}
+            "interior_gi": build_interior_gi, "animated": build_animated, "default_cube": build_default_cube}
 
 
 def _source_hash() -> str:
