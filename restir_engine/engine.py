@@ -36,7 +36,8 @@ def settings_from_scene(scene) -> RenderSettings:
                           spatial_passes=int(s.spatial_passes), bias_correction=s.bias_correction,
                           temporal_reuse=bool(s.temporal_reuse), confidence_cap=float(s.confidence_cap),
                           light_tiles=s.light_tiles, light_tile_count=int(s.light_tile_count),
-                          light_tile_size=int(s.light_tile_size), boiling_filter=bool(s.boiling_filter),
+                          light_tile_size=int(s.light_tile_size), light_sampler=s.light_sampler,
+                          boiling_filter=bool(s.boiling_filter),
                           boiling_threshold=float(s.boiling_threshold),
                           coverage_samples=0 if s.coverage_samples == "AUTO" else int(s.coverage_samples),
                           film_transparent=bool(scene.render.film_transparent))
@@ -143,7 +144,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, msg)
         self._write(result.passes, core_scene.camera.window, scene, view_layer)
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
-                                                                  "coverage_samples", "coverage_reason")}
+                                                                  "coverage_samples", "coverage_reason",
+                                                                  "spatial_radius")}
         LAST_FRAME_STATS.clear()
         LAST_FRAME_STATS.update(export_seconds=t_export, core_seconds=result.seconds, samples=result.samples_done,
                                 frame=scene.frame_current, cancelled=result.cancelled, **result.stats)

@@ -62,6 +62,14 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                ("ON", "On", "Always draw candidates from tiles", 1),
                ("OFF", "Off", "Draw every candidate from the full light table", 2)],
         default=TileSettings.mode)
+    light_sampler: EnumProperty(
+        name="Tile Sampling",
+        description="How the light tiles are drawn",
+        items=[("SPATIAL", "Spatial", "One tile per 16x16 pixel block, drawn with more probability for the lights "
+                "near that block's surfaces (light clusters weighted by power over distance, 10 % by power alone): "
+                "surfaces next to an emitter get candidates from it", 0),
+               ("POWER", "Power", "Tiles drawn by light power alone, one picked at random per block", 1)],
+        default="SPATIAL")
     light_tile_count: IntProperty(name="Tiles", description="Light tiles drawn per sample pass", default=TileSettings.count,
                                   min=1, soft_max=1024)
     light_tile_size: IntProperty(name="Tile Size", description="Light points per tile", default=TileSettings.size, min=1,
@@ -78,8 +86,9 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                                   default=TemporalSettings.confidence_cap, min=1.0, soft_max=100.0)
     spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring reservoirs merged per spatial pass",
                                    default=SpatialSettings.neighbors, min=0, soft_max=16)
-    spatial_radius: FloatProperty(name="Radius", description="Spatial reuse radius in pixels", default=SpatialSettings.radius,
-                                  min=1.0, soft_max=100.0, subtype="PIXEL")
+    spatial_radius: FloatProperty(name="Radius", description="Spatial reuse radius in pixels; 0 = automatic: "
+                                  "8 px at 640x360, scaled with the image diagonal (4 px at least)",
+                                  default=SpatialSettings.radius, min=0.0, soft_max=100.0, subtype="PIXEL")
     spatial_passes: IntProperty(name="Passes", description="Spatial reuse passes (more passes add correlation)",
                                 default=SpatialSettings.passes, min=0, soft_max=4)
     bias_correction: EnumProperty(

@@ -87,9 +87,10 @@ def main():
         render_frame(scene, RenderSettings(samples=1, integrator="RESTIR", data_passes=False))  # warm-up
         from restir_engine.core.context_cache import context_for
         from restir_engine.core import pathtracer
-        auto, reason = choose_direct_method(context_for(scene, 0, False, pathtracer.build_context)[0].lights)
+        lights = context_for(scene, 0, False, pathtracer.build_context)[0].lights
         for bounces in args.bounces:
             for label, frames in (("still", 1), ("animation", 4)):
+                auto, reason = choose_direct_method(lights, False, bounces)
                 row = {"scene": f"{name}-{variant}", "bounces": bounces, "case": label, "auto": auto,
                        "reason": reason, "methods": {}}
                 for m in METHODS:

@@ -92,16 +92,19 @@ def _many_coloured_lights(width=40):
     return Scene(concat(sets), mats, Lamps.empty(), top_down_camera(width, width, height_above=0.3, half_extent=1.2))
 
 
+@pytest.mark.parametrize("sampler", ["POWER", "SPATIAL"])
 @pytest.mark.parametrize("method", ["RIS", "RESTIR"])
-def test_tile_candidates_converge_to_the_path_tracer(method):
+def test_tile_candidates_converge_to_the_path_tracer(method, sampler):
     """Candidates from a few small tiles (strongly correlated within a 16 x 16 block, and between
     spatial neighbours) still give the path tracer's image mean within 5 standard errors (24 independent
     seeds each: measured over 40 seeds, every renderer's image mean has a standard deviation of 0.0032 per
     seed, so se ≈ 0.0009, half the 0.8 % the check needs; the test can see a 4 % error). Temporal reuse is off: it makes the passes of one seed
-    correlated, which needs many more seeds for the same power (it is tested without tiles)."""
+    correlated, which needs many more seeds for the same power (it is tested without tiles). SPATIAL: one tile
+    per block from its own light distribution (light_blocks.py), with the BSDF candidates' MIS at that pdf."""
     scene = _many_coloured_lights()
     st = dict(samples=16, max_bounces=0, integrator="RESTIR", direct_method=method, light_candidates=8,
-              light_tiles="ON", light_tile_count=4, light_tile_size=64, spatial_radius=8, temporal_reuse=False)
+              light_tiles="ON", light_tile_count=4, light_tile_size=64, spatial_radius=8, temporal_reuse=False,
+              light_sampler=sampler)
     a = [render_frame(scene, RenderSettings(**st, seed=s)) for s in range(24)]
     assert all(r.stats["light_tiles"] for r in a)
     ma = np.array([r.passes["Combined"][..., :3].mean() for r in a])
@@ -110,3 +113,57 @@ def test_tile_candidates_converge_to_the_path_tracer(method):
     se = np.sqrt(ma.var(ddof=1) / len(ma) + mb.var(ddof=1) / len(mb))
     assert se < 0.008 * mb.mean()
     assert abs(ma.mean() - mb.mean()) < 5 * se, (ma.mean(), mb.mean(), se)
+
+
+def _block_tiles(scene, width, height_above=0.0):
+    """Block tiles for a top-down view of the z = 0 floor of ``scene`` (positions of the pixel centres)."""
+    from restir_engine.core import light_blocks, pathtracer
+    ctx = pathtracer.build_context(scene, 0)
+    half = 1.2
+    c = -half + (np.arange(width) + 0.5) * 2 * half / width
+    pos = np.stack([np.broadcast_to(c[None, :], (width, width)), np.broadcast_to(c[:, None], (width, width)),
+                    np.full((width, width), height_above)]).astype(np.float32)
+    return ctx.lights, light_blocks.BlockLightTiles(ctx.lights, pos, width, width, np.random.default_rng(7), size=4096)
+
+
+def test_block_tiles_store_their_blocks_pdf_and_draw_clusters_by_it():
+    """Each tile point carries the area pdf of its block's distribution (the one the BSDF candidates' MIS
+    evaluates), every block's cluster probabilities sum to 1, and 4096 draws per block follow them
+    (chi-square over the clusters, 1e-4 false-alarm level)."""
+    from restir_engine.core.light_blocks import clusters_of
+    lights, bt = _block_tiles(_many_coloured_lights(), 40)
+    assert np.allclose(bt.q.sum(axis=1), 1.0)
+    assert (bt.q > 0).all()  # every cluster keeps a positive probability: unbiased whatever the bound
+    block = np.repeat(np.arange(bt.q.shape[0]), bt.size)
+    bx, by = block % bt.blocks_x, block // bt.blocks_x
+    pdf = bt.pdf_area(bt.points.light.astype(np.int64), bx * 16, by * 16)
+    assert np.allclose(bt.points.pdf, pdf, rtol=1e-6)
+    cl = clusters_of(lights)
+    chosen = cl.cluster_of[bt.points.light].reshape(-1, bt.size)
+    for b in range(bt.q.shape[0]):
+        counts = np.bincount(chosen[b], minlength=cl.count)
+        expected = bt.q[b] * bt.size
+        keep = expected > 5
+        chi2 = ((counts[keep] - expected[keep]) ** 2 / expected[keep]).sum()
+        dof = max(1, keep.sum() - 1)
+        assert chi2 < dof + 4.0 * np.sqrt(2 * dof) + 10, (b, chi2, dof)  # ~1e-4 tail of chi-square
+
+
+def test_block_tiles_favour_the_lights_above_the_block():
+    """A block right under a light gives it more probability than the power table does (the point of the
+    spatial sampler), a far block less."""
+    from restir_engine.core.light_blocks import clusters_of
+    scene = _many_coloured_lights()
+    lights, bt = _block_tiles(scene, 40)
+    cl = clusters_of(lights)
+    # the light nearest to the floor point under block 0's centre, and the farthest one
+    centre = np.array([-1.2 + 8 * 2.4 / 40, -1.2 + 8 * 2.4 / 40, 0.0])
+    light_c = lights.tri_verts.mean(axis=1)
+    d = np.linalg.norm(light_c - centre, axis=1)
+    near, far = int(np.argmin(d)), int(np.argmax(d))
+    power_pdf = lights.tri_pdf_area
+    block_pdf = bt.pdf_area(np.array([near, far]), np.array([0, 0]), np.array([0, 0]))
+    assert block_pdf[0] > 2 * power_pdf[near], (block_pdf[0], power_pdf[near])
+    assert block_pdf[1] < power_pdf[far]
+    from restir_engine.core.light_blocks import CLUSTERS
+    assert cl.count == min(lights.n_tri, CLUSTERS)

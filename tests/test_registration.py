@@ -31,7 +31,7 @@ def test_settings_defaults(addon):
         assert (s.direct_method, s.light_candidates, s.bsdf_candidates, s.coverage_samples) == ("AUTO", 32, 1, "AUTO")
         assert (s.light_tiles, s.light_tile_count, s.light_tile_size) == ("AUTO", 128, 1024)
         assert (s.temporal_reuse, s.confidence_cap, s.spatial_neighbors, s.spatial_radius, s.bias_correction) == (
-            True, 20.0, 5, 30.0, "UNBIASED")
+            True, 20.0, 5, 0.0, "UNBIASED")
         vl = scene.view_layers[0].restir
         assert not (vl.use_pass_direct or vl.use_pass_indirect or vl.use_pass_emission or vl.use_pass_reservoir_m)
     finally:

@@ -35,6 +35,7 @@ from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
 from .context_cache import context_for
 from .direct_choice import choose_direct_method
+from .light_blocks import BlockLightTiles
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
 from .profile import NullClock
 from .restir import di, reuse
@@ -69,7 +70,7 @@ class RenderSettings:
     light_candidates: int = di.CandidateSettings.light_candidates
     bsdf_candidates: int = di.CandidateSettings.bsdf_candidates
     spatial_neighbors: int = reuse.SpatialSettings.neighbors
-    spatial_radius: float = reuse.SpatialSettings.radius
+    spatial_radius: float = reuse.SpatialSettings.radius  # pixels; 0 = automatic (reuse.auto_radius)
     spatial_passes: int = reuse.SpatialSettings.passes
     bias_correction: str = reuse.SpatialSettings.bias_correction  # "NONE" (1/M) or "UNBIASED" (pairwise MIS)
     temporal_reuse: bool = True  # ReSTIR: pass 0 of a frame reuses pass 0 of the previous frame (history)
@@ -79,6 +80,7 @@ class RenderSettings:
     light_tiles: str = TileSettings.mode  # light candidates from presampled tiles: "AUTO", "ON", "OFF"
     light_tile_count: int = TileSettings.count
     light_tile_size: int = TileSettings.size
+    light_sampler: str = "SPATIAL"  # light tiles: "SPATIAL" (per-block importance, light_blocks.py) or "POWER"
     film_transparent: bool = False
     data_passes: bool = True  # Depth, Normal and Vector (one more ray per pixel and frame); off when not written
     tile_pixels: int = CHUNK_PIXELS  # pixels per chunk of work (smaller: finer progress and cancellation)
@@ -186,7 +188,8 @@ class FrameRenderer:
         if settings.integrator == "RESTIR":
             self.method, self.method_reason = settings.direct_method, "set by the user"
             if self.method == "AUTO":
-                self.method, self.method_reason = choose_direct_method(self.ctx.lights, settings.reservoir_passes)
+                self.method, self.method_reason = choose_direct_method(self.ctx.lights, settings.reservoir_passes,
+                                                                        settings.max_bounces)
             tiles = TileSettings(settings.light_tiles, settings.light_tile_count, settings.light_tile_size)
             if tiles.mode not in TILE_MODES:
                 raise ValueError(f"unknown light tile mode {tiles.mode!r}; available: {TILE_MODES}")
@@ -195,8 +198,10 @@ class FrameRenderer:
             if self.method in ("RIS", "RESTIR"):
                 self.candidates = di.CandidateSettings(self.method, max(0, settings.light_candidates),
                                                        max(0, settings.bsdf_candidates), tiles)
-            self.spatial = reuse.SpatialSettings(max(0, settings.spatial_neighbors),
-                                                 max(1.0, float(settings.spatial_radius)),
+            cam = scene.camera
+            radius = float(settings.spatial_radius) if settings.spatial_radius > 0 else \
+                reuse.auto_radius(cam.width, cam.height)
+            self.spatial = reuse.SpatialSettings(max(0, settings.spatial_neighbors), max(1.0, radius),
                                                  max(0, settings.spatial_passes), settings.bias_correction)
         self.space = di.LightSpace(self.ctx.lights)
         self.coverage, self.coverage_reason = coverage_samples(settings.coverage_samples, self.ctx.lights,
@@ -332,7 +337,14 @@ class FrameRenderer:
         candidates = self.candidates
         if resampled and ctx.lights.tri_alias is not None and candidates.tile_settings.wanted(npix, candidates.light_candidates):
             with clock.stage("initial"):
-                tiles = LightTiles(ctx.lights, candidates.tile_settings, w, h, rng(st.seed, st.frame, s, STREAM_TILES))
+                r_tiles = rng(st.seed, st.frame, s, STREAM_TILES)
+                if st.light_sampler == "SPATIAL":
+                    pos = np.full((3, npix), np.nan, np.float32)
+                    for c in chunks:
+                        pos[:, c.pixels[c.hits.rows]] = c.hits.surf.p
+                    tiles = BlockLightTiles(ctx.lights, pos.reshape(3, h, w), w, h, r_tiles)
+                else:
+                    tiles = LightTiles(ctx.lights, candidates.tile_settings, w, h, r_tiles)
             candidates = dataclasses.replace(candidates, tiles=tiles)
             self.used_tiles = True
         continuing = pathtracer.needs_continuation(ctx, resampled)
@@ -557,6 +569,7 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
              "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun, "boiling_dropped": fr.boiling_dropped,
              "context_reused": fr.context_reused, "coverage_samples": fr.coverage,
              "direct_method": fr.method, "direct_reason": fr.method_reason,
+             "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None,
              "coverage_reason": fr.coverage_reason}
     if clock is not None:
         stats["stages"] = clock.stages

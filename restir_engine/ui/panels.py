@@ -92,8 +92,11 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
             col.prop(s, "light_tiles")
             sub = col.column(align=True)
             sub.active = s.light_tiles != "OFF"
-            sub.prop(s, "light_tile_count")
-            sub.prop(s, "light_tile_size")
+            sub.prop(s, "light_sampler")
+            row = sub.column(align=True)
+            row.active = s.light_sampler == "POWER"  # spatial tiles: one per block, their own size
+            row.prop(s, "light_tile_count")
+            row.prop(s, "light_tile_size")
             if s.direct_method in ("RESTIR", "AUTO"):
                 col = layout.column(align=True, heading="Temporal Reuse")
                 col.prop(s, "temporal_reuse", text="")
@@ -104,6 +107,8 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
                 col = layout.column(align=True, heading="Spatial Reuse")
                 col.prop(s, "spatial_neighbors")
                 col.prop(s, "spatial_radius")
+                if s.spatial_radius == 0 and last and last.get("spatial_radius"):
+                    col.label(text=f"Auto radius in the last render: {last['spatial_radius']:.1f} px")
                 col.prop(s, "spatial_passes")
                 layout.prop(s, "bias_correction")
                 col = layout.column(align=True, heading="Boiling Filter")

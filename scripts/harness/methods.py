@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from restir_engine.core.restir.reuse import SpatialSettings
 
 
 @dataclass(frozen=True)
@@ -21,8 +20,7 @@ class Method:
     color: str = "C0"
 
 
-# The spatial radius is not set here: ``settings_for`` scales the 30 px default (meant for 640x360 and
-# up) with the image width, as on 64x48 to 320x180 images 30 px mostly lands outside the window.
+# The spatial radius is not set here: the engine's automatic radius scales with the resolution.
 METHODS = [
     Method("cycles", "Cycles (CPU, outside reference)", "CYCLES", {}, (1, 2, 4, 8, 16), (1, 2, 4, 8, 16, 32, 64, 128),
            "C7"),
@@ -62,10 +60,6 @@ def by_key(keys=None):
 
 
 def settings_for(method: Method, width: int) -> dict:
-    """The scene.restir settings of ``method`` for an image ``width`` pixels wide: ReSTIR's spatial radius
-    is the 30 px default at 640 px and above, scaled down with the width (at least 6 px) below."""
-    out = dict(method.settings)
-    if out.get("direct_method") == "RESTIR" and "spatial_radius" not in out:
-        default = SpatialSettings.radius
-        out["spatial_radius"] = float(max(6.0, min(default, default * width / 640)))
-    return out
+    """The scene.restir settings of ``method`` for an image ``width`` pixels wide (the spatial radius is the
+    engine's automatic one, scaled with the resolution, unless the method sets it)."""
+    return dict(method.settings)

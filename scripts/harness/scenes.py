@@ -1,7 +1,8 @@
 """Scene library, built by code with bpy (deterministic; no binary .blend in git).
 
 Each entry says what it stresses. ``ensure_blend(name, variant, size)`` builds the scene into the
-cache directory on demand (keyed by a hash of this file, so editing a builder rebuilds it).
+cache directory on demand (keyed by a hash of the builder's source and the helpers it calls, so editing a
+builder rebuilds that scene only).
 
   cornell      box + one emissive quad: simple, fast sanity scene; variant subdiv-K adds a
                20·4^K-triangle sphere (cost versus scene size)
@@ -13,6 +14,8 @@ cache directory on demand (keyed by a hash of this file, so editing a builder re
   animated     camera move + moving occluder + a light that switches off at frame 5 + an object sliding
                away to reveal a lit background (8 frames)
   default_cube Blender's factory startup scene (cube, point light, grey world): the first F12 a user tries
+  many_lights_pan  many_lights (variant = light count) with a slow camera pan over PAN_FRAMES frames: temporal
+               reuse under camera motion
 """
 from __future__ import annotations
 
@@ -258,6 +261,40 @@ def build_default_cube(variant="default", size="medium"):
     return scene
 
 
+PAN_FRAMES = 8
+
+
+def build_many_lights_pan(variant="10k", size="medium"):
+    """many_lights with the camera panning 1° and dollying 0.1 m per frame (frames 1..PAN_FRAMES)."""
+    scene = build_many_lights(variant, size)
+    scene.frame_start, scene.frame_end = 1, PAN_FRAMES
+    cam = scene.camera
+    cam.rotation_euler.z = math.radians(-3.5)
+    cam.keyframe_insert("rotation_euler", frame=1)
+    cam.keyframe_insert("location", frame=1)
+    cam.rotation_euler.z = math.radians(3.5)
+    cam.location.y += 0.7
+    cam.keyframe_insert("rotation_euler", frame=PAN_FRAMES)
+    cam.keyframe_insert("location", frame=PAN_FRAMES)
+    for fc in _fcurves(cam):
+        for k in fc.keyframe_points:
+            k.interpolation = "LINEAR"
+    return scene
+
+
+def _fcurves(obj):
+    """F-curves of an object's action (Blender 4.x: action.fcurves; 5.x: layered actions)."""
+    action = obj.animation_data.action
+    if hasattr(action, "fcurves") and len(action.fcurves):
+        return list(action.fcurves)
+    out = []
+    for layer in getattr(action, "layers", []):
+        for strip in layer.strips:
+            for bag in strip.channelbags:
+                out.extend(bag.fcurves)
+    return out
+
+
 ANIM_FRAMES = 8
 LIGHT_OFF_FRAME = 5
 
@@ -291,18 +328,34 @@ def build_animated(variant="default", size="small"):
 
 
 BUILDERS = {"cornell": build_cornell, "many_lights": build_many_lights, "glossy": build_glossy,
-            "interior_gi": build_interior_gi, "animated": build_animated, "default_cube": build_default_cube}
+            "interior_gi": build_interior_gi, "animated": build_animated, "default_cube": build_default_cube,
+            "many_lights_pan": build_many_lights_pan}
 
 
-def _source_hash() -> str:
-    with open(__file__, "rb") as f:
-        return hashlib.sha256(f.read() + bpy.app.version_string.encode()).hexdigest()[:12]
+def _source_hash(name: str) -> str:
+    """Hash of the source of scene ``name``'s builder and of every function of this module it calls (directly
+    or not), and of the Blender version: editing one builder (or adding one) rebuilds only what it changes, and
+    the Cycles references keyed by the file name stay valid for the others."""
+    import inspect
+    seen, todo, parts = set(), [BUILDERS[name]], []
+    while todo:
+        fn = todo.pop()
+        if fn.__name__ in seen:
+            continue
+        seen.add(fn.__name__)
+        parts.append(inspect.getsource(fn))
+        for ref in fn.__code__.co_names:
+            obj = globals().get(ref)
+            if inspect.isfunction(obj) and obj.__module__ == __name__:
+                todo.append(obj)
+    text = "".join(sorted(parts)) + bpy.app.version_string
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
 def ensure_blend(name: str, variant: str = "default", size="small") -> str:
     """Path of the cached .blend for (scene, variant, size), building it when missing or outdated."""
     size_key = size if isinstance(size, str) else f"{size[0]}x{size[1]}"
-    path = os.path.join(CACHE, "scenes", f"{name}-{variant}-{size_key}-{_source_hash()}.blend")
+    path = os.path.join(CACHE, "scenes", f"{name}-{variant}-{size_key}-{_source_hash(name)}.blend")
     if not os.path.exists(path):
         os.makedirs(os.path.dirname(path), exist_ok=True)
         BUILDERS[name](variant=variant, size=size)

@@ -2,8 +2,9 @@
 
 Initial resampling (streaming RIS, Talbot et al. 2005; Bitterli et al. 2020 §3-4) combines candidates of two
 strategies by the balance heuristic:
-  light candidates: ``light_candidates`` points from the power alias table over triangle lights (through
-                    light tiles when they pay), pdf p_l = p_select / A (area measure)
+  light candidates: ``light_candidates`` points from the power alias table over surface lights (through
+                    light tiles when they pay), pdf p_l = p_select / A (area measure); with the spatial light
+                    sampler from the pixel's block tile (light_blocks.py), p_l = q_block(light) / A
   BSDF candidates:  ``bsdf_candidates`` BSDF-sampled rays; a ray that reaches emitters yields the lamp it
                     crosses and the emissive surface it stops at (each generated with p_b), a ray that
                     reaches none is a null candidate (it still counts in M_b, never re-drawn)
@@ -130,9 +131,10 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     m_b = cfg.bsdf_candidates if lights.n_tri else 0
     stream = Stream(DIReservoirs, n, rng)
     res = stream.res
+    tiles = cfg.tiles if px is not None else None
+    block_tiles = m_l > 0 and hasattr(tiles, "pdf_area")  # light_blocks.BlockLightTiles: pdf per block
     if m_l and n:
-        w, p_hats, points, pick = _light_candidates(ctx, terms, rng, cfg.tiles if px is not None else None,
-                                                    m_l, m_b, px, py)
+        w, p_hats, points, pick = _light_candidates(ctx, terms, rng, tiles, m_l, m_b, px, py)
         # select candidate k with probability w_k / Σw: the number of prefix sums at or below u·Σw
         total = w.sum(axis=0)
         target = rng.random(n, dtype=np.float32) * total
@@ -176,8 +178,11 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
             if lp.has_spots:
                 pts = with_spots(pts, lp.spot_tri, lamps, here.p)
             p_hat, pb = here.evaluate(pts)
+            pl = pts.pdf
+            if block_tiles:  # the light candidates' pdf at this pixel's block
+                pl = tiles.pdf_area(lp.light, px[r], py[r])
             cand = DIReservoirs(light=lp.light, b1=lp.b1, b2=lp.b2, M=None, W=None, p_hat=None)
-            stream.add(p_hat / np.maximum(m_l * pts.pdf + m_b * pb, 1e-30), p_hat, cand, rows=r)
+            stream.add(p_hat / np.maximum(m_l * pl + m_b * pb, 1e-30), p_hat, cand, rows=r)
     return stream.finish(1.0), first_ray
 
 

@@ -131,12 +131,23 @@ class TemporalSettings:
 
 @dataclass
 class SpatialSettings:
-    """neighbors per pass, radius in pixels (of the full render width), passes, bias correction."""
+    """neighbors per pass, radius in pixels (0 = automatic, :func:`auto_radius`), passes, bias correction."""
 
     neighbors: int = 5
-    radius: float = 30.0
+    radius: float = 0.0
     passes: int = 1
     bias_correction: str = "UNBIASED"
+
+
+AUTO_RADIUS = 8.0          # pixels at 640 x 360 (measured: docs/RESULTS.md, "Spatial radius")
+AUTO_RADIUS_MIN = 4.0
+_REFERENCE_DIAGONAL = float(np.hypot(640, 360))
+
+
+def auto_radius(width: int, height: int) -> float:
+    """The automatic spatial radius (pixels) of a width x height render: AUTO_RADIUS at 640 x 360, scaled with
+    the image diagonal (the same surface area at any resolution), at least AUTO_RADIUS_MIN."""
+    return float(max(AUTO_RADIUS_MIN, AUTO_RADIUS * np.hypot(width, height) / _REFERENCE_DIAGONAL))
 
 
 def _indices(rows) -> np.ndarray:
