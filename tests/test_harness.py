@@ -42,3 +42,20 @@ def test_path_tracer_converges_to_cycles_reference(addon):
         mask[quadrant] = True
         b, s = metrics.rel_bias(img, ref, mask), metrics.bias_standard_error(img, ref, mask)
         assert abs(b) < Z_MAX * s, f"quadrant bias {b:+.4f}, standard error {s:.4f}"
+
+
+def test_pan_scene_moves_the_camera_and_default_cube_is_the_startup_file(addon):
+    """The harness scenes added for the many-lights pan and the default cube build, and are what they say."""
+    import bpy
+    from harness.scenes import PAN_FRAMES
+    bpy.ops.wm.open_mainfile(filepath=ensure_blend("many_lights_pan", "100", "tiny"))
+    scene = bpy.context.scene
+    scene.frame_set(1)
+    first = scene.camera.matrix_world.copy()
+    scene.frame_set(PAN_FRAMES)
+    assert (scene.camera.matrix_world.translation - first.translation).length > 0.5
+    assert abs(scene.camera.matrix_world.to_euler().z - first.to_euler().z) > 0.1
+    bpy.ops.wm.open_mainfile(filepath=ensure_blend("default_cube", "default", "tiny"))
+    names = {o.name for o in bpy.context.scene.objects}
+    assert {"Cube", "Light", "Camera"} <= names
+    assert bpy.data.objects["Light"].data.type == "POINT"
