@@ -42,7 +42,8 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
         description="Camera rays per pixel for the emission seen directly (lamps, emissive surfaces, the world): "
                     "the pixel is split into strata, the lighting is shaded at one ray and the emission averaged "
                     "over one ray per stratum, so small bright emitters and their edges converge faster",
-        items=[("AUTO", "Auto", "4 rays per pixel where the camera can see emitters, else 1", 0),
+        items=[("AUTO", "Auto", "4 rays per pixel where the camera can see emitters (16 where it sees 4096 or more "
+                "emissive triangles), else 1", 0),
                ("1", "1 Ray", "One camera ray per pixel and sample", 1),
                ("4", "4 Rays", "2 x 2 strata", 4),
                ("9", "9 Rays", "3 x 3 strata", 9),
