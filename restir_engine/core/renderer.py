@@ -1,9 +1,10 @@
 """Per-frame orchestration: a sample pass as named stages over the whole window, chunks on the thread pool.
 
 Stages of a sample pass (each timed by a profile.StageClock when one is given):
-  primary   camera rays, emission seen directly, the G-buffer (every integrator); with pixel coverage
-            (``coverage_samples`` > 1) the pixel is split into that many strata: the surface is shaded at one
-            ray in a random stratum, the emission seen directly (and alpha) is averaged over one ray per stratum
+  primary   camera rays (pass s of a pixel at Sobol point s, digitally shifted per pixel), emission seen directly, the
+            G-buffer (every integrator); with pixel coverage
+            (``coverage_samples`` > 1) the pixel is split into that many strata: the surface is shaded at the
+            pass's ray (in whichever stratum it falls), the emission seen directly (and alpha) is averaged over one ray per stratum
             (both are unbiased estimates of the box-filtered pixel)
   initial   ReSTIR/RIS: light tiles, target terms and initial resampling (light + BSDF candidates)
   paths     the first vertex's BSDF ray and bounces 1..max_bounces (pathtracer.continue_paths); it needs no
@@ -42,7 +43,7 @@ from .restir import di, reuse
 from .restir.gbuffer import GBuffer
 from .restir.history import TemporalHistory
 from .sampling import (STREAM_CAMERA, STREAM_INITIAL, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL,
-                       STREAM_TILES, finite, rng, uniform_ints)
+                       STREAM_PIXEL_OFFSET, STREAM_TILES, finite, pass_jitter, rng)
 from .scene import Scene
 from .target import WIDTH, ShadingTerms
 
@@ -315,17 +316,19 @@ class FrameRenderer:
 
         def primary(c: _Chunk):
             r = rng(st.seed, st.frame, s, STREAM_CAMERA, c.index)
-            j = r.random((len(c.pixels), 2), dtype=np.float32)
+            # the pass's position in the pixel: Sobol point s, shifted per pixel (the shift keyed without the pass)
+            shift = rng(st.seed, st.frame, 0, STREAM_PIXEL_OFFSET, c.index).bit_generator.random_raw(len(c.pixels))
+            j = pass_jitter(shift.view(np.uint32).reshape(-1, 2), s)
             px = (x0 + c.pixels % w).astype(np.float32)
             py = (y0 + c.pixels // w).astype(np.float32)
             if strata == 1:
                 c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
                 return
-            # the shaded ray in a random stratum (uniform over the pixel), one more ray in each other stratum
+            # the shaded ray where the pass puts it (uniform over the pixel, so uniform within the stratum it
+            # falls in), one more ray in each other stratum
             g = int(round(np.sqrt(strata)))
-            k0 = uniform_ints(r, strata, len(c.pixels))
-            c.hits = pathtracer.primary(ctx, px + ((k0 % g).astype(np.float32) + j[:, 0]) / g,
-                                        py + ((k0 // g).astype(np.float32) + j[:, 1]) / g)
+            c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
+            k0 = np.minimum((j[:, 0] * g).astype(np.int64), g - 1) + g * np.minimum((j[:, 1] * g).astype(np.int64), g - 1)
             k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
             jj = r.random((2,) + k.shape, dtype=np.float32)
             em, al = pathtracer.seen_emission(ctx, (px + ((k % g).astype(np.float32) + jj[0]) / g).ravel(),

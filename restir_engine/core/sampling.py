@@ -15,6 +15,36 @@ STREAM_SHADE = 3
 STREAM_TEMPORAL = 4
 STREAM_TILES = 5
 STREAM_INITIAL = 6
+STREAM_PIXEL_OFFSET = 7  # per-pixel rotation of the pass sequence (keyed without the pass)
+
+def _sobol_2d(s: int) -> tuple[int, int]:
+    """Point ``s`` of the first two Sobol dimensions as 32-bit integers: the van der Corput radical inverse in
+    base 2 and the dimension of primitive polynomial x + 1 (direction numbers v_i = v_(i-1) xor (v_(i-1) >> 1)):
+    every 2^k consecutive points from 0 form a (0, k, 2)-net, stratified in every elementary interval."""
+    x = y = 0
+    v = 1 << 31
+    i = 0
+    while s >> i:
+        if (s >> i) & 1:
+            x ^= 1 << (31 - i)
+            y ^= v
+        v ^= v >> 1
+        i += 1
+    return x, y
+
+
+def pass_jitter(shift: np.ndarray, s: int) -> np.ndarray:
+    """Positions in the pixel (n, 2) float32 for sample pass ``s``: Sobol point s, digitally shifted by a per-pixel
+    random ``shift`` (n, 2) uint32 (xor; Cranley-Patterson for base 2). Each pass is uniform over the pixel
+    (unbiased); the first 2^k passes of a pixel are stratified in every 2^-a x 2^-b box with a + b = k, so edges
+    and small emitters converge faster than with independent jitter."""
+    x, y = _sobol_2d(int(s))
+    out = np.empty(shift.shape, np.float32)
+    out[:, 0] = (shift[:, 0] ^ np.uint32(x)) >> np.uint32(8)  # 24 bits: exact in float32, < 1
+    out[:, 1] = (shift[:, 1] ^ np.uint32(y)) >> np.uint32(8)
+    out *= np.float32(1.0 / (1 << 24))
+    out += np.float32(0.5 / (1 << 24))  # the centre of the 24-bit cell: uniform in [0, 1), never 0 or 1
+    return out
 STREAM_SPATIAL = 16  # + spatial pass index
 
 
