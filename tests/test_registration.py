@@ -111,3 +111,44 @@ def test_panels_draw_every_setting(addon):
     for name in ("samples", "seed", "max_bounces", "light_candidates", "temporal_reuse", "confidence_cap",
                  "preroll_frames", "spatial_neighbors", "bias_correction", "use_pass_reservoir_m", "use_pass_vector"):
         assert name in seen, name
+
+
+def test_panels_draw_with_the_last_render_choices(addon):
+    """The Sampling and Passes panels draw (with a recording stand-in for the layout) for the defaults, including
+    the box that shows what Auto chose in the last render."""
+    from restir_engine import engine
+    from restir_engine.ui import panels
+
+    drawn = []
+
+    class Layout:
+        def __getattr__(self, name):
+            def call(*args, **kwargs):
+                drawn.append((name, args, kwargs.get("text")))
+                return Layout()
+            return call
+
+        def __setattr__(self, name, value):
+            pass
+
+    class Context:
+        scene = bpy.context.scene
+        view_layer = bpy.context.view_layer
+        engine = "RESTIR"
+
+    st = Context.scene.restir
+    st.integrator, st.direct_method, st.coverage_samples, st.spatial_radius = "RESTIR", "AUTO", "AUTO", 0.0
+    engine.LAST_CHOICES[Context.scene.name] = {"direct_method": "LIGHT_SAMPLING", "direct_reason": "1 point lamp",
+                                               "coverage_samples": 4, "coverage_reason": "emitters can be seen",
+                                               "spatial_radius": 8.0}
+    try:
+        for panel in (panels.RESTIR_PT_sampling, panels.RESTIR_PT_passes):
+            class Fake:
+                layout = Layout()
+                split_layout = panels.RestirPanel.split_layout
+            panel.draw(Fake(), Context())
+    finally:
+        engine.LAST_CHOICES.clear()
+    texts = [t for _n, _a, t in drawn if t]
+    assert "Last render: Light Sampling" in texts and "1 point lamp" in texts
+    assert any(t.startswith("Pixel coverage: 4 rays") for t in texts)
