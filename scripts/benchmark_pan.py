@@ -76,11 +76,20 @@ def main():
             "settings": st, "direct_method": seq[-1][4].get("direct_method"),
             "rel_mse": [rel_mse(s[0], r) for s, r in zip(seq, refs)],
             "rel_mse_surfaces": [rel_mse(s[1], r) for s, r in zip(seq, lits)],
-            "wall_s": [s[2] for s in seq], "core_s": [s[3] for s in seq]}
+            "wall_s": [s[2] for s in seq], "core_s": [s[3] for s in seq],
+            "temporal_accepted": [s[4].get("reuse", {}).get("temporal_accepted") for s in seq],
+            "temporal_mean_M": [s[4].get("reuse", {}).get("temporal_mean_M") for s in seq],
+            "final_M_p10_p50_p90": [s[4].get("reuse", {}).get("final_M_p10_p50_p90") for s in seq]}
         r = result["runs"][key]
         print(f"{key:<12} ({r['direct_method']}) relMSE per frame " + " ".join(f"{e:.3f}" for e in r["rel_mse"])
               + f" | surfaces " + " ".join(f"{e:.3f}" for e in r["rel_mse_surfaces"])
               + f" | wall {np.mean(r['wall_s'][1:]):.2f}s core {np.mean(r['core_s'][1:]):.2f}s", flush=True)
+        if key == "temporal":
+            print("  history accepted per frame " + " ".join(f"{a:.2f}" if a is not None else "-"
+                                                           for a in r["temporal_accepted"])
+                  + " | mean M after temporal " + " ".join(f"{m:.1f}" if m is not None else "-"
+                                                           for m in r["temporal_mean_M"])
+                  + f" | final M p10/p50/p90 (last frame) {r['final_M_p10_p50_p90'][-1]}", flush=True)
     for f in frames[-STEADY:]:
         ladder, ladder_lit = [], []
         render_blend_passes(blend, "CYCLES", 1, 0, seed=0, frame=f)  # warm-up

@@ -228,6 +228,7 @@ class FrameRenderer:
                     "res_m": _BUFFERS.zeros((h, w)), "res_w": _BUFFERS.zeros((h, w))}
         self.samples_done = 0
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
+        self.reuse_stats = {}  # the last pass's temporal acceptance and confidence (diagnostics)
         self.used_tiles = False
         self._data = None
         # temporal reuse runs through the first sample pass of each frame: pass 0 reuses the previous
@@ -448,6 +449,9 @@ class FrameRenderer:
                 del jobs
                 res = space.kind.gather(parts, len(gb))
                 del parts
+                # every fresh reservoir has M = 1 and a merged history adds at least 1: M > 1.5 = history accepted
+                self.reuse_stats["temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
+                self.reuse_stats["temporal_mean_M"] = float(res.M.mean()) if len(res.M) else 0.0
         if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode
             with clock.stage("boiling"):
                 self.boiling_dropped += int(boiling_filter(res, gb.pix, gb.width, gb.height,
@@ -463,6 +467,8 @@ class FrameRenderer:
                 del jobs
                 res = space.kind.gather(parts, len(gb))
                 del parts
+        if len(res.M):
+            self.reuse_stats["final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
         if s == 0:  # the next frame's history; confidence at most the cap, so no reused M ever exceeds it
             lights = ctx.lights
             self.history = TemporalHistory(gb, res.replace(M=np.minimum(res.M, st.confidence_cap)),
@@ -578,7 +584,7 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
              "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun, "boiling_dropped": fr.boiling_dropped,
              "context_reused": fr.context_reused, "coverage_samples": fr.coverage,
              "direct_method": fr.method, "direct_reason": fr.method_reason,
-             "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None,
+             "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None, "reuse": dict(fr.reuse_stats),
              "coverage_reason": fr.coverage_reason}
     if clock is not None:
         stats["stages"] = clock.stages
