@@ -16,11 +16,12 @@ correlated as with the plain light tiles). The BSDF candidates' MIS needs the sa
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .accel import in_worker, pool
 from .light_tiles import LightPoints, light_points
-from .sampling import uniform_triangle
 
 CLUSTERS = 1024
 BLOCK = 16  # pixels per side of a screen block
@@ -138,10 +139,7 @@ class BlockLightTiles:
         pos = np.searchsorted(cl.cum, lo + u[1] * (hi - lo), side="right") - 1
         pos = np.clip(pos, cl.start[c], cl.start[c + 1] - 1)
         light = cl.order[pos].astype(np.int32)
-        b1s, b2s = uniform_triangle(u[2].astype(np.float32), u[3].astype(np.float32))
-        if lights.any_sphere:
-            sph = np.flatnonzero(lights.sphere_r[light] > 0)
-            b1s[sph], b2s[sph] = u[2, sph].astype(np.float32), u[3, sph].astype(np.float32)
+        b1s, b2s = lights.area_coords(light, u[2].astype(np.float32), u[3].astype(np.float32))
         cols_ = slice(b0 * self.size, b1 * self.size)
         light_points(lights, light, b1s, b2s, out=self.rows[:, cols_])
         self.rows[9, cols_] = self._pdf(lights, cl, light, block_of + b0)
@@ -171,11 +169,9 @@ def _block_bounds(positions: np.ndarray, bx: int, by: int):
     pad = np.full((3, by * BLOCK, bx * BLOCK), np.nan, np.float64)
     pad[:, :h, :w] = positions
     blocks = pad.reshape(3, by, BLOCK, bx, BLOCK).transpose(0, 1, 3, 2, 4).reshape(3, by * bx, BLOCK * BLOCK)
-    with np.errstate(all="ignore"):
-        import warnings
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks
-            return np.nanmin(blocks, axis=2), np.nanmax(blocks, axis=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks (no hit) give NaN bounds
+        return np.nanmin(blocks, axis=2), np.nanmax(blocks, axis=2)
 
 
 def _morton3(x, y, z) -> np.ndarray:

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .sampling import uniform_triangle
 
 TILE_MODES = ("AUTO", "ON", "OFF")
 BLOCK = 16              # pixels per side of a screen block sharing one tile
@@ -104,10 +103,7 @@ def sample_points(lights, u: np.ndarray) -> LightPoints:
     """Points from the surface-light power table (``u``: (n, 4) uniforms), uniform in area on each light
     (triangles: barycentrics; spheres: sphere coordinates, uniform in area for uniform (b1, b2))."""
     light = lights.tri_alias.sample(u[:, 0], u[:, 1]).astype(np.int32)
-    b1, b2 = uniform_triangle(u[:, 2], u[:, 3])
-    if lights.any_sphere:
-        sph = np.flatnonzero(lights.sphere_r[light] > 0)
-        b1[sph], b2[sph] = u[sph, 2], u[sph, 3]
+    b1, b2 = lights.area_coords(light, u[:, 2], u[:, 3])
     return light_points(lights, light, b1, b2)
 
 

@@ -18,6 +18,8 @@ import numpy as np
 
 from .bsdf import luminance
 from .sampling import AliasTable, barycentric, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
+from .scene import Lamps, MaterialTable, Scene, TriangleSet
+from .textures import apply_texture, mean_color
 
 EMPTY = np.zeros(0, np.int64)
 
@@ -52,8 +54,7 @@ def one_minus_cos_cone(r2_over_d2: np.ndarray) -> np.ndarray:
     """1 - cos θ_max of the cone a sphere subtends, from (r/d)² < 1, without cancellation (float64)."""
     x = np.asarray(r2_over_d2, np.float64)
     return x / (1.0 + np.sqrt(np.maximum(0.0, 1.0 - x)))
-from .scene import Lamps, MaterialTable, Scene, TriangleSet
-from .textures import apply_texture, mean_color
+
 
 def triangle_geometry(verts: np.ndarray):
     """Unit geometric normals (winding order) (n, 3) and areas (n,) of (n, 3, 3) triangles."""
@@ -209,13 +210,26 @@ class LightTable:
         """Positions in ``light`` of sphere lights."""
         return np.flatnonzero(self.sphere_r[light] > 0) if self.any_sphere else EMPTY
 
+    def _from_points(self, light, p):
+        """Spheres ``light`` seen from points p (3, k), in float64: the vector to the centre (3, k), its length
+        (k,) and the radius (k,)."""
+        pc = np.take(self.rows_v0, light, axis=1).astype(np.float64) - p.astype(np.float64)
+        return pc, np.sqrt(np.einsum("ij,ij->j", pc, pc)), self.sphere_r[light].astype(np.float64)
+
+    def area_coords(self, light: np.ndarray, u2: np.ndarray, u3: np.ndarray):
+        """Point coordinates (b1, b2) uniform in area on surface lights ``light`` from uniforms u2, u3:
+        barycentrics on triangles, the uniforms themselves on spheres (sphere coordinates)."""
+        b1, b2 = uniform_triangle(u2, u3)
+        sph = self._spheres(light)
+        if sph.size:
+            b1[sph], b2[sph] = u2[sph], u3[sph]
+        return b1, b2
+
     def _cone_pdf(self, light, receiver, dist, cos_light):
         """Cone-sampling pdf (solid angle) of spheres ``light`` from receivers (3, k); receivers inside a sphere
         sample it by area."""
-        c = np.take(self.rows_v0, light, axis=1).astype(np.float64) - receiver
-        d2 = np.einsum("ij,ij->j", c, c)
-        r = self.sphere_r[light].astype(np.float64)
-        x = r * r / np.maximum(d2, 1e-300)
+        _pc, dc, r = self._from_points(light, receiver)
+        x = r * r / np.maximum(dc * dc, 1e-300)
         inside = x >= 1.0
         cone = self.sel_pdf[light] / (2.0 * np.pi * np.where(inside, 1.0, one_minus_cos_cone(x)))
         area = self.sel_pdf_area[light] * dist * dist / np.maximum(np.abs(cos_light), 1e-8)
@@ -225,9 +239,8 @@ class LightTable:
         """Rays o + t d ((3, k) rows, unit d) against spheres ``light``: distance t (k,) of the first crossing
         in (0, tmax) (inf = none), sphere coordinates (b1, b2) of that point and cos θ there (between -d and the
         outward normal)."""
-        c = np.take(self.rows_v0, light, axis=1).astype(np.float64)
-        oc = o.astype(np.float64) - c
-        r = self.sphere_r[light].astype(np.float64)
+        pc, _dc, r = self._from_points(light, o)
+        oc = -pc
         dd = d.astype(np.float64)
         b = np.einsum("ij,ij->j", oc, dd)
         # discriminant from the closest approach (accurate for small far spheres): r² - |oc - b d|²
@@ -355,10 +368,7 @@ class LightTable:
     def _cone_sample(self, light, p, u2, u3):
         """Sphere coordinates (b1, b2) of the points where directions drawn uniformly in the cone subtended by
         spheres ``light`` from p (3, k) first meet them (uniform area points for p inside a sphere)."""
-        c = np.take(self.rows_v0, light, axis=1).astype(np.float64)
-        pc = c - p.astype(np.float64)
-        dc = np.sqrt(np.einsum("ij,ij->j", pc, pc))
-        r = self.sphere_r[light].astype(np.float64)
+        pc, dc, r = self._from_points(light, p)
         x = r * r / np.maximum(dc * dc, 1e-300)
         inside = x >= 1.0
         one_minus = u2.astype(np.float64) * one_minus_cos_cone(np.where(inside, 0.0, x))

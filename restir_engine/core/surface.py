@@ -8,7 +8,6 @@ from __future__ import annotations
 import numpy as np
 
 from .bsdf import SurfaceParams, ViewTerms, ggx_albedo_at
-from .lights import emitted_radiance
 from .sampling import barycentric, cols, dot, norm, orthonormal_basis
 from .textures import apply_texture
 
@@ -79,10 +78,6 @@ class Surface:
         if v is None:
             v = self._view = ViewTerms.of(self.params, self.wo_l, self.albedo)
         return v
-
-    def emission(self, ctx) -> np.ndarray:
-        """Emitted radiance (3, n) towards the incoming ray (mesh emission is two-sided by default)."""
-        return emitted_radiance(ctx.scene.geometry, ctx.scene.materials, self.prim, self.b1, self.b2)
 
     def take(self, idx) -> "Surface":
         """The surfaces ``idx`` (an index array or a slice) as a new Surface."""
