@@ -22,7 +22,7 @@ sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
-from harness.metrics import rel_bias, rel_mse  # noqa: E402
+from harness.metrics import interpolate_loglog, rel_bias, rel_mse  # noqa: E402
 from harness.reference import reference_image  # noqa: E402
 from harness.render import render_blend_passes  # noqa: E402
 from harness.scenes import ensure_blend  # noqa: E402
@@ -67,11 +67,8 @@ def main():
     for key, pts in out["ladders"].items():
         if key == "cycles":
             continue
-        ratios = []
-        for p in pts:
-            t = np.log([c["seconds"] for c in cyc])
-            e = np.log([c["rel_mse"] for c in cyc])
-            ratios.append(float(np.exp(np.interp(np.log(p["seconds"]), t, e))) / p["rel_mse"])
+        ratios = [interpolate_loglog([c["seconds"] for c in cyc], [c["rel_mse"] for c in cyc], p["seconds"])
+                  / p["rel_mse"] for p in pts]
         out.setdefault("cycles_over_ours", {})[key] = ratios
         print(f"{key}: Cycles relMSE / ours at equal time " + " ".join(f"{r:.2f}" for r in ratios), flush=True)
     os.makedirs(args.out, exist_ok=True)

@@ -33,6 +33,8 @@ import restir_engine  # noqa: E402
 from harness.metrics import rel_mse  # noqa: E402
 from harness.reference import reference_image, reference_lit  # noqa: E402
 from harness.scenes import ensure_blend  # noqa: E402
+from restir_engine.core import pathtracer  # noqa: E402
+from restir_engine.core.context_cache import context_for  # noqa: E402
 from restir_engine.core.direct_choice import choose_direct_method  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
@@ -85,8 +87,6 @@ def main():
         bpy.ops.wm.open_mainfile(filepath=path)
         scene = export_scene(bpy.context.evaluated_depsgraph_get())
         render_frame(scene, RenderSettings(samples=1, integrator="RESTIR", data_passes=False))  # warm-up
-        from restir_engine.core.context_cache import context_for
-        from restir_engine.core import pathtracer
         lights = context_for(scene, 0, False, pathtracer.build_context)[0].lights
         for bounces in args.bounces:
             for label, frames in (("still", 1), ("animation", 4)):

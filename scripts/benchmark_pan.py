@@ -6,7 +6,7 @@ at equal time, direct light only.
 
 Every frame is rendered through the engine (bpy.ops.render.render: export, motion vectors, history), scored
 against a cached Cycles reference of that frame (--reference-spp). Cycles renders the steady frames (the last
-three) at a ladder of sample counts; its relMSE at our time per frame is interpolated on that ladder (log-log).
+three) at a ladder of sample counts; its relMSE at our time per frame is interpolated on that ladder (log-log, clamped to its range).
 The ratio Cycles relMSE / ours at equal time is what the ReSTIR DI issue targets (>= 2).
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
-from harness.metrics import rel_mse  # noqa: E402
+from harness.metrics import interpolate_loglog, rel_mse  # noqa: E402
 from harness.reference import reference_image, reference_lit  # noqa: E402
 from harness.render import render_blend_passes  # noqa: E402
 from harness.scenes import PAN_FRAMES, ensure_blend  # noqa: E402
@@ -46,12 +46,8 @@ def render_sequence(blend, settings, seed):
 
 
 def equal_time(ladder, seconds):
-    """relMSE of a (seconds, relMSE) ladder at ``seconds``, interpolated log-log (extrapolated at the ends)."""
-    t = np.log([p[0] for p in ladder])
-    e = np.log([p[1] for p in ladder])
-    k = np.clip(np.searchsorted(t, np.log(seconds)), 1, len(t) - 1)
-    a = (np.log(seconds) - t[k - 1]) / (t[k] - t[k - 1])
-    return float(np.exp(e[k - 1] + a * (e[k] - e[k - 1])))
+    """relMSE of a [(seconds, relMSE)] ladder at ``seconds`` (metrics.interpolate_loglog, clamped to its range)."""
+    return interpolate_loglog([p[0] for p in ladder], [p[1] for p in ladder], seconds)
 
 
 def main():
@@ -82,7 +78,7 @@ def main():
             "final_M_p10_p50_p90": [s[4].get("reuse", {}).get("final_M_p10_p50_p90") for s in seq]}
         r = result["runs"][key]
         print(f"{key:<12} ({r['direct_method']}) relMSE per frame " + " ".join(f"{e:.3f}" for e in r["rel_mse"])
-              + f" | surfaces " + " ".join(f"{e:.3f}" for e in r["rel_mse_surfaces"])
+              + " | surfaces " + " ".join(f"{e:.3f}" for e in r["rel_mse_surfaces"])
               + f" | wall {np.mean(r['wall_s'][1:]):.2f}s core {np.mean(r['core_s'][1:]):.2f}s", flush=True)
         if key == "temporal":
             print("  history accepted per frame " + " ".join(f"{a:.2f}" if a is not None else "-"
