@@ -130,6 +130,7 @@ class LightTiles:
     def __init__(self, lights, cfg: TileSettings, width: int, height: int, rng: np.random.Generator):
         self.count, self.size = max(1, cfg.count), max(1, cfg.size)
         self.points = sample_points(lights, rng.random((self.count * self.size, 4), dtype=np.float32))
+        self.lights = lights
         self.rows = self.points.packed()
         self.blocks_x = (width + BLOCK - 1) // BLOCK
         blocks = self.blocks_x * ((height + BLOCK - 1) // BLOCK)
@@ -139,3 +140,8 @@ class LightTiles:
         """First point index of the tile serving window pixels (px, py) (integers, window coordinates)."""
         block = (py // BLOCK) * self.blocks_x + px // BLOCK
         return self.tile_of_block[block] * self.size
+
+    def pdf_area(self, light: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
+        """Area-measure pdf (n,) with which a light candidate of pixel (px, py) is the point on ``light``: the
+        power table's, whatever the pixel."""
+        return self.lights.tri_pdf_area[light]

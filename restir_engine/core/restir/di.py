@@ -132,7 +132,6 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     stream = Stream(DIReservoirs, n, rng)
     res = stream.res
     tiles = cfg.tiles if px is not None else None
-    block_tiles = m_l > 0 and hasattr(tiles, "pdf_area")  # light_blocks.BlockLightTiles: pdf per block
     if m_l and n:
         w, p_hats, points, pick = _light_candidates(ctx, terms, rng, tiles, m_l, m_b, px, py)
         # select candidate k with probability w_k / Σw: the number of prefix sums at or below u·Σw
@@ -178,9 +177,8 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
             if lp.has_spots:
                 pts = with_spots(pts, lp.spot_tri, lamps, here.p)
             p_hat, pb = here.evaluate(pts)
-            pl = pts.pdf
-            if block_tiles:  # the light candidates' pdf at this pixel's block
-                pl = tiles.pdf_area(lp.light, px[r], py[r])
+            # the light candidates' pdf of this point at this pixel (tiles: per block, or the power table's)
+            pl = pts.pdf if tiles is None else tiles.pdf_area(lp.light, px[r], py[r])
             cand = DIReservoirs(light=lp.light, b1=lp.b1, b2=lp.b2, M=None, W=None, p_hat=None)
             stream.add(p_hat / np.maximum(m_l * pl + m_b * pb, 1e-30), p_hat, cand, rows=r)
     return stream.finish(1.0), first_ray
