@@ -218,12 +218,32 @@ def needs_continuation(ctx: TraceContext, direct_resampled: bool) -> bool:
     return ctx.max_bounces > 0 or not direct_resampled or bool(np.any(ctx.scene.world_radiance > 0))
 
 
+@dataclass
+class FirstBounce:
+    """Where the first BSDF rays of primary surfaces (n) went, for ReSTIR GI: ``rows`` (k,) the surfaces whose
+    ray hit geometry at x2; ``throughput`` (3, k) f·|cos θ|/p of that ray (p: ``pdf`` (k,), solid angle);
+    x2 ``p`` (3, k), its geometric normal ``n2`` (3, k) turned toward the primary surface, its BSDF parameters
+    ``params`` (bsdf.SurfaceParams, k) and ``lo`` (3, k) the radiance leaving x2 toward the primary surface
+    estimated by the rest of the path (next-event estimation at x2 and bounces 2..max_bounces; not x2's own
+    emission, which is the primary surface's direct light). The path tracer's indirect light is
+    throughput · lo."""
+
+    rows: np.ndarray
+    throughput: np.ndarray
+    pdf: np.ndarray
+    p: np.ndarray
+    n2: np.ndarray
+    params: SurfaceParams
+    lo: np.ndarray
+
+
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
-                   first_ray=None):
+                   first_ray=None, first_bounce: bool = False):
     """Continue paths from primary surfaces s (n). Returns (direct (3, n): the first BSDF ray's emitter hits
     (MIS-weighted; none when ``direct_resampled``) and the world it escapes to; indirect (3, n): bounces
     1..max_bounces). ``first_ray`` (a traced :class:`BsdfRay` from s, e.g. ReSTIR's BSDF candidate) is used as
-    the first ray instead of drawing a new one."""
+    the first ray instead of drawing a new one. With ``first_bounce`` a third value, :class:`FirstBounce`, tells
+    where the first rays went and what radiance left there (indirect is then its throughput · lo)."""
     n = len(s)
     direct = np.zeros((3, n), np.float32)
     indirect = np.zeros((3, n), np.float32)
@@ -231,8 +251,9 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     throughput = np.ones((3, n), np.float32)
     lamps = ctx.scene.lamps
     world = ctx.scene.world_radiance.astype(np.float32)[:, None]
+    first = None
     for bounce in range(ctx.max_bounces + 1):
-        target = direct if bounce == 0 else indirect
+        target = direct if bounce == 0 else (indirect if first is None else first.lo)
         if bounce > 0:
             target[:, idx] += next_event(ctx, s, rng, throughput)
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -------
@@ -285,7 +306,22 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             break
         idx, throughput = idx[hsel], cols(throughput, hsel)
         s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], cols(o, hsel), cols(d, hsel), hits.t[hsel])
-    return direct, indirect
+        if bounce == 0 and first_bounce:
+            # from here on the path estimates the radiance leaving x2: throughput 1, accumulated per first hit
+            first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.ng, s.params,
+                                np.zeros((3, len(idx)), np.float32))
+            idx = np.arange(len(idx))
+            throughput = np.ones((3, len(idx)), np.float32)
+    if not first_bounce:
+        return direct, indirect
+    if first is None:
+        first = FirstBounce(np.zeros(0, np.int64), np.zeros((3, 0), np.float32), np.zeros(0, np.float32),
+                            np.zeros((3, 0), np.float32), np.zeros((3, 0), np.float32),
+                            ctx.material_params.take(np.zeros(0, np.intp)), np.zeros((3, 0), np.float32))
+    else:
+        first.lo = finite(first.lo)
+        indirect[:, first.rows] = first.throughput * first.lo
+    return direct, indirect, first
 
 
 def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):

@@ -39,11 +39,13 @@ from .direct_choice import choose_direct_method
 from .light_blocks import BlockLightTiles
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
 from .profile import NullClock
-from .restir import di, reuse
+from .context_cache import fingerprint
+from .restir import di, gi, reuse
 from .restir.gbuffer import GBuffer
 from .restir.history import TemporalHistory
-from .sampling import (STREAM_CAMERA, STREAM_INITIAL, STREAM_PATH, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL,
-                       STREAM_PIXEL_OFFSET, STREAM_TILES, finite, pass_jitter, rng)
+from .sampling import (STREAM_CAMERA, STREAM_GI_SPATIAL, STREAM_GI_TEMPORAL, STREAM_INITIAL, STREAM_PATH,
+                       STREAM_PIXEL_OFFSET, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, STREAM_TILES, finite,
+                       pass_jitter, rng)
 from .scene import Scene
 from .target import WIDTH, ShadingTerms
 
@@ -86,6 +88,13 @@ class RenderSettings:
     data_passes: bool = True  # Depth, Normal and Vector (one more ray per pixel and frame); off when not written
     tile_pixels: int = CHUNK_PIXELS  # pixels per chunk of work (smaller: finer progress and cancellation)
     coverage_samples: int = 0  # camera rays per pixel for the emission seen directly: 1, 4, 9, 16 ...; 0 = automatic
+    indirect_method: str = "PATH"  # with integrator RESTIR: "OFF" (no bounces), "PATH" or "RESTIR_GI" (restir/gi.py)
+    gi_spatial_neighbors: int = gi.GISettings.neighbors
+    gi_spatial_radius: float = gi.GISettings.radius  # pixels; 0 = automatic (GI_RADIUS_FACTOR x reuse.auto_radius)
+    gi_spatial_passes: int = gi.GISettings.passes
+    gi_confidence_cap: float = gi.GISettings.confidence_cap
+    gi_max_age: int = gi.GISettings.max_age  # frames a GI sample may be reused for
+    gi_roughness_threshold: float = gi.GISettings.roughness_threshold
 
 
 def coverage_samples(setting: int, lights, lamps) -> tuple[int, str]:
@@ -106,6 +115,7 @@ def coverage_samples(setting: int, lights, lamps) -> tuple[int, str]:
 
 
 AUTO_COVERAGE = 4
+GI_RADIUS_FACTOR = 2.0  # the automatic GI spatial radius against DI's (indirect light varies more slowly)
 MANY_COVERAGE = 16
 MANY_EMITTERS = 4096
 
@@ -166,6 +176,8 @@ class _Chunk:
     bsdf_ray: object = None
     direct: np.ndarray = None
     indirect: np.ndarray = None
+    gi_res: object = None  # gi.GIReservoirs of its surfaces
+    glossy: np.ndarray = None  # (surfaces,) bool: GI resamples only the diffuse lobe there (gi.glossy_x1)
 
     @property
     def surfaces(self) -> slice:
@@ -190,13 +202,19 @@ class FrameRenderer:
         self.method_reason = "path tracer"
         if settings.integrator == "RESTIR" and settings.direct_method not in di.DIRECT_METHODS:
             raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {di.DIRECT_METHODS}")
-        self.ctx, self.context_reused = context_for(scene, settings.max_bounces, settings.film_transparent,
+        if settings.integrator == "RESTIR" and settings.indirect_method not in gi.INDIRECT_METHODS:
+            raise ValueError(f"unknown indirect method {settings.indirect_method!r}; available: {gi.INDIRECT_METHODS}")
+        bounces = settings.max_bounces
+        if settings.integrator == "RESTIR" and settings.indirect_method == "OFF":
+            bounces = 0
+        self.ctx, self.context_reused = context_for(scene, bounces, settings.film_transparent,
                                                     pathtracer.build_context)
+        self.gi = None  # gi.GISettings when the indirect light is resampled
         if settings.integrator == "RESTIR":
             self.method, self.method_reason = settings.direct_method, "set by the user"
             if self.method == "AUTO":
                 self.method, self.method_reason = choose_direct_method(self.ctx.lights, settings.reservoir_passes,
-                                                                        settings.max_bounces)
+                                                                        bounces)
             tiles = TileSettings(settings.light_tiles, settings.light_tile_count, settings.light_tile_size)
             if tiles.mode not in TILE_MODES:
                 raise ValueError(f"unknown light tile mode {tiles.mode!r}; available: {TILE_MODES}")
@@ -210,6 +228,21 @@ class FrameRenderer:
                 reuse.auto_radius(cam.width, cam.height)
             self.spatial = reuse.SpatialSettings(max(0, settings.spatial_neighbors), max(1.0, radius),
                                                  max(0, settings.spatial_passes), settings.bias_correction)
+            if settings.indirect_method == "RESTIR_GI" and bounces > 0:
+                gi_radius = float(settings.gi_spatial_radius) if settings.gi_spatial_radius > 0 else \
+                    GI_RADIUS_FACTOR * reuse.auto_radius(cam.width, cam.height)
+                self.gi = gi.GISettings(max(0, int(settings.gi_spatial_neighbors)), max(1.0, gi_radius),
+                                        max(0, int(settings.gi_spatial_passes)), float(settings.gi_confidence_cap),
+                                        max(0, int(settings.gi_max_age)), float(settings.gi_roughness_threshold))
+                self.gi_spatial = reuse.SpatialSettings(self.gi.neighbors, self.gi.radius, self.gi.passes,
+                                                        settings.bias_correction)
+                unbiased = settings.bias_correction == "UNBIASED"
+                self.gi_space = gi.GISpace(self.ctx.geom_accel if unbiased else None)
+                lights, lamps = self.ctx.lights, self.ctx.scene.lamps
+                # any change of what emits light (a lamp moved, switched, re-coloured) drops the GI history:
+                # its cached radiance would be stale
+                self.gi_light_key = fingerprint(lights.tri_verts, lights.rows_le, lights.power, lamps.sun_dir,
+                                                lamps.sun_irradiance, self.ctx.scene.world_radiance)
         self.space = di.LightSpace(self.ctx.lights)
         self.coverage, self.coverage_reason = coverage_samples(settings.coverage_samples, self.ctx.lights,
                                                                self.ctx.scene.lamps)
@@ -217,6 +250,9 @@ class FrameRenderer:
         self.set_camera(scene.camera)
         if history is not None and history.fits(scene.camera):
             self.prev_history = history.remapped(self.ctx.lights)  # from the previous frame (None: lights cannot map)
+            if self.prev_history is not None and self.prev_history.gi_res is not None and \
+                    (self.gi is None or self.prev_history.gi_key != self.gi_light_key):
+                self.prev_history = dataclasses.replace(self.prev_history, gi_res=None, gi_terms=None)
 
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
@@ -226,6 +262,8 @@ class FrameRenderer:
         self.acc = {"emit": _BUFFERS.zeros((h, w, 3)), "direct": _BUFFERS.zeros((h, w, 3)),
                     "indirect": _BUFFERS.zeros((h, w, 3)), "alpha": _BUFFERS.zeros((h, w)),
                     "res_m": _BUFFERS.zeros((h, w)), "res_w": _BUFFERS.zeros((h, w))}
+        if self.gi is not None:
+            self.acc["gi_m"], self.acc["gi_w"] = _BUFFERS.zeros((h, w)), _BUFFERS.zeros((h, w))
         self.samples_done = 0
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
         self.reuse_stats = {}  # the last pass's temporal acceptance and confidence (diagnostics)
@@ -308,8 +346,10 @@ class FrameRenderer:
         chunks = [_Chunk(i, np.arange(sl.start, sl.stop)) for i, sl in enumerate(self._spans(npix))]
         resampled = self.candidates is not None
         reusing = self.method == "RESTIR"
+        gi_on = self.gi is not None
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
-        chunk_stages = 4 + int(resampled) + (int(self.spatial.passes) + 1 if reusing else 0)
+        chunk_stages = 4 + int(resampled) + (int(self.spatial.passes) + 1 if reusing else 0) + \
+            (int(self.gi.passes) + 1 if gi_on else 0)
         stop = _Progress(progress, should_stop, len(chunks) * chunk_stages)
         ctx = self.ctx
 
@@ -360,6 +400,8 @@ class FrameRenderer:
         continuing = pathtracer.needs_continuation(ctx, resampled)
         # the frame's target terms, one (27, surfaces) block the chunks write into (reuse gathers from it)
         terms = np.empty((WIDTH, first), np.float32) if resampled else None
+        # ReSTIR GI's target terms: the same, with the specular lobe off at glossy primary surfaces
+        gi_terms = np.empty((WIDTH, first), np.float32) if gi_on else None
 
         def initial(c: _Chunk):
             surf = c.hits.surf
@@ -373,20 +415,35 @@ class FrameRenderer:
                 self._map(initial, chunks, stop)
 
         def paths(c: _Chunk):
-            """Before reuse: the continuation needs no reservoir, and its first ray is freed early."""
+            """Before reuse: the continuation needs no reservoir, and its first ray is freed early. With ReSTIR GI
+            the first bounces become the initial GI reservoirs."""
             if not continuing:
                 c.direct, c.indirect = None, None
                 return
-            c.direct, c.indirect = pathtracer.continue_paths(
+            out = pathtracer.continue_paths(
                 ctx, c.hits.surf, rng(st.seed, st.frame, s, STREAM_PATH, c.index), direct_resampled=resampled,
-                first_ray=c.bsdf_ray)
+                first_ray=c.bsdf_ray, first_bounce=gi_on)
             c.bsdf_ray = None
+            c.direct, c.indirect = out[0], out[1]
+            if gi_on:
+                surf = c.hits.surf
+                block = gi_terms[:, c.surfaces]
+                if resampled:
+                    block[:] = terms[:, c.surfaces]
+                else:
+                    ShadingTerms.of_surfaces(surf, block)
+                c.glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
+                t = gi.diffuse_only(ShadingTerms(block), c.glossy)
+                c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi.roughness_threshold)
 
         with clock.stage("paths"):
             self._map(paths, chunks, stop)
+        gb = res = gi_res = gb_gi = None
+        if reusing or gi_on:
+            with clock.stage("gbuffer"):
+                gb = self._gbuffer(chunks, terms if reusing else gi_terms)
         if reusing:
             with clock.stage("gbuffer"):
-                gb = self._gbuffer(chunks, terms)
                 res = di.DIReservoirs.empty(len(gb))
                 for c in chunks:
                     res.assign(c.surfaces, c.res)
@@ -394,11 +451,31 @@ class FrameRenderer:
             res = self._reuse(gb, res, s, stop)
             for c in chunks:
                 c.res = res.take(c.surfaces)
+        if gi_on:
+            with clock.stage("gbuffer"):
+                gb_gi = gb.with_terms(ShadingTerms(gi_terms))
+                gi_res = gi.GIReservoirs.empty(len(gb))
+                for c in chunks:
+                    gi_res.assign(c.surfaces, c.gi_res)
+                    c.gi_res = None
+            gi_res = self._reuse_gi(gb_gi, gi_res, s, stop)
+            for c in chunks:
+                c.gi_res = gi_res.take(c.surfaces)
+        if s == 0 and gb is not None:  # the next frame's history; confidence at most the cap, so no reused M exceeds it
+            lights = ctx.lights
+            self.history = TemporalHistory(
+                gb, None if res is None else res.replace(M=np.minimum(res.M, st.confidence_cap)), ctx.scene.camera,
+                lights.signature, st.frame, lights.light_uid, lights.uid_space,
+                gi_res=None if gi_res is None else gi.age_history(gi_res.replace(
+                    M=np.minimum(gi_res.M, np.float32(self.gi.confidence_cap))), self.gi.max_age),
+                gi_terms=None if gb_gi is None else gb_gi.terms, gi_key=self.gi_light_key if gi_on else None)
 
         def shade(c: _Chunk):
             r = rng(st.seed, st.frame, s, STREAM_SHADE, c.index)
             direct = di.shade(ctx, c.hits.surf, c.res, r) if resampled else pathtracer.next_event(ctx, c.hits.surf, r)
             c.direct = direct if c.direct is None else c.direct + direct
+            if gi_on:
+                c.indirect = c.indirect + gi.shade(ctx.geom_accel, c.hits.surf, c.gi_res, c.glossy)
 
         with clock.stage("shade"):
             self._map(shade, chunks, stop)
@@ -429,52 +506,70 @@ class FrameRenderer:
         frame's history. Returns the frame's final reservoirs (raises _Stopped when asked to stop)."""
         st = self.settings
         clock = self.clock
-        spans = self._spans(len(gb))
         space = self.space
         ctx = self.ctx
-        if st.temporal_reuse and s == 0 and self.prev_history is not None:
-            with clock.stage("temporal"):
-                hist = self.prev_history
-                # object motion is known for the previous frame only; a history from another frame gets none
-                motion = ctx.scene.motion if hist.frame == st.frame - 1 else None
-                prepared = space.prepare(hist.res)
-                now = space.prepare(res) if st.bias_correction == "UNBIASED" else None
-                had = hist.had_light
-                possible = None if had is None else (lambda rows: had[np.maximum(res.light[rows], 0)])
-                jobs = [(rows, (space, gb, res, now, hist, prepared, rows, st.confidence_cap, st.bias_correction,
-                                motion, rng(st.seed, st.frame, s, STREAM_TEMPORAL, i), possible))
-                        for i, rows in enumerate(spans)]
-                del prepared, now  # released with the jobs once merged
-                parts = self._map(_run_job(reuse.temporal_reuse), jobs, stop)
-                del jobs
-                res = space.kind.gather(parts, len(gb))
-                del parts
-                # every fresh reservoir has M = 1 and a merged history adds at least 1: M > 1.5 = history accepted
-                self.reuse_stats["temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
-                self.reuse_stats["temporal_mean_M"] = float(res.M.mean()) if len(res.M) else 0.0
+        if st.temporal_reuse and s == 0 and self.prev_history is not None and self.prev_history.res is not None:
+            hist = self.prev_history
+            # object motion is known for the previous frame only; a history from another frame gets none
+            motion = ctx.scene.motion if hist.frame == st.frame - 1 else None
+            had = hist.had_light
+            possible = None if had is None else (lambda rows, res=res: had[np.maximum(res.light[rows], 0)])
+            res = self._temporal(space, gb, res, hist, motion, st.confidence_cap, STREAM_TEMPORAL, possible, s, stop,
+                                 "temporal")
+            # every fresh reservoir has M = 1 and a merged history adds at least 1: M > 1.5 = history accepted
+            self.reuse_stats["temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
+            self.reuse_stats["temporal_mean_M"] = float(res.M.mean()) if len(res.M) else 0.0
         if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode
             with clock.stage("boiling"):
                 self.boiling_dropped += int(boiling_filter(res, gb.pix, gb.width, gb.height,
                                                            st.boiling_threshold).sum())
         for k in range(self.spatial.passes if self.spatial.neighbors else 0):
-            with clock.stage("spatial"):
-                prepared = space.prepare(res)
-                jobs = [(rows, (space, gb, res, prepared, rows, self.spatial,
-                                rng(st.seed, st.frame, s, STREAM_SPATIAL + k, i)))
-                        for i, rows in enumerate(spans)]
-                del prepared  # released with the jobs once merged
-                parts = self._map(_run_job(reuse.spatial_reuse), jobs, stop)
-                del jobs
-                res = space.kind.gather(parts, len(gb))
-                del parts
+            res = self._spatial(space, gb, res, self.spatial, STREAM_SPATIAL + k, s, stop, "spatial")
         if len(res.M):
             self.reuse_stats["final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
-        if s == 0:  # the next frame's history; confidence at most the cap, so no reused M ever exceeds it
-            lights = ctx.lights
-            self.history = TemporalHistory(gb, res.replace(M=np.minimum(res.M, st.confidence_cap)),
-                                           ctx.scene.camera, lights.signature, st.frame, lights.light_uid,
-                                           lights.uid_space)
         return res
+
+    def _reuse_gi(self, gb: GBuffer, res, s: int, stop):
+        """ReSTIR GI: temporal (first pass of a frame, with a GI history) and spatial passes, as :meth:`_reuse`."""
+        st = self.settings
+        hist = self.prev_history
+        if st.temporal_reuse and s == 0 and hist is not None and hist.gi_res is not None:
+            motion = self.ctx.scene.motion if hist.frame == st.frame - 1 else None
+            view = dataclasses.replace(hist, gbuf=hist.gbuf.with_terms(hist.gi_terms), res=hist.gi_res)
+            res = self._temporal(self.gi_space, gb, res, view, motion, self.gi.confidence_cap, STREAM_GI_TEMPORAL,
+                                 None, s, stop, "gi_temporal")
+            self.reuse_stats["gi_temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
+        for k in range(self.gi.passes if self.gi.neighbors else 0):
+            res = self._spatial(self.gi_space, gb, res, self.gi_spatial, STREAM_GI_SPATIAL + k, s, stop, "gi_spatial")
+        if len(res.M):
+            self.reuse_stats["gi_final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
+        return res
+
+    def _temporal(self, space, gb, res, hist, motion, cap, stream, possible, s, stop, stage):
+        """One temporal merge of every surface's reservoir with its previous frame's (reuse.temporal_reuse)."""
+        st = self.settings
+        with self.clock.stage(stage):
+            prepared = space.prepare(hist.res)
+            now = space.prepare(res) if st.bias_correction == "UNBIASED" else None
+            jobs = [(rows, (space, gb, res, now, hist, prepared, rows, cap, st.bias_correction, motion,
+                            rng(st.seed, st.frame, s, stream, i), possible))
+                    for i, rows in enumerate(self._spans(len(gb)))]
+            del prepared, now  # released with the jobs once merged
+            parts = self._map(_run_job(reuse.temporal_reuse), jobs, stop)
+            del jobs
+            return space.kind.gather(parts, len(gb))
+
+    def _spatial(self, space, gb, res, cfg, stream, s, stop, stage):
+        """One spatial pass over every surface (reuse.spatial_reuse)."""
+        st = self.settings
+        with self.clock.stage(stage):
+            prepared = space.prepare(res)
+            jobs = [(rows, (space, gb, res, prepared, rows, cfg, rng(st.seed, st.frame, s, stream, i)))
+                    for i, rows in enumerate(self._spans(len(gb)))]
+            del prepared  # released with the jobs once merged
+            parts = self._map(_run_job(reuse.spatial_reuse), jobs, stop)
+            del jobs
+            return space.kind.gather(parts, len(gb))
 
     def _accumulate(self, chunks, resampled: bool, stop) -> None:
         """Add the chunks' results to the running sums (chunks hold disjoint pixels: one pool task each)."""
@@ -494,6 +589,9 @@ class FrameRenderer:
             if resampled:
                 flat["res_m"][pix] += c.res.M
                 flat["res_w"][pix] += c.res.W
+            if c.gi_res is not None:
+                flat["gi_m"][pix] += c.gi_res.M
+                flat["gi_w"][pix] += c.gi_res.W
 
         self._map(add, chunks, stop)
 
@@ -522,6 +620,9 @@ class FrameRenderer:
         if self.candidates is not None:
             jobs["Reservoir M"] = lambda: mean("res_m")
             jobs["Reservoir UCW"] = lambda: mean("res_w")
+        if self.gi is not None:
+            jobs["GI Reservoir M"] = lambda: mean("gi_m")
+            jobs["GI Reservoir UCW"] = lambda: mean("gi_w")
         run = map if in_worker() else pool().map  # one pass per pool task (inline inside a worker)
         out = dict(zip(jobs, run(lambda job: job(), jobs.values())))
         if self.settings.data_passes:
@@ -585,7 +686,10 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
              "context_reused": fr.context_reused, "coverage_samples": fr.coverage,
              "direct_method": fr.method, "direct_reason": fr.method_reason,
              "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None, "reuse": dict(fr.reuse_stats),
-             "coverage_reason": fr.coverage_reason}
+             "coverage_reason": fr.coverage_reason,
+             "indirect_method": ("RESTIR_GI" if fr.gi is not None else
+                                 "OFF" if ctx.max_bounces == 0 else "PATH"),
+             "gi_spatial_radius": fr.gi.radius if fr.gi is not None else None}
     if clock is not None:
         stats["stages"] = clock.stages
     return FrameResult(passes, fr.samples_done, time.perf_counter() - t0, cancelled, stats, fr.history)

@@ -46,6 +46,8 @@ def pass_jitter(shift: np.ndarray, s: int) -> np.ndarray:
     out += np.float32(0.5 / (1 << 24))  # the centre of the 24-bit cell: uniform in [0, 1), never 0 or 1
     return out
 STREAM_SPATIAL = 16  # + spatial pass index
+STREAM_GI_TEMPORAL = 8
+STREAM_GI_SPATIAL = 48  # + spatial pass index
 
 
 def rng(seed: int, frame: int, pass_index: int, stream: int, chunk: int = 0) -> np.random.Generator:

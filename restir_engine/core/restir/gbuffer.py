@@ -26,3 +26,11 @@ class GBuffer:
 
     def __len__(self) -> int:
         return len(self.pix)
+
+    def with_terms(self, terms: ShadingTerms) -> "GBuffer":
+        """The same surfaces with other target terms (ReSTIR GI's): a shallow copy sharing every other array."""
+        out = GBuffer.__new__(GBuffer)
+        out.__dict__.update(self.__dict__)
+        out.terms = terms
+        out.normals = getattr(terms, "ns", None)
+        return out

@@ -16,7 +16,7 @@ from .reservoir import Reservoirs
 
 @dataclass
 class TemporalHistory:
-    """The previous frame's G-buffer, its final reservoirs (confidence capped),
+    """The previous frame's G-buffer, its final DI reservoirs (confidence capped; None when DI was not reused),
     its camera and the light-table signature the reservoirs index into."""
 
     gbuf: GBuffer
@@ -28,6 +28,9 @@ class TemporalHistory:
     uid_space: tuple = ()                # (scene triangles, lamp triangles) the ids index into
     had_light: np.ndarray | None = None  # after remapping to a new light table: (n_tri,) bool, lights of the
     #                                      current table that were lights in this history's frame
+    gi_res: Reservoirs | None = None     # ReSTIR GI: the frame's final GI reservoirs (aged, confidence capped)
+    gi_terms: object = None              # their target terms (target.ShadingTerms; the G-buffer's are DI's)
+    gi_key: bytes | None = None          # fingerprint of everything that emits: any change drops the GI history
 
     def fits(self, camera) -> bool:
         """Whether this history can serve a frame seen by ``camera`` (same window and resolution)."""
@@ -41,6 +44,8 @@ class TemporalHistory:
         ``had_light`` set; anything else cannot be mapped (None)."""
         if self.light_signature == lights.signature:
             return self
+        if self.res is None:  # no DI reservoirs to remap (the GI history is checked by its own key)
+            return dataclasses.replace(self, light_signature=lights.signature)
         if self.light_uid is None or self.uid_space != lights.uid_space:
             return None
         uid_to_light = np.full(int(sum(self.uid_space)), -1, np.int64)

@@ -8,7 +8,11 @@ surface had in the previous frame. The sample type enters through a *space* obje
   space.gather(prepared, idx)         samples ``idx`` of ``prepared``, evaluable at any surfaces
   space.evaluate(terms, gathered)     p̂ (n,) of gathered samples at surfaces ``terms``
   space.target(terms, prepared, idx)  both in one
-  space.jacobian (optional)           shift Jacobians; DI samples live in area measure: none is needed
+  space.evaluate_mis (optional)       p̂ for the MIS weights of the neighbours' techniques (GI: with visibility)
+  space.shift_ok (optional)           biased mode only: (n,) bool, whether a sample may move from the neighbour's
+                                      surface to the pixel's (GI: Jacobian outlier rejection)
+Samples live in area measure (DI: points on lights, GI: secondary surface points), so shifting a sample to
+another pixel needs no Jacobian.
 
 Merges (one code path, :func:`merge`):
   NONE      w_i = p̂_c(y_i) W_i M_i,  W = Σw / (p̂_c(y) ΣM)    (1/M: fast, darkens where a neighbour's
@@ -160,6 +164,13 @@ def _columns(a: np.ndarray, rows) -> np.ndarray:
     return a[:, rows] if isinstance(rows, slice) else np.take(a, rows, axis=1)
 
 
+def _mis_target(space):
+    """The target a neighbour's technique has for the canonical sample in the MIS weights: the space's
+    ``evaluate_mis`` (e.g. with visibility, where a technique can only make samples its surface sees) or
+    ``evaluate``."""
+    return getattr(space, "evaluate_mis", space.evaluate)
+
+
 def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: SpatialSettings,
                   rng: np.random.Generator) -> Reservoirs:
     """One spatial pass for surfaces ``rows`` of the G-buffer ``gb`` (restir.gbuffer.GBuffer): merge up to
@@ -198,9 +209,11 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
             neighbours.append(Neighbour(res, q, ok, m_q, z, z))
             continue
         pc = space.target(me, prepared, q) * (ok & (res.key[q] >= 0))
+        if not unbiased and hasattr(space, "shift_ok"):  # biased mode: drop shifts with outlying Jacobians
+            pc *= space.shift_ok(me.p, np.take(gb.terms.p, q, axis=1), space.gather(prepared, q))
         pq = None
         if unbiased:
-            pq = space.evaluate(gb.terms.take(q), own) * (ok & own_ok)
+            pq = _mis_target(space)(gb.terms.take(q), own) * (ok & own_ok)
         neighbours.append(Neighbour(res, q, ok, m_q, pc, pq))
     return merge(canonical, neighbours, cfg.bias_correction, rng)
 
@@ -241,12 +254,14 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     pc = np.zeros(n, np.float32)
     if use.any():
         pc = space.target(gb.terms.take(rows), prepared_prev, q) * use
+        if bias_correction != "UNBIASED" and hasattr(space, "shift_ok"):
+            pc *= space.shift_ok(p_now, np.take(prev_gb.terms.p, q, axis=1), space.gather(prepared_prev, q))
     pq = None
     if bias_correction == "UNBIASED":
         pq = np.zeros(n, np.float32)
         both = ok & canonical.has_sample()
         if both.any():
-            pq = space.evaluate(prev_gb.terms.take(q), space.gather(prepared_now, rows))
+            pq = _mis_target(space)(prev_gb.terms.take(q), space.gather(prepared_now, rows))
             if possible_before is not None:
                 pq = pq * possible_before(rows)
             pq = pq * both

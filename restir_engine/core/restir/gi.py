@@ -1,0 +1,245 @@
+"""ReSTIR GI (Ouyang et al. 2021): reservoirs over secondary surface points, initial samples and shading.
+
+A sample is a point x2 on a surface (position, unit geometric normal n2 facing the side the light leaves
+from) with the radiance Lo (RGB, W·sr⁻¹·m⁻², scene-linear) leaving it toward the primary surface x1 that
+found it, estimated by the rest of a path (next-event estimation at x2 and further bounces).
+
+Everything is in AREA measure on the secondary surfaces, exactly like ReSTIR DI with x2 as a light point of
+radiance Lo: the target at a primary surface x1 is
+  p̂(x2) = luminance(f(ωo, ωi) · Lo) · |cos θ1| · cos φ2 / d²       (0 where x2 faces away from x1)
+(target.ShadingTerms.evaluate, the full material at x1), and a reservoir's W is in m². Shifting a sample to
+another pixel keeps x2 (the reconnection shift); in solid angle its Jacobian is
+  |J| = (cos φ_q / cos φ_r) · (|x1_r − x2|² / |x1_q − x2|²)          (r: the pixel that made the sample,
+                                                                      q: the pixel receiving it)
+(:func:`reconnection_jacobian`). An area-measure W already contains it: W_ω at q = W_area · cos φ_q / d_q²
+= W_ω at r · |J|, so reuse.py merges GI reservoirs unchanged and no Jacobian is applied anywhere.
+
+Caching Lo assumes x2 reflects the same radiance toward every receiver (Lambertian): a sample whose x2 is
+glossy (roughness below the threshold, or mostly specular) is not put in a reservoir; its path-traced value
+goes to the pixel directly. At a glossy x1 the reservoirs resample the diffuse lobe only and the specular
+lobe keeps the path-traced sample: f = f_d + f_s splits the integral exactly.
+
+Unbiased reuse (pairwise MIS) needs the neighbour's target at the canonical sample to be zero where the
+neighbour could not have found it: a shadow ray from the neighbour's x1 to the sample (``evaluate_mis``).
+
+Reservoir memory per pixel: age int16 (-1 = empty), x2 3 x float32, n2 3 x float16, Lo 3 x float32, M, W, p̂
+float32 = 44 bytes.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..accel import shadow_rays
+from ..bsdf import eval_view
+from ..light_tiles import PackedPoints
+from ..sampling import cols, dot, finite, norm, to_local, vmax
+from .reservoir import Reservoirs
+
+INDIRECT_METHODS = ("OFF", "PATH", "RESTIR_GI")
+JACOBIAN_LIMIT = 10.0  # biased mode: shifts whose |J| is outside [1/10, 10] are rejected (as RTXDI's sample app)
+DIFFUSE_SHARE = 0.5  # x2 with a specular sampling share above this is glossy (its Lo depends on direction)
+
+
+class GIReservoirs(Reservoirs):
+    """age int16 (frames since the sample was made; -1 = empty), x2 (x, y, z), its normal (nx, ny, nz, float16),
+    Lo (lr, lg, lb); M, W (m²), p̂."""
+
+    SAMPLE = {"age": np.int16, "x": np.float32, "y": np.float32, "z": np.float32, "nx": np.float16,
+              "ny": np.float16, "nz": np.float16, "lr": np.float32, "lg": np.float32, "lb": np.float32}
+
+
+@dataclass
+class GISettings:
+    """ReSTIR GI stages: spatial neighbours / radius (pixels, 0 = automatic) / passes, confidence cap (the
+    largest M a reused reservoir keeps), max sample age (frames), roughness threshold (below it x1 resamples its
+    diffuse lobe only and x2 is not cached)."""
+
+    neighbors: int = 3
+    radius: float = 0.0
+    passes: int = 1
+    confidence_cap: float = 20.0
+    max_age: int = 30
+    roughness_threshold: float = 0.3
+
+
+def reconnection_jacobian(x1_from: np.ndarray, x1_to: np.ndarray, x2: np.ndarray, n2: np.ndarray) -> np.ndarray:
+    """|J| (n,) of moving a sample x2 (normal n2) from the receiver x1_from to the receiver x1_to (all (3, n)):
+    dω_to / dω_from = (cos φ_to / cos φ_from) · (|x1_from − x2|² / |x1_to − x2|²), φ the angle at x2 between
+    n2 and the direction to the receiver; 0 where it is not finite."""
+    a = x1_from - x2
+    b = x1_to - x2
+    da, db = dot(a, a), dot(b, b)
+    cos_a = np.abs(dot(a, n2)) / np.sqrt(np.maximum(da, 1e-30))
+    cos_b = np.abs(dot(b, n2)) / np.sqrt(np.maximum(db, 1e-30))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        j = (cos_b / cos_a) * (da / db)
+    return np.where(np.isfinite(j), j, 0.0).astype(np.float32)
+
+
+def glossy_x1(params, threshold: float) -> np.ndarray:
+    """(n,) bool: primary surfaces whose specular lobe is too sharp to reconnect (roughness² = α below
+    threshold², with a specular lobe)."""
+    return (params.alpha < np.float32(threshold) ** 2) & (params.spec_on > 0)
+
+
+def cacheable_x2(params, threshold: float) -> np.ndarray:
+    """(n,) bool: secondary surfaces whose outgoing radiance may be cached (rough enough and mostly diffuse)."""
+    return (params.spec_on == 0) | ((params.alpha >= np.float32(threshold) ** 2) & (params.p_spec <= DIFFUSE_SHARE))
+
+
+def diffuse_only(terms, glossy: np.ndarray):
+    """The target terms with the specular lobe switched off where ``glossy`` (in place: spec_on row)."""
+    if glossy.any():
+        terms.spec_on[glossy] = 0.0
+        terms.glossy = bool((terms.spec_on > 0).any())
+    return terms
+
+
+def initial(first, terms, n: int, glossy: np.ndarray, threshold: float):
+    """One GI reservoir per primary surface (n) from its first bounce (pathtracer.FirstBounce), and the part of
+    the path-traced indirect light (3, n) the reservoirs do not carry: the specular lobe at glossy x1
+    (``glossy`` (n,) bool), and every sample whose x2 cannot be cached. ``terms``: the GI target terms of the n
+    surfaces (specular lobe off where glossy). A reservoir holds its one candidate: M = 1, W = 1 / p_area with
+    p_area = p_ω · cos φ2 / d² the pdf of x2 in area measure."""
+    res = GIReservoirs.empty(n)
+    res.M[:] = 1.0
+    rest = np.zeros((3, n), np.float32)
+    rows = first.rows
+    if rows.size == 0:
+        return res, rest
+    keep = cacheable_x2(first.params, threshold)
+    here = terms.take(rows)
+    pts = PackedPoints(first.p, first.n2, first.lo, np.zeros(len(rows), np.float32), np.zeros(len(rows), bool))
+    p_hat = here.evaluate(pts, want_pdf=False)[0]
+    d = first.p - here.p
+    d2 = dot(d, d)
+    cos2 = -dot(d, first.n2) / np.sqrt(np.maximum(d2, 1e-30))
+    p_area = first.pdf * cos2 / np.maximum(d2, 1e-30)
+    ok = keep & (p_hat > 0) & (p_area > 0)
+    # what the reservoir does not carry: all of a non-cacheable sample, the specular lobe at a glossy x1
+    carried = first.throughput * ok
+    g = glossy[rows] & ok
+    if g.any():
+        kd_t = here.kd[:, g] / _LUM[:, None]          # f_d = kd (the terms hold kd · luminance weights)
+        ci = np.maximum(dot(cols(d, np.flatnonzero(g)), cols(here.ns, np.flatnonzero(g))), 0.0) / \
+            np.sqrt(np.maximum(d2[g], 1e-30))
+        carried[:, g] = kd_t * (ci / np.maximum(first.pdf[g], 1e-30))
+    rest[:, rows] = finite((first.throughput - carried) * first.lo)
+    sel = np.flatnonzero(ok)
+    r = rows[sel]
+    res.age[r] = 0
+    res.x[r], res.y[r], res.z[r] = first.p[0, sel], first.p[1, sel], first.p[2, sel]
+    res.nx[r], res.ny[r], res.nz[r] = first.n2[0, sel], first.n2[1, sel], first.n2[2, sel]
+    res.lr[r], res.lg[r], res.lb[r] = first.lo[0, sel], first.lo[1, sel], first.lo[2, sel]
+    res.p_hat[r] = p_hat[sel]
+    res.W[r] = 1.0 / p_area[sel]
+    return res, rest
+
+
+_LUM = np.array([0.2126, 0.7152, 0.0722], np.float32)
+
+
+def _points(res: GIReservoirs, idx=None) -> np.ndarray:
+    """(11, n) packed points (target.PackedPoints rows) of reservoirs ``idx`` (all when None)."""
+    take = (lambda a: a) if idx is None else (lambda a: a[idx])
+    n = len(res) if idx is None else len(take(res.x))
+    out = np.zeros((11, n), np.float32)
+    for i, name in enumerate(("x", "y", "z", "nx", "ny", "nz", "lr", "lg", "lb")):
+        out[i] = take(getattr(res, name))
+    return out
+
+
+class GISpace:
+    """GI samples for the generic reuse code (reuse.py): points x2 with radiance Lo, the DI target function.
+    ``accel``: the geometry (visibility of the neighbours' primary hits in the unbiased mode; None: no rays)."""
+
+    kind = GIReservoirs
+
+    def __init__(self, accel=None):
+        self.accel = accel
+
+    @staticmethod
+    def prepare(res: GIReservoirs) -> np.ndarray:
+        return _points(res)
+
+    @staticmethod
+    def gather(prepared: np.ndarray, idx) -> PackedPoints:
+        return PackedPoints.of(prepared[:, idx] if isinstance(idx, slice) else np.take(prepared, idx, axis=1))
+
+    @staticmethod
+    def evaluate(terms, pts: PackedPoints) -> np.ndarray:
+        return terms.evaluate(pts, want_pdf=False)[0]
+
+    def target(self, terms, prepared, idx) -> np.ndarray:
+        return self.evaluate(terms, self.gather(prepared, idx))
+
+    @staticmethod
+    def shift_ok(p_to: np.ndarray, p_from: np.ndarray, pts: PackedPoints) -> np.ndarray:
+        """Biased mode: (n,) bool, the reconnection Jacobian of moving samples ``pts`` from primary hits p_from to
+        p_to lies in [1 / JACOBIAN_LIMIT, JACOBIAN_LIMIT]. Without it the 1/M merge turns samples made far
+        from x2 into fireflies next to it (the pairwise MIS weights of the unbiased mode handle them)."""
+        j = reconnection_jacobian(p_from, p_to, pts.pos, pts.normal)
+        return (j <= JACOBIAN_LIMIT) & (j >= np.float32(1.0 / JACOBIAN_LIMIT))
+
+    def evaluate_mis(self, terms, pts: PackedPoints) -> np.ndarray:
+        """p̂ with visibility: zero where the surfaces ``terms`` cannot see the sample (they could not have
+        found it, so their technique must get no MIS weight for it)."""
+        p = self.evaluate(terms, pts)
+        live = np.flatnonzero(p > 0)
+        if live.size and self.accel is not None:
+            p[live[~visible(self.accel, cols(terms.p, live), cols(terms.ng, live), cols(pts.pos, live),
+                            cols(pts.normal, live))]] = 0.0
+        return p
+
+
+def visible(accel, p: np.ndarray, ng: np.ndarray, x2: np.ndarray, n2: np.ndarray) -> np.ndarray:
+    """(n,) bool: whether the primary surfaces (p, ng) see the points x2 (normals n2, facing them) unoccluded."""
+    q = x2 + n2 * np.float32(1e-4) * np.maximum(np.abs(x2).max(axis=0), np.float32(1.0))
+    wi = q - p
+    dist = norm(wi)
+    wi = wi / np.maximum(dist, np.float32(1e-30))
+    o, d, far = shadow_rays(p, ng, q, wi, dist)
+    return ~accel.occluded(o, d, far)
+
+
+def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray) -> np.ndarray:
+    """Indirect radiance (3, n) at the primary surfaces ``surf`` from their GI reservoirs: f · Lo · |cos θ1| ·
+    cos φ2 / d² · V · W with one shadow ray (f the diffuse lobe only where ``glossy``)."""
+    n = len(surf)
+    out = np.zeros((3, n), np.float32)
+    live = np.flatnonzero(res.has_sample() & (res.W > 0))
+    if live.size == 0:
+        return out
+    sub = surf if live.size == n else surf.take(live)
+    pts = _points(res, live)
+    x2, n2, lo = pts[0:3], pts[3:6], pts[6:9]
+    p = sub.p
+    d = x2 - p
+    dist = norm(d)
+    wi = d / np.maximum(dist, np.float32(1e-30))
+    cos2 = -dot(wi, n2)
+    wi_l = to_local(wi, sub.ns, sub.t, sub.bt)
+    f, _pdf = eval_view(sub.view, sub.wo_l, wi_l)
+    g = glossy[live]
+    if g.any():
+        f[:, g] = sub.view.kd[:, g] * (wi_l[2, g] > 0)
+    ok = (cos2 > 0) & (dot(wi, sub.ng) > 0)
+    contrib = f * lo
+    contrib *= np.abs(wi_l[2]) * cos2 / np.maximum(dist * dist, np.float32(1e-30)) * res.W[live] * ok
+    go = np.flatnonzero(vmax(contrib) > 0)
+    if go.size:
+        vis = visible(accel, cols(p, go), cols(sub.ng, go), cols(x2, go), cols(n2, go))
+        out[:, live[go[vis]]] = cols(contrib, go[vis])
+    return finite(out)
+
+
+def age_history(res: GIReservoirs, max_age: int) -> GIReservoirs:
+    """The reservoirs as next frame's history: every sample one frame older, those older than ``max_age``
+    dropped (a copy; confidence M kept)."""
+    out = res.replace(age=res.age.copy(), W=res.W.copy(), p_hat=res.p_hat.copy())
+    has = out.has_sample()
+    out.age[has] += 1
+    out.clear(has & (out.age > max_age))
+    return out
