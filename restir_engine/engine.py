@@ -40,6 +40,10 @@ def settings_from_scene(scene) -> RenderSettings:
                           boiling_filter=bool(s.boiling_filter),
                           boiling_threshold=float(s.boiling_threshold),
                           coverage_samples=0 if s.coverage_samples == "AUTO" else int(s.coverage_samples),
+                          indirect_method=s.indirect_method, gi_spatial_neighbors=int(s.gi_spatial_neighbors),
+                          gi_spatial_radius=float(s.gi_spatial_radius), gi_spatial_passes=int(s.gi_spatial_passes),
+                          gi_confidence_cap=float(s.gi_confidence_cap), gi_max_age=int(s.gi_max_age),
+                          gi_roughness_threshold=float(s.gi_roughness_threshold),
                           film_transparent=bool(scene.render.film_transparent))
 
 
@@ -101,8 +105,9 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         t0 = time.perf_counter()
         settings = with_data_passes(settings_from_scene(scene), view_layer)
         # AUTO may resolve to ReSTIR (known once the scene is exported): keep and preroll its history too
-        wants_temporal = settings.integrator == "RESTIR" and settings.direct_method in ("RESTIR", "AUTO") and \
-            settings.temporal_reuse
+        wants_temporal = settings.integrator == "RESTIR" and settings.temporal_reuse and (
+            settings.direct_method in ("RESTIR", "AUTO") or
+            (settings.indirect_method == "RESTIR_GI" and settings.max_bounces > 0))
         key = (scene.name, view_layer.name)
         prev = _TEMPORAL_HISTORY.pop(key, None)
         history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None
@@ -145,7 +150,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         self._write(result.passes, core_scene.camera.window, scene, view_layer)
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
                                                                   "coverage_samples", "coverage_reason",
-                                                                  "spatial_radius")}
+                                                                  "spatial_radius", "indirect_method",
+                                                                  "gi_spatial_radius")}
         LAST_FRAME_STATS.clear()
         LAST_FRAME_STATS.update(export_seconds=t_export, core_seconds=result.seconds, samples=result.samples_done,
                                 frame=scene.frame_current, cancelled=result.cancelled, **result.stats)
@@ -170,7 +176,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                     neighbour_frames(self, depsgraph, core, self.camera_override, need_next=False)
                     result = render_frame(core, replace(settings, samples=1, frame=f, data_passes=False),
                                           history=history)
-                    if result.stats["direct_method"] != "RESTIR":  # AUTO chose a method without history
+                    if result.history is None:  # AUTO chose a method without history (and no ReSTIR GI)
                         return None, False
                     history = result.history
                 except (ExportError, Cancelled):

@@ -10,6 +10,11 @@ def has_reservoirs(scene) -> bool:
     return s.integrator == "RESTIR" and s.direct_method in ("AUTO", "RIS", "RESTIR")  # AUTO resamples when asked
 
 
+def has_gi_reservoirs(scene) -> bool:
+    s = scene.restir
+    return s.integrator == "RESTIR" and s.indirect_method == "RESTIR_GI" and s.max_bounces > 0
+
+
 PASSES = (
     ("Combined", "RGBA", "COLOR", lambda sc, vl: True, "Combined"),
     ("Depth", "Z", "VALUE", lambda sc, vl: vl.use_pass_z, "Depth"),
@@ -21,6 +26,10 @@ PASSES = (
     ("Reservoir M", "X", "VALUE", lambda sc, vl: vl.restir.use_pass_reservoir_m and has_reservoirs(sc), "Reservoir M"),
     ("Reservoir UCW", "X", "VALUE", lambda sc, vl: vl.restir.use_pass_reservoir_ucw and has_reservoirs(sc),
      "Reservoir UCW"),
+    ("GI Reservoir M", "X", "VALUE", lambda sc, vl: vl.restir.use_pass_gi_reservoir_m and has_gi_reservoirs(sc),
+     "GI Reservoir M"),
+    ("GI Reservoir UCW", "X", "VALUE", lambda sc, vl: vl.restir.use_pass_gi_reservoir_ucw and has_gi_reservoirs(sc),
+     "GI Reservoir UCW"),
 )
 
 

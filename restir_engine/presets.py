@@ -4,21 +4,28 @@ from __future__ import annotations
 import bpy
 from bpy.props import EnumProperty
 
+from .core.restir.gi import GISettings
 from .core.restir.reuse import SpatialSettings, TemporalSettings
+
+# ReSTIR GI at its measured defaults (docs/RESULTS.md, "ReSTIR GI")
+_GI = {"indirect_method": "RESTIR_GI", "gi_spatial_neighbors": GISettings.neighbors,
+       "gi_spatial_radius": GISettings.radius, "gi_spatial_passes": GISettings.passes,
+       "gi_confidence_cap": GISettings.confidence_cap, "gi_max_age": GISettings.max_age,
+       "gi_roughness_threshold": GISettings.roughness_threshold}
 
 PRESETS = {
     "FAST": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 4, "light_candidates": 8,
              "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": TemporalSettings.confidence_cap, "spatial_neighbors": 3,
              "preroll_frames": 2, "spatial_radius": SpatialSettings.radius, "spatial_passes": 1, "bias_correction": "NONE",
-             "light_tiles": "AUTO", "boiling_filter": True},
+             "light_tiles": "AUTO", "boiling_filter": True, **_GI},
     "BALANCED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
                  "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": TemporalSettings.confidence_cap, "spatial_neighbors": 5,
                  "spatial_radius": SpatialSettings.radius, "spatial_passes": 1, "bias_correction": "NONE", "light_tiles": "AUTO",
-                 "boiling_filter": False},
+                 "boiling_filter": False, **_GI},
     "UNBIASED": {"integrator": "RESTIR", "direct_method": "RESTIR", "samples": 16, "light_candidates": 32,
                  "bsdf_candidates": 1, "temporal_reuse": True, "confidence_cap": TemporalSettings.confidence_cap, "spatial_neighbors": 5,
                  "spatial_radius": SpatialSettings.radius, "spatial_passes": 1, "bias_correction": "UNBIASED",
-                 "light_tiles": "AUTO", "boiling_filter": False},
+                 "light_tiles": "AUTO", "boiling_filter": False, **_GI},
     "REFERENCE": {"integrator": "PATH", "samples": 256},
 }
 
@@ -29,9 +36,9 @@ def apply_preset(settings, name: str) -> None:
 
 
 PRESET_ITEMS = [
-    ("FAST", "Fast", "Biased ReSTIR, 8 light candidates, 3 neighbours, boiling filter, 4 samples"),
-    ("BALANCED", "Balanced", "Biased ReSTIR (1/M), 32 candidates, 5 neighbours, 16 samples"),
-    ("UNBIASED", "Unbiased", "Unbiased ReSTIR (pairwise MIS): converges to the path tracer"),
+    ("FAST", "Fast", "Biased ReSTIR DI + GI, 8 light candidates, 3 neighbours, boiling filter, 4 samples"),
+    ("BALANCED", "Balanced", "Biased ReSTIR DI + GI (1/M), 32 candidates, 5 neighbours, 16 samples"),
+    ("UNBIASED", "Unbiased", "Unbiased ReSTIR DI + GI (pairwise MIS): converges to the path tracer"),
     ("REFERENCE", "Reference", "The path tracer at 256 samples")]
 
 

@@ -7,6 +7,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 from .core.boiling import THRESHOLD as BOILING_THRESHOLD
 from .core.light_tiles import TileSettings
 from .core.restir.di import CandidateSettings
+from .core.restir.gi import GISettings
 from .core.restir.reuse import SpatialSettings, TemporalSettings
 
 
@@ -112,6 +113,35 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                       min=0)
     max_bounces: IntProperty(name="Max Bounces", description="Indirect bounces (0 = direct light only)",
                              default=4, min=0, soft_max=32, max=1024)
+    indirect_method: EnumProperty(
+        name="Indirect Method",
+        description="How the ReSTIR integrator estimates indirect light (bounces) at the first hit",
+        items=[("OFF", "Off", "No indirect light (direct light only, whatever Max Bounces says)", 0),
+               ("PATH", "Path Tracing", "One path per pixel and sample, as the path tracer", 1),
+               ("RESTIR_GI", "ReSTIR GI", "Resample the first bounce: each pixel's path finds a point x2 and the "
+                "light leaving it; reservoirs of x2 points are reused over frames (temporal) and neighbouring "
+                "pixels (spatial) with the reconnection shift. Glossy surfaces keep path-traced samples for "
+                "their sharp lobes", 2)],
+        default="RESTIR_GI", update=_update_passes)
+    gi_spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring GI reservoirs merged per spatial "
+                                      "pass (unbiased mode: one visibility ray each)",
+                                      default=GISettings.neighbors, min=0, soft_max=16)
+    gi_spatial_radius: FloatProperty(name="Radius", description="GI spatial reuse radius in pixels; 0 = automatic: "
+                                     "0.75 x the direct light's (6 px at 640x360, scaled with the image diagonal, 4 px at least)",
+                                     default=GISettings.radius, min=0.0, soft_max=100.0, subtype="PIXEL")
+    gi_spatial_passes: IntProperty(name="Passes", description="GI spatial reuse passes",
+                                   default=GISettings.passes, min=0, soft_max=4)
+    gi_confidence_cap: FloatProperty(name="Confidence Cap", description="Largest confidence M a reused GI "
+                                     "reservoir keeps", default=GISettings.confidence_cap, min=1.0, soft_max=100.0)
+    gi_max_age: IntProperty(name="Max Sample Age", description="Frames a GI sample may be carried by temporal "
+                            "reuse before it is dropped (its cached radiance ages while objects move; any change "
+                            "of the lights drops the whole GI history at once)", default=GISettings.max_age, min=0,
+                            soft_max=100)
+    gi_roughness_threshold: FloatProperty(
+        name="Roughness Threshold", description="Below this roughness a surface's specular lobe is too sharp to "
+        "reconnect: seen by the camera, only its diffuse lobe is resampled (the specular keeps its path-traced "
+        "sample); hit by a bounce, its light is not cached for reuse", default=GISettings.roughness_threshold,
+        min=0.0, max=1.0)
 
 
 class RestirViewLayerSettings(bpy.types.PropertyGroup):
@@ -126,6 +156,11 @@ class RestirViewLayerSettings(bpy.types.PropertyGroup):
     use_pass_reservoir_ucw: BoolProperty(name="Reservoir UCW", description="Unbiased contribution weight W of the "
                                          "shaded reservoir (ReSTIR integrator with RIS)", default=False,
                                          update=_update_passes)
+    use_pass_gi_reservoir_m: BoolProperty(name="GI Reservoir M", description="Confidence M of the shaded ReSTIR GI "
+                                          "reservoir (Indirect Method ReSTIR GI)", default=False, update=_update_passes)
+    use_pass_gi_reservoir_ucw: BoolProperty(name="GI Reservoir UCW", description="Unbiased contribution weight W "
+                                            "(m²) of the shaded ReSTIR GI reservoir (Indirect Method ReSTIR GI)",
+                                            default=False, update=_update_passes)
 
 
 CLASSES = (RestirSceneSettings, RestirViewLayerSettings)

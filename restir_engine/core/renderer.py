@@ -115,7 +115,8 @@ def coverage_samples(setting: int, lights, lamps) -> tuple[int, str]:
 
 
 AUTO_COVERAGE = 4
-GI_RADIUS_FACTOR = 2.0  # the automatic GI spatial radius against DI's (indirect light varies more slowly)
+GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's: 6 px at 640x360 (measured on interior_gi:
+#                          relMSE 0.23 at 5 px, 0.29 at 8, 0.71 at 16 with 4 passes, 1 spp)
 MANY_COVERAGE = 16
 MANY_EMITTERS = 4096
 

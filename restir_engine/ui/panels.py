@@ -120,6 +120,41 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
                 sub.prop(s, "boiling_threshold")
 
 
+class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
+    bl_label = "Indirect"
+    bl_parent_id = "RESTIR_PT_sampling"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.scene.restir.integrator == "RESTIR"
+
+    def draw(self, context):
+        layout = self.split_layout()
+        s = context.scene.restir
+        layout.prop(s, "indirect_method")
+        if s.indirect_method != "RESTIR_GI":
+            return
+        if s.max_bounces == 0:
+            layout.label(text="Max Bounces is 0: there is no indirect light", icon="INFO")
+        if s.direct_method in ("RESTIR", "AUTO"):
+            layout.label(text="Temporal reuse and bias correction: as set for direct light")
+        else:  # the shared settings are not drawn above for these direct methods
+            layout.prop(s, "temporal_reuse")
+            layout.prop(s, "bias_correction")
+        col = layout.column(align=True, heading="Temporal Reuse")
+        col.active = s.temporal_reuse
+        col.prop(s, "gi_confidence_cap")
+        col.prop(s, "gi_max_age")
+        col = layout.column(align=True, heading="Spatial Reuse")
+        col.prop(s, "gi_spatial_neighbors")
+        col.prop(s, "gi_spatial_radius")
+        last = _last_choices(context.scene)
+        if s.gi_spatial_radius == 0 and last and last.get("gi_spatial_radius"):
+            col.label(text=f"Auto radius in the last render: {last['gi_spatial_radius']:.1f} px")
+        col.prop(s, "gi_spatial_passes")
+        layout.prop(s, "gi_roughness_threshold")
+
+
 def _last_choices(scene):
     """What the automatic settings picked in this scene's last render (engine.LAST_CHOICES), or None."""
     from ..engine import LAST_CHOICES
@@ -156,9 +191,14 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
             col.label(text="Auto uses ReSTIR when a reservoir pass is on")
         col.prop(vl.restir, "use_pass_reservoir_m")
         col.prop(vl.restir, "use_pass_reservoir_ucw")
+        col = layout.column(heading="ReSTIR GI", align=True)
+        sc = context.scene.restir
+        col.active = sc.integrator == "RESTIR" and sc.indirect_method == "RESTIR_GI" and sc.max_bounces > 0
+        col.prop(vl.restir, "use_pass_gi_reservoir_m")
+        col.prop(vl.restir, "use_pass_gi_reservoir_ucw")
 
 
-PANELS = (RESTIR_PT_sampling, RESTIR_PT_light_paths, RESTIR_PT_passes)
+PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_indirect, RESTIR_PT_light_paths, RESTIR_PT_passes)
 
 
 def _standard_panels():

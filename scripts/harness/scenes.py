@@ -282,6 +282,25 @@ def build_many_lights_pan(variant="10k", size="medium"):
     return scene
 
 
+def build_interior_gi_pan(variant="default", size="medium"):
+    """interior_gi (a room lit almost only by light bounced off its back wall) with the camera panning 1° and
+    moving 0.05 m sideways per frame (frames 1..PAN_FRAMES)."""
+    scene = build_interior_gi(variant, size)
+    scene.frame_start, scene.frame_end = 1, PAN_FRAMES
+    cam = scene.camera
+    cam.rotation_euler.z = math.radians(-3.5)
+    cam.keyframe_insert("rotation_euler", frame=1)
+    cam.keyframe_insert("location", frame=1)
+    cam.rotation_euler.z = math.radians(3.5)
+    cam.location.x += 0.35
+    cam.keyframe_insert("rotation_euler", frame=PAN_FRAMES)
+    cam.keyframe_insert("location", frame=PAN_FRAMES)
+    for fc in _fcurves(cam):
+        for k in fc.keyframe_points:
+            k.interpolation = "LINEAR"
+    return scene
+
+
 def _fcurves(obj):
     """F-curves of an object's action (Blender 4.x: action.fcurves; 5.x: layered actions)."""
     action = obj.animation_data.action
@@ -329,7 +348,7 @@ def build_animated(variant="default", size="small"):
 
 BUILDERS = {"cornell": build_cornell, "many_lights": build_many_lights, "glossy": build_glossy,
             "interior_gi": build_interior_gi, "animated": build_animated, "default_cube": build_default_cube,
-            "many_lights_pan": build_many_lights_pan}
+            "many_lights_pan": build_many_lights_pan, "interior_gi_pan": build_interior_gi_pan}
 
 
 def _source_hash(name: str) -> str:
