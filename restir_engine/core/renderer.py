@@ -231,7 +231,7 @@ class FrameRenderer:
                                                  max(0, settings.spatial_passes), settings.bias_correction)
             if settings.indirect_method == "RESTIR_GI" and bounces > 0:
                 gi_radius = float(settings.gi_spatial_radius) if settings.gi_spatial_radius > 0 else \
-                    GI_RADIUS_FACTOR * reuse.auto_radius(cam.width, cam.height)
+                    max(reuse.AUTO_RADIUS_MIN, GI_RADIUS_FACTOR * reuse.auto_radius(cam.width, cam.height))
                 self.gi = gi.GISettings(max(0, int(settings.gi_spatial_neighbors)), max(1.0, gi_radius),
                                         max(0, int(settings.gi_spatial_passes)), float(settings.gi_confidence_cap),
                                         max(0, int(settings.gi_max_age)), float(settings.gi_roughness_threshold))
@@ -467,8 +467,8 @@ class FrameRenderer:
             self.history = TemporalHistory(
                 gb, None if res is None else res.replace(M=np.minimum(res.M, st.confidence_cap)), ctx.scene.camera,
                 lights.signature, st.frame, lights.light_uid, lights.uid_space,
-                gi_res=None if gi_res is None else gi.age_history(gi_res.replace(
-                    M=np.minimum(gi_res.M, np.float32(self.gi.confidence_cap))), self.gi.max_age),
+                gi_res=None if gi_res is None else gi.age_history(self.gi_history_res.replace(
+                    M=np.minimum(self.gi_history_res.M, np.float32(self.gi.confidence_cap))), self.gi.max_age),
                 gi_terms=None if gb_gi is None else gb_gi.terms, gi_key=self.gi_light_key if gi_on else None)
 
         def shade(c: _Chunk):
@@ -476,7 +476,9 @@ class FrameRenderer:
             direct = di.shade(ctx, c.hits.surf, c.res, r) if resampled else pathtracer.next_event(ctx, c.hits.surf, r)
             c.direct = direct if c.direct is None else c.direct + direct
             if gi_on:
-                c.indirect = c.indirect + gi.shade(ctx.geom_accel, c.hits.surf, c.gi_res, c.glossy)
+                # the unbiased mode's reservoirs hold only samples their surface sees (gi.clear_occluded)
+                c.indirect = c.indirect + gi.shade(ctx.geom_accel, c.hits.surf, c.gi_res, c.glossy,
+                                                   verified=st.bias_correction == "UNBIASED")
 
         with clock.stage("shade"):
             self._map(shade, chunks, stop)
@@ -540,10 +542,26 @@ class FrameRenderer:
             res = self._temporal(self.gi_space, gb, res, view, motion, self.gi.confidence_cap, STREAM_GI_TEMPORAL,
                                  None, s, stop, "gi_temporal")
             self.reuse_stats["gi_temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
+            res = self._gi_visible(gb, res, stop, "gi_temporal")
+        # the next frame's history is taken before the spatial passes: on the regression room (4 frames, 4 passes)
+        # the per-pixel variance is 0.34x the path tracer's this way against 0.57x when the spatially merged
+        # reservoirs are fed back (their neighbours' samples are correlated with the next frame's spatial pass)
+        self.gi_history_res = res
         for k in range(self.gi.passes if self.gi.neighbors else 0):
             res = self._spatial(self.gi_space, gb, res, self.gi_spatial, STREAM_GI_SPATIAL + k, s, stop, "gi_spatial")
+            res = self._gi_visible(gb, res, stop, "gi_spatial")
         if len(res.M):
             self.reuse_stats["gi_final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
+        return res
+
+    def _gi_visible(self, gb, res, stop, stage):
+        """Unbiased mode: empty the GI samples their surfaces cannot see (gi.clear_occluded), one ray per pixel."""
+        if self.settings.bias_correction != "UNBIASED":
+            return res
+        with self.clock.stage(stage):
+            # slices: each task's reservoirs and terms are views, cleared in place
+            self._map(lambda rows: gi.clear_occluded(self.ctx.geom_accel, gb.terms.take(rows), res.take(rows)),
+                      self._spans(len(gb)), stop)
         return res
 
     def _temporal(self, space, gb, res, hist, motion, cap, stream, possible, s, stop, stage):

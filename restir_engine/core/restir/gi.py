@@ -204,9 +204,25 @@ def visible(accel, p: np.ndarray, ng: np.ndarray, x2: np.ndarray, n2: np.ndarray
     return ~accel.occluded(o, d, far)
 
 
-def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray) -> np.ndarray:
+def clear_occluded(accel, terms, res: GIReservoirs) -> GIReservoirs:
+    """The reservoirs (of surfaces ``terms``) with every sample their surface cannot see emptied (M kept), in
+    place. Run after each merge of the unbiased mode: a reservoir then only ever holds samples its own surface
+    sees, the domain its technique is credited with in the neighbours' MIS weights (``GISpace.evaluate_mis``).
+    Without it a sample passed on by an earlier spatial pass could be invisible to the surface holding it and the
+    MIS weights of later passes summed to more than one (measured +1.8 % after 4 frames with 4 passes). The
+    estimate is unchanged otherwise: an occluded sample contributes nothing when shaded."""
+    live = np.flatnonzero(res.has_sample())
+    if live.size:
+        pts = _points(res, live)
+        vis = visible(accel, cols(terms.p, live), cols(terms.ng, live), pts[0:3], pts[3:6])
+        res.clear(live[~vis])
+    return res
+
+
+def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray, verified: bool = False) -> np.ndarray:
     """Indirect radiance (3, n) at the primary surfaces ``surf`` from their GI reservoirs: f · Lo · |cos θ1| ·
-    cos φ2 / d² · V · W with one shadow ray (f the diffuse lobe only where ``glossy``)."""
+    cos φ2 / d² · V · W with one shadow ray (f the diffuse lobe only where ``glossy``), none when the samples are
+    ``verified`` visible (:func:`clear_occluded`)."""
     n = len(surf)
     out = np.zeros((3, n), np.float32)
     live = np.flatnonzero(res.has_sample() & (res.W > 0))
@@ -230,8 +246,11 @@ def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray) -> np.ndarray:
     contrib *= np.abs(wi_l[2]) * cos2 / np.maximum(dist * dist, np.float32(1e-30)) * res.W[live] * ok
     go = np.flatnonzero(vmax(contrib) > 0)
     if go.size:
-        vis = visible(accel, cols(p, go), cols(sub.ng, go), cols(x2, go), cols(n2, go))
-        out[:, live[go[vis]]] = cols(contrib, go[vis])
+        if verified:
+            out[:, live[go]] = cols(contrib, go)
+        else:
+            vis = visible(accel, cols(p, go), cols(sub.ng, go), cols(x2, go), cols(n2, go))
+            out[:, live[go[vis]]] = cols(contrib, go[vis])
     return finite(out)
 
 
