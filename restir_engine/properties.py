@@ -140,7 +140,7 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
     gi_roughness_threshold: FloatProperty(
         name="Roughness Threshold", description="Below this roughness a surface's specular lobe is too sharp to "
         "reconnect: seen by the camera, only its diffuse lobe is resampled (the specular keeps its path-traced "
-        "sample); hit by a bounce, its light is not cached for reuse", default=GISettings.roughness_threshold,
+        "sample). Light leaving a bounce's surface is always split: only its diffuse part is cached for reuse", default=GISettings.roughness_threshold,
         min=0.0, max=1.0)
 
 

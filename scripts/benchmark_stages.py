@@ -38,7 +38,8 @@ from restir_engine.core.profile import StageClock, embree_seconds  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 
-STAGES = ("primary", "initial", "gbuffer", "temporal", "boiling", "spatial", "shade", "paths", "passes")
+STAGES = ("primary", "initial", "gbuffer", "temporal", "boiling", "spatial", "gi_temporal", "gi_spatial", "shade",
+          "paths", "passes")
 RUNS = [  # (name, scene, integrator settings): RESTIR runs use the add-on's defaults (ReSTIR DI, unbiased, temporal + spatial)
     ("demo PATH", "demo", dict(integrator="PATH", max_bounces=4)),
     ("demo RESTIR", "demo", dict(integrator="RESTIR", direct_method="RESTIR", max_bounces=4)),
@@ -46,6 +47,13 @@ RUNS = [  # (name, scene, integrator settings): RESTIR runs use the add-on's def
     ("many_lights RESTIR", "many_lights", dict(integrator="RESTIR", direct_method="RESTIR", max_bounces=0)),
     ("interior_gi PATH", "interior_gi", dict(integrator="PATH", max_bounces=4)),
     ("interior_gi RESTIR", "interior_gi", dict(integrator="RESTIR", direct_method="RESTIR", max_bounces=4)),
+    # ReSTIR DI + ReSTIR GI (the add-on's defaults for both): the frame-time target of the GI issue (<= 2.5 s)
+    ("demo DI+GI", "demo", dict(integrator="RESTIR", direct_method="RESTIR", indirect_method="RESTIR_GI",
+                                max_bounces=4)),
+    ("many_lights DI+GI", "many_lights", dict(integrator="RESTIR", direct_method="RESTIR",
+                                              indirect_method="RESTIR_GI", max_bounces=1)),
+    ("interior_gi DI+GI", "interior_gi", dict(integrator="RESTIR", direct_method="RESTIR",
+                                              indirect_method="RESTIR_GI", max_bounces=4)),
 ]
 
 

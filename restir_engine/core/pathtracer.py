@@ -162,13 +162,14 @@ def _seen(ctx: TraceContext, o, d, tmax, hits):
     return finite(emitted), alpha
 
 
-def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None) -> np.ndarray:
+def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False):
     """Next-event estimation at surfaces s (n): one light sample each, MIS-weighted against BSDF sampling
-    (delta lights weight 1), one shadow ray. Radiance (3, n), times ``throughput`` (3, n) if given."""
+    (delta lights weight 1), one shadow ray. Radiance (3, n), times ``throughput`` (3, n) if given. With
+    ``diffuse`` also the part reflected by the diffuse lobe alone: (radiance, diffuse part)."""
     n = len(s)
     out = np.zeros((3, n), np.float32)
     if ctx.lights.empty or n == 0:
-        return out
+        return (out, out.copy()) if diffuse else out
     ls = ctx.lights.sample(s.p, rng.random((4, n), dtype=np.float32))
     wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
     f, pdf_b = eval_view(s.view, s.wo_l, wi_l)
@@ -178,12 +179,21 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
     if throughput is not None:
         contrib *= throughput
     live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (vmax(contrib) > 0))
+    lv = live
     if live.size:
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), cols(ls.pos, live), cols(ls.wi, live),
                                   ls.dist[live])
         lv = live[~ctx.geom_accel.occluded(so, sd, far)]
         out[:, lv] = finite(cols(contrib, lv))
-    return out
+    if not diffuse:
+        return out
+    out_d = np.zeros((3, n), np.float32)
+    if lv.size:
+        valid = (wi_l[2, lv] > 0) & (s.view.co[lv] > 0)
+        kd = np.take(s.view.kd, lv, axis=1) * valid
+        out_d[:, lv] = finite(kd * cols(ls.le, lv) * (np.abs(wi_l[2, lv]) * w[lv] /
+                                                       np.maximum(ls.pdf[lv], np.float32(1e-30))))
+    return out, out_d
 
 
 @dataclass
@@ -225,7 +235,8 @@ class FirstBounce:
     x2 ``p`` (3, k), its geometric normal ``n2`` (3, k) turned toward the primary surface, its BSDF parameters
     ``params`` (bsdf.SurfaceParams, k) and ``lo`` (3, k) the radiance leaving x2 toward the primary surface
     estimated by the rest of the path (next-event estimation at x2 and bounces 2..max_bounces; not x2's own
-    emission, which is the primary surface's direct light). The path tracer's indirect light is
+    emission, which is the primary surface's direct light), ``lo_d`` (3, k) the part of it x2's diffuse lobe
+    reflects (the same light samples weighed by the diffuse lobe alone). The path tracer's indirect light is
     throughput · lo."""
 
     rows: np.ndarray
@@ -235,6 +246,7 @@ class FirstBounce:
     n2: np.ndarray
     params: SurfaceParams
     lo: np.ndarray
+    lo_d: np.ndarray = None
 
 
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
@@ -252,25 +264,44 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     lamps = ctx.scene.lamps
     world = ctx.scene.world_radiance.astype(np.float32)[:, None]
     first = None
+    dthr = None  # with first_bounce, after x2's BSDF sample: the throughput through x2's diffuse lobe alone
     for bounce in range(ctx.max_bounces + 1):
         target = direct if bounce == 0 else (indirect if first is None else first.lo)
-        if bounce > 0:
+        if bounce == 1 and first is not None:  # at x2: split by lobe (throughput is 1 here)
+            ne, ne_d = next_event(ctx, s, rng, None, diffuse=True)
+            target[:, idx] += ne
+            first.lo_d[:, idx] += ne_d
+        elif bounce > 0 and dthr is not None:
+            ne = next_event(ctx, s, rng, None)
+            target[:, idx] += ne * throughput
+            first.lo_d[:, idx] += ne * dthr
+        elif bounce > 0:
             target[:, idx] += next_event(ctx, s, rng, throughput)
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -------
         ray = first_ray if bounce == 0 and first_ray is not None else \
             sample_rays(s, rng.random((3, len(idx)), dtype=np.float32))
         rows, wi_l, f, pdf, o, d, hits = ray.rows, ray.wi_l, ray.f, ray.pdf, ray.o, ray.d, ray.hits
         thr = cols(throughput, rows) * f
-        thr *= wi_l[2] / np.maximum(pdf, np.float32(1e-30))
+        scale = wi_l[2] / np.maximum(pdf, np.float32(1e-30))
+        thr *= scale
+        if bounce == 1 and first is not None:  # x2's diffuse lobe alone (throughput 1 before it)
+            kd = cols(s.view.kd, rows) * ((wi_l[2] > 0) & (s.view.co[rows] > 0))
+            dthr = kd * scale
+        elif dthr is not None:
+            dthr = cols(dthr, rows) * f * scale
         ok = vfinite(thr)
         if bounce + 1 >= ctx.rr_start:
             q = np.clip(vmax(thr), 0.05, 1.0)
             ok &= rng.random(len(rows), dtype=np.float32) < q
             thr /= q
+            if dthr is not None:
+                dthr /= q
         keep = np.flatnonzero(ok)
         if keep.size == 0:
             break
         idx, throughput, prev_pdf = idx[rows[keep]], cols(thr, keep), pdf[keep]
+        if dthr is not None:
+            dthr = cols(dthr, keep)
         o, d = cols(o, keep), cols(d, keep)
         if hits is None:
             hits = ctx.geom_accel.intersect(o, d)
@@ -283,11 +314,16 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             sel = np.flatnonzero(lh.prim >= 0)
             if sel.size:
                 le, pl = _lamp_emission(ctx, lh, o, d, sel)
-                target[:, idx[sel]] += finite(cols(throughput, sel) * le * power_heuristic(prev_pdf[sel], pl))
+                le *= power_heuristic(prev_pdf[sel], pl)
+                target[:, idx[sel]] += finite(cols(throughput, sel) * le)
+                if dthr is not None:
+                    first.lo_d[:, idx[sel]] += finite(cols(dthr, sel) * le)
         hit = hits.prim >= 0
         esc = np.flatnonzero(~hit)
         if esc.size:  # film transparency affects camera rays only
             target[:, idx[esc]] += finite(cols(throughput, esc) * world)
+            if dthr is not None:
+                first.lo_d[:, idx[esc]] += finite(cols(dthr, esc) * world)
         hsel = np.flatnonzero(hit)
         if hsel.size == 0:
             break
@@ -301,15 +337,20 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
                 cos_l = -dot(cols(d, hs), cols(ctx.geom_ng_rows, hp[em]))
                 le *= (cos_l > 0) | ctx.lights.tri_two_sided[light[em]]
                 pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
-                target[:, idx[hs]] += finite(cols(throughput, hs) * le * power_heuristic(prev_pdf[hs], pl))
+                le *= power_heuristic(prev_pdf[hs], pl)
+                target[:, idx[hs]] += finite(cols(throughput, hs) * le)
+                if dthr is not None:
+                    first.lo_d[:, idx[hs]] += finite(cols(dthr, hs) * le)
         if bounce == ctx.max_bounces:
             break
         idx, throughput = idx[hsel], cols(throughput, hsel)
+        if dthr is not None:
+            dthr = cols(dthr, hsel)
         s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], cols(o, hsel), cols(d, hsel), hits.t[hsel])
         if bounce == 0 and first_bounce:
             # from here on the path estimates the radiance leaving x2: throughput 1, accumulated per first hit
             first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.ng, s.params,
-                                np.zeros((3, len(idx)), np.float32))
+                                np.zeros((3, len(idx)), np.float32), np.zeros((3, len(idx)), np.float32))
             idx = np.arange(len(idx))
             throughput = np.ones((3, len(idx)), np.float32)
     if not first_bounce:
@@ -317,9 +358,11 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     if first is None:
         first = FirstBounce(np.zeros(0, np.int64), np.zeros((3, 0), np.float32), np.zeros(0, np.float32),
                             np.zeros((3, 0), np.float32), np.zeros((3, 0), np.float32),
-                            ctx.material_params.take(np.zeros(0, np.intp)), np.zeros((3, 0), np.float32))
+                            ctx.material_params.take(np.zeros(0, np.intp)), np.zeros((3, 0), np.float32),
+                            np.zeros((3, 0), np.float32))
     else:
         first.lo = finite(first.lo)
+        first.lo_d = finite(first.lo_d)
         indirect[:, first.rows] = first.throughput * first.lo
     return direct, indirect, first
 

@@ -95,6 +95,7 @@ class RenderSettings:
     gi_confidence_cap: float = gi.GISettings.confidence_cap
     gi_max_age: int = gi.GISettings.max_age  # frames a GI sample may be reused for
     gi_roughness_threshold: float = gi.GISettings.roughness_threshold
+    gi_target: str = "INTEGRAND"  # GI target function (gi.GI_TARGETS); the alternative is kept for measurements only
 
 
 def coverage_samples(setting: int, lights, lamps) -> tuple[int, str]:
@@ -238,7 +239,7 @@ class FrameRenderer:
                 self.gi_spatial = reuse.SpatialSettings(self.gi.neighbors, self.gi.radius, self.gi.passes,
                                                         settings.bias_correction)
                 unbiased = settings.bias_correction == "UNBIASED"
-                self.gi_space = gi.GISpace(self.ctx.geom_accel if unbiased else None)
+                self.gi_space = gi.GISpace(self.ctx.geom_accel if unbiased else None, settings.gi_target)
                 lights, lamps = self.ctx.lights, self.ctx.scene.lamps
                 # any change of what emits light (a lamp moved, switched, re-coloured) drops the GI history:
                 # its cached radiance would be stale
@@ -435,7 +436,8 @@ class FrameRenderer:
                     ShadingTerms.of_surfaces(surf, block)
                 c.glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
                 t = gi.diffuse_only(ShadingTerms(block), c.glossy)
-                c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi.roughness_threshold)
+                c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi.roughness_threshold,
+                                                  self.gi_space)
 
         with clock.stage("paths"):
             self._map(paths, chunks, stop)

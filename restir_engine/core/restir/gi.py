@@ -14,10 +14,13 @@ another pixel keeps x2 (the reconnection shift); in solid angle its Jacobian is
 (:func:`reconnection_jacobian`). An area-measure W already contains it: W_ω at q = W_area · cos φ_q / d_q²
 = W_ω at r · |J|, so reuse.py merges GI reservoirs unchanged and no Jacobian is applied anywhere.
 
-Caching Lo assumes x2 reflects the same radiance toward every receiver (Lambertian): a sample whose x2 is
-glossy (roughness below the threshold, or mostly specular) is not put in a reservoir; its path-traced value
-goes to the pixel directly. At a glossy x1 the reservoirs resample the diffuse lobe only and the specular
-lobe keeps the path-traced sample: f = f_d + f_s splits the integral exactly.
+Caching Lo assumes x2 reflects the same radiance toward every receiver (Lambertian). So the path splits the
+light leaving x2 by lobe (pathtracer.FirstBounce.lo_d: the same light samples weighed by x2's diffuse lobe
+alone): only that diffuse part is cached and reused; the specular part (all of it on metals) goes to the pixel
+as the path traced it. The split is exact; the one approximation left is the Principled diffuse lobe's Fresnel
+weight 1 − F(cos θ) at x2, taken at the direction the sample was made for (Diffuse BSDF: exact). At a glossy x1
+(roughness below the threshold) the reservoirs resample the diffuse lobe only and the specular lobe keeps the
+path-traced sample: f = f_d + f_s splits the integral exactly there too.
 
 Unbiased reuse (pairwise MIS) needs the neighbour's target at the canonical sample to be zero where the
 neighbour could not have found it: a shadow ray from the neighbour's x1 to the sample (``evaluate_mis``).
@@ -38,8 +41,8 @@ from ..sampling import cols, dot, finite, norm, to_local, vmax
 from .reservoir import Reservoirs
 
 INDIRECT_METHODS = ("OFF", "PATH", "RESTIR_GI")
+GI_TARGETS = ("INTEGRAND", "RADIANCE")  # p̂ = lum(f · Lo) |cos θ1| G  or  lum(Lo) G (measured: docs/RESULTS.md)
 JACOBIAN_LIMIT = 10.0  # biased mode: shifts whose |J| is outside [1/10, 10] are rejected (as RTXDI's sample app)
-DIFFUSE_SHARE = 0.5  # x2 with a specular sampling share above this is glossy (its Lo depends on direction)
 
 
 class GIReservoirs(Reservoirs):
@@ -54,7 +57,7 @@ class GIReservoirs(Reservoirs):
 class GISettings:
     """ReSTIR GI stages: spatial neighbours / radius (pixels, 0 = automatic) / passes, confidence cap (the
     largest M a reused reservoir keeps), max sample age (frames), roughness threshold (below it x1 resamples its
-    diffuse lobe only and x2 is not cached)."""
+    diffuse lobe only; its specular lobe keeps the path-traced sample)."""
 
     neighbors: int = 3
     radius: float = 0.0
@@ -84,11 +87,6 @@ def glossy_x1(params, threshold: float) -> np.ndarray:
     return (params.alpha < np.float32(threshold) ** 2) & (params.spec_on > 0)
 
 
-def cacheable_x2(params, threshold: float) -> np.ndarray:
-    """(n,) bool: secondary surfaces whose outgoing radiance may be cached (rough enough and mostly diffuse)."""
-    return (params.spec_on == 0) | ((params.alpha >= np.float32(threshold) ** 2) & (params.p_spec <= DIFFUSE_SHARE))
-
-
 def diffuse_only(terms, glossy: np.ndarray):
     """The target terms with the specular lobe switched off where ``glossy`` (in place: spec_on row)."""
     if glossy.any():
@@ -97,28 +95,39 @@ def diffuse_only(terms, glossy: np.ndarray):
     return terms
 
 
-def initial(first, terms, n: int, glossy: np.ndarray, threshold: float):
+def radiance_target(terms, pts: PackedPoints) -> np.ndarray:
+    """The alternative target lum(Lo) · cos φ2 / d² (area measure), zero where f · cos θ1 is (below x1's horizon)
+    or x2 faces away: the BSDF at x1 left out."""
+    d = pts.pos - terms.p
+    d2 = np.maximum(dot(d, d), np.float32(1e-30))
+    cl = -dot(d, pts.normal)
+    ok = (dot(d, terms.ns) > 0) & (dot(d, terms.ng) > 0) & (cl > 1e-8 * np.sqrt(d2))
+    lum = _LUM[0] * pts.le[0] + _LUM[1] * pts.le[1] + _LUM[2] * pts.le[2]
+    return (lum * cl / (d2 * np.sqrt(d2)) * ok).astype(np.float32)
+
+
+def initial(first, terms, n: int, glossy: np.ndarray, threshold: float, space=None):
     """One GI reservoir per primary surface (n) from its first bounce (pathtracer.FirstBounce), and the part of
-    the path-traced indirect light (3, n) the reservoirs do not carry: the specular lobe at glossy x1
-    (``glossy`` (n,) bool), and every sample whose x2 cannot be cached. ``terms``: the GI target terms of the n
-    surfaces (specular lobe off where glossy). A reservoir holds its one candidate: M = 1, W = 1 / p_area with
-    p_area = p_ω · cos φ2 / d² the pdf of x2 in area measure."""
+    the path-traced indirect light (3, n) the reservoirs do not carry: the light x2's specular lobe sent, and the
+    specular lobe at glossy x1 (``glossy`` (n,) bool). ``terms``: the GI target terms of the n surfaces (specular
+    lobe off where glossy). A reservoir holds its one candidate, x2 with its diffuse light lo_d: M = 1,
+    W = 1 / p_area with p_area = p_ω · cos φ2 / d² the pdf of x2 in area measure."""
     res = GIReservoirs.empty(n)
     res.M[:] = 1.0
     rest = np.zeros((3, n), np.float32)
     rows = first.rows
     if rows.size == 0:
         return res, rest
-    keep = cacheable_x2(first.params, threshold)
+    lo_d = first.lo_d
     here = terms.take(rows)
-    pts = PackedPoints(first.p, first.n2, first.lo, np.zeros(len(rows), np.float32), np.zeros(len(rows), bool))
-    p_hat = here.evaluate(pts, want_pdf=False)[0]
+    pts = PackedPoints(first.p, first.n2, lo_d, np.zeros(len(rows), np.float32), np.zeros(len(rows), bool))
+    p_hat = (space or GISpace()).evaluate(here, pts)
     d = first.p - here.p
     d2 = dot(d, d)
     cos2 = -dot(d, first.n2) / np.sqrt(np.maximum(d2, 1e-30))
     p_area = first.pdf * cos2 / np.maximum(d2, 1e-30)
-    ok = keep & (p_hat > 0) & (p_area > 0)
-    # what the reservoir does not carry: all of a non-cacheable sample, the specular lobe at a glossy x1
+    ok = (p_hat > 0) & (p_area > 0)
+    # what the reservoir does not carry: x2's specular light, all of a sample it cannot hold, x1's specular lobe
     carried = first.throughput * ok
     g = glossy[rows] & ok
     if g.any():
@@ -126,13 +135,13 @@ def initial(first, terms, n: int, glossy: np.ndarray, threshold: float):
         ci = np.maximum(dot(cols(d, np.flatnonzero(g)), cols(here.ns, np.flatnonzero(g))), 0.0) / \
             np.sqrt(np.maximum(d2[g], 1e-30))
         carried[:, g] = kd_t * (ci / np.maximum(first.pdf[g], 1e-30))
-    rest[:, rows] = finite((first.throughput - carried) * first.lo)
+    rest[:, rows] = finite(first.throughput * (first.lo - lo_d) + (first.throughput - carried) * lo_d)
     sel = np.flatnonzero(ok)
     r = rows[sel]
     res.age[r] = 0
     res.x[r], res.y[r], res.z[r] = first.p[0, sel], first.p[1, sel], first.p[2, sel]
     res.nx[r], res.ny[r], res.nz[r] = first.n2[0, sel], first.n2[1, sel], first.n2[2, sel]
-    res.lr[r], res.lg[r], res.lb[r] = first.lo[0, sel], first.lo[1, sel], first.lo[2, sel]
+    res.lr[r], res.lg[r], res.lb[r] = lo_d[0, sel], lo_d[1, sel], lo_d[2, sel]
     res.p_hat[r] = p_hat[sel]
     res.W[r] = 1.0 / p_area[sel]
     return res, rest
@@ -157,8 +166,11 @@ class GISpace:
 
     kind = GIReservoirs
 
-    def __init__(self, accel=None):
+    def __init__(self, accel=None, target: str = "INTEGRAND"):
+        if target not in GI_TARGETS:
+            raise ValueError(f"unknown GI target {target!r}; available: {GI_TARGETS}")
         self.accel = accel
+        self.target_kind = target
 
     @staticmethod
     def prepare(res: GIReservoirs) -> np.ndarray:
@@ -168,8 +180,9 @@ class GISpace:
     def gather(prepared: np.ndarray, idx) -> PackedPoints:
         return PackedPoints.of(prepared[:, idx] if isinstance(idx, slice) else np.take(prepared, idx, axis=1))
 
-    @staticmethod
-    def evaluate(terms, pts: PackedPoints) -> np.ndarray:
+    def evaluate(self, terms, pts: PackedPoints) -> np.ndarray:
+        if self.target_kind == "RADIANCE":
+            return radiance_target(terms, pts)
         return terms.evaluate(pts, want_pdf=False)[0]
 
     def target(self, terms, prepared, idx) -> np.ndarray:
