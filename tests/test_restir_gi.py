@@ -82,8 +82,8 @@ def _runs(scene, seeds, frames=1, bounces=1, samples=1, **kw):
 @pytest.fixture(scope="module")
 def room():
     """The regression room with its tiny light 100x dimmer and its metal block at roughness 0.5 (not 0.2): as built,
-    light reflected by the block is path-traced in both estimators (x2 on a glossy metal is not cached) and its
-    fireflies (one image mean 9x the average in 300) make a standard error from a few hundred repetitions
+    light reflected by the block is path-traced in both estimators (a metal's light is specular, never cached)
+    and its fireflies (one image mean 9x the average in 300) make a standard error from a few hundred repetitions
     unreliable. Mirror-like surfaces are tested in the closed room below."""
     scene = regression_room(48, 36)
     scene.materials.emission[5] = 30.0
@@ -170,11 +170,11 @@ def _box_room(floor: dict, wall: dict, width=40, height=30, divider=False):
 @pytest.mark.parametrize("floor", [
     {"base_color": (0.9, 0.9, 0.9), "roughness": 0.05, "metallic": 1.0},   # mirror: x1 glossy, x2 glossy
     {"base_color": (0.6, 0.6, 0.6), "roughness": 0.15, "f0": 0.04},        # glossy dielectric below the threshold
-    {"base_color": (0.8, 0.5, 0.3), "roughness": 0.5, "metallic": 1.0},    # rough metal (x2 not cached)
+    {"base_color": (0.8, 0.5, 0.3), "roughness": 0.5, "metallic": 1.0},    # rough metal (its light is not cached)
 ], ids=["mirror", "glossy_dielectric", "rough_metal"])
 def test_glossy_and_mirror_surfaces_stay_unbiased(floor):
-    """Glossy primary surfaces resample their diffuse lobe only and glossy secondary surfaces are not cached: the
-    unbiased mode must still agree with the path tracer (5 standard errors per quarter; 60 runs of 8 samples each,
+    """Glossy primary surfaces resample their diffuse lobe only, and only the diffuse part of the light leaving a
+    secondary surface is cached (its specular part stays path traced): the unbiased mode must still agree with the path tracer (5 standard errors per quarter; 60 runs of 8 samples each,
     able to see a 5 % bias)."""
     scene = _box_room(floor, {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}, 48, 36)
     ref = _runs(scene, range(500, 560), bounces=2, samples=8, indirect_method="PATH")
