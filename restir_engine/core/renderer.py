@@ -34,12 +34,11 @@ from . import pathtracer
 from .accel import in_worker, pool, thread_count
 from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
-from .context_cache import context_for
+from .context_cache import context_for, fingerprint
 from .direct_choice import choose_direct_method
 from .light_blocks import BlockLightTiles
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
 from .profile import NullClock
-from .context_cache import fingerprint
 from .restir import di, gi, reuse
 from .restir.gbuffer import GBuffer
 from .restir.history import TemporalHistory
@@ -436,12 +435,11 @@ class FrameRenderer:
                     ShadingTerms.of_surfaces(surf, block)
                 c.glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
                 t = gi.diffuse_only(ShadingTerms(block), c.glossy)
-                c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi.roughness_threshold,
-                                                  self.gi_space)
+                c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi_space)
 
         with clock.stage("paths"):
             self._map(paths, chunks, stop)
-        gb = res = gi_res = gb_gi = None
+        gb = res = gi_res = gb_gi = gi_history = None
         if reusing or gi_on:
             with clock.stage("gbuffer"):
                 gb = self._gbuffer(chunks, terms if reusing else gi_terms)
@@ -461,7 +459,7 @@ class FrameRenderer:
                 for c in chunks:
                     gi_res.assign(c.surfaces, c.gi_res)
                     c.gi_res = None
-            gi_res = self._reuse_gi(gb_gi, gi_res, s, stop)
+            gi_res, gi_history = self._reuse_gi(gb_gi, gi_res, s, stop)
             for c in chunks:
                 c.gi_res = gi_res.take(c.surfaces)
         if s == 0 and gb is not None:  # the next frame's history; confidence at most the cap, so no reused M exceeds it
@@ -469,8 +467,8 @@ class FrameRenderer:
             self.history = TemporalHistory(
                 gb, None if res is None else res.replace(M=np.minimum(res.M, st.confidence_cap)), ctx.scene.camera,
                 lights.signature, st.frame, lights.light_uid, lights.uid_space,
-                gi_res=None if gi_res is None else gi.age_history(self.gi_history_res.replace(
-                    M=np.minimum(self.gi_history_res.M, np.float32(self.gi.confidence_cap))), self.gi.max_age),
+                gi_res=None if gi_history is None else gi.age_history(gi_history.replace(
+                    M=np.minimum(gi_history.M, np.float32(self.gi.confidence_cap))), self.gi.max_age),
                 gi_terms=None if gb_gi is None else gb_gi.terms, gi_key=self.gi_light_key if gi_on else None)
 
         def shade(c: _Chunk):
@@ -535,7 +533,8 @@ class FrameRenderer:
         return res
 
     def _reuse_gi(self, gb: GBuffer, res, s: int, stop):
-        """ReSTIR GI: temporal (first pass of a frame, with a GI history) and spatial passes, as :meth:`_reuse`."""
+        """ReSTIR GI: temporal (first pass of a frame, with a GI history) and spatial passes, as :meth:`_reuse`.
+        Returns (the final reservoirs, the reservoirs before the spatial passes: the next frame's history)."""
         st = self.settings
         hist = self.prev_history
         if st.temporal_reuse and s == 0 and hist is not None and hist.gi_res is not None:
@@ -548,13 +547,13 @@ class FrameRenderer:
         # the next frame's history is taken before the spatial passes: on the regression room (4 frames, 4 passes)
         # the per-pixel variance is 0.34x the path tracer's this way against 0.57x when the spatially merged
         # reservoirs are fed back (their neighbours' samples are correlated with the next frame's spatial pass)
-        self.gi_history_res = res
+        history = res
         for k in range(self.gi.passes if self.gi.neighbors else 0):
             res = self._spatial(self.gi_space, gb, res, self.gi_spatial, STREAM_GI_SPATIAL + k, s, stop, "gi_spatial")
             res = self._gi_visible(gb, res, stop, "gi_spatial")
         if len(res.M):
             self.reuse_stats["gi_final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
-        return res
+        return res, history
 
     def _gi_visible(self, gb, res, stop, stage):
         """Unbiased mode: empty the GI samples their surfaces cannot see (gi.clear_occluded), one ray per pixel.

@@ -106,7 +106,7 @@ def radiance_target(terms, pts: PackedPoints) -> np.ndarray:
     return (lum * cl / (d2 * np.sqrt(d2)) * ok).astype(np.float32)
 
 
-def initial(first, terms, n: int, glossy: np.ndarray, threshold: float, space=None):
+def initial(first, terms, n: int, glossy: np.ndarray, space=None):
     """One GI reservoir per primary surface (n) from its first bounce (pathtracer.FirstBounce), and the part of
     the path-traced indirect light (3, n) the reservoirs do not carry: the light x2's specular lobe sent, and the
     specular lobe at glossy x1 (``glossy`` (n,) bool). ``terms``: the GI target terms of the n surfaces (specular
