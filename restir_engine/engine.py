@@ -151,7 +151,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
                                                                   "coverage_samples", "coverage_reason",
                                                                   "spatial_radius", "indirect_method",
-                                                                  "gi_spatial_radius")}
+                                                                  "gi_spatial_radius", "gi_skipped_passes")}
+        LAST_CHOICES[scene.name]["samples"] = result.samples_done
         LAST_FRAME_STATS.clear()
         LAST_FRAME_STATS.update(export_seconds=t_export, core_seconds=result.seconds, samples=result.samples_done,
                                 frame=scene.frame_current, cancelled=result.cancelled, **result.stats)

@@ -297,3 +297,19 @@ def test_bright_tiny_emitter_and_glossy_caustics_stay_finite():
             # own 1 + history (cap 20) before 4 spatial passes of 3 neighbours: at most 21 * 4**4
             assert m.max() <= 21 * 4 ** 4
         assert np.isfinite(hist.gi_res.W).all() and (hist.gi_res.M <= 20).all()
+
+
+def test_passes_with_nothing_to_cache_keep_the_path_traced_light(room):
+    """A plane under a constant world: its bounce rays find nothing but the world, the GI reservoirs would carry
+    none of the indirect light, so every pass keeps the path tracer's (the same image as Indirect Method Path
+    Tracing, same seed) and says so; the room, whose bounces land on walls, keeps ReSTIR GI."""
+    from scenes_core import plane_under_world
+    scene = plane_under_world(width=24)
+    st = dict(samples=3, max_bounces=2, seed=4, integrator="RESTIR", direct_method="LIGHT_SAMPLING")
+    gi_run = render_frame(scene, RenderSettings(**st, indirect_method="RESTIR_GI"))
+    path_run = render_frame(scene, RenderSettings(**st, indirect_method="PATH"))
+    assert gi_run.stats["gi_skipped_passes"] == 3 and gi_run.stats["indirect_method"] == "PATH"
+    assert np.array_equal(gi_run.passes["Combined"], path_run.passes["Combined"])
+    r = render_frame(room, RenderSettings(**st, indirect_method="RESTIR_GI"))
+    assert r.stats["gi_skipped_passes"] == 0 and r.stats["indirect_method"] == "RESTIR_GI"
+    assert r.stats["reuse"]["gi_share"] > 0.5

@@ -34,6 +34,7 @@ from . import pathtracer
 from .accel import in_worker, pool, thread_count
 from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
+from .bsdf import luminance_rows
 from .context_cache import context_for, fingerprint
 from .direct_choice import choose_direct_method
 from .light_blocks import BlockLightTiles
@@ -115,6 +116,7 @@ def coverage_samples(setting: int, lights, lamps) -> tuple[int, str]:
 
 
 AUTO_COVERAGE = 4
+GI_MIN_SHARE = 0.05  # a pass whose GI reservoirs would carry less of its indirect light skips GI reuse
 GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's: 6 px at 640x360 (measured on interior_gi:
 #                          relMSE 0.23 at 5 px, 0.29 at 8, 0.71 at 16 with 4 passes, 1 spp)
 MANY_COVERAGE = 16
@@ -178,6 +180,8 @@ class _Chunk:
     direct: np.ndarray = None
     indirect: np.ndarray = None
     gi_res: object = None  # gi.GIReservoirs of its surfaces
+    path_indirect: np.ndarray = None  # the path tracer's indirect light (used when a pass skips GI reuse)
+    gi_share: tuple = (0.0, 0.0)  # luminance sums: (path-traced indirect light, the part the reservoirs carry)
     glossy: np.ndarray = None  # (surfaces,) bool: GI resamples only the diffuse lobe there (gi.glossy_x1)
 
     @property
@@ -267,6 +271,7 @@ class FrameRenderer:
             self.acc["gi_m"], self.acc["gi_w"] = _BUFFERS.zeros((h, w)), _BUFFERS.zeros((h, w))
         self.samples_done = 0
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
+        self.gi_skipped = 0  # sample passes that kept path-traced indirect light (GI_MIN_SHARE)
         self.reuse_stats = {}  # the last pass's temporal acceptance and confidence (diagnostics)
         self.used_tiles = False
         self._data = None
@@ -435,10 +440,26 @@ class FrameRenderer:
                     ShadingTerms.of_surfaces(surf, block)
                 c.glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
                 t = gi.diffuse_only(ShadingTerms(block), c.glossy)
+                c.path_indirect = c.indirect
                 c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi_space)
+                total = float(luminance_rows(c.path_indirect).sum())
+                c.gi_share = (total, total - float(luminance_rows(c.indirect).sum()))
 
         with clock.stage("paths"):
             self._map(paths, chunks, stop)
+        if gi_on:
+            # GI reuse only pays where its reservoirs carry the indirect light: a scene with no bounce light to
+            # cache (the default cube: nothing for its rays to hit) keeps the path-traced indirect light as it is
+            total = sum(c.gi_share[0] for c in chunks)
+            share = sum(c.gi_share[1] for c in chunks) / total if total > 0 else 0.0
+            self.reuse_stats["gi_share"] = share
+            if share < GI_MIN_SHARE:
+                gi_on = False
+                self.gi_skipped += 1
+                for c in chunks:
+                    c.indirect, c.gi_res = c.path_indirect, None
+            for c in chunks:
+                c.path_indirect = None
         gb = res = gi_res = gb_gi = gi_history = None
         if reusing or gi_on:
             with clock.stage("gbuffer"):
@@ -708,8 +729,9 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
              "direct_method": fr.method, "direct_reason": fr.method_reason,
              "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None, "reuse": dict(fr.reuse_stats),
              "coverage_reason": fr.coverage_reason,
-             "indirect_method": ("RESTIR_GI" if fr.gi is not None else
-                                 "OFF" if ctx.max_bounces == 0 else "PATH"),
+             "indirect_method": ("OFF" if ctx.max_bounces == 0 else "PATH" if fr.gi is None or
+                                 fr.gi_skipped == fr.samples_done else "RESTIR_GI"),
+             "gi_skipped_passes": fr.gi_skipped,
              "gi_spatial_radius": fr.gi.radius if fr.gi is not None else None}
     if clock is not None:
         stats["stages"] = clock.stages

@@ -136,6 +136,10 @@ class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
             return
         if s.max_bounces == 0:
             layout.label(text="Max Bounces is 0: there is no indirect light", icon="INFO")
+        last = _last_choices(context.scene)
+        if last and last.get("gi_skipped_passes"):
+            layout.label(text=f"Last render: path-traced indirect light in {last['gi_skipped_passes']} of "
+                              f"{last.get('samples', '?')} passes (almost no bounce light to cache)", icon="INFO")
         if s.direct_method in ("RESTIR", "AUTO"):
             layout.label(text="Temporal reuse and bias correction: as set for direct light")
         else:  # the shared settings are not drawn above for these direct methods
@@ -148,7 +152,6 @@ class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
         col = layout.column(align=True, heading="Spatial Reuse")
         col.prop(s, "gi_spatial_neighbors")
         col.prop(s, "gi_spatial_radius")
-        last = _last_choices(context.scene)
         if s.gi_spatial_radius == 0 and last and last.get("gi_spatial_radius"):
             col.label(text=f"Auto radius in the last render: {last['gi_spatial_radius']:.1f} px")
         col.prop(s, "gi_spatial_passes")
