@@ -38,6 +38,7 @@ from ..accel import shadow_rays
 from ..bsdf import eval_view
 from ..light_tiles import PackedPoints
 from ..sampling import cols, dot, finite, norm, to_local, vmax
+from ..target import LUM as _LUM
 from .reservoir import Reservoirs
 
 INDIRECT_METHODS = ("OFF", "PATH", "RESTIR_GI")
@@ -146,8 +147,6 @@ def initial(first, terms, n: int, glossy: np.ndarray, space=None):
     res.W[r] = 1.0 / p_area[sel]
     return res, rest
 
-
-_LUM = np.array([0.2126, 0.7152, 0.0722], np.float32)
 
 
 def _points(res: GIReservoirs, idx=None) -> np.ndarray:
