@@ -20,50 +20,22 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 
-import numpy as np  # noqa: E402
+sys.path.insert(0, os.path.join(ROOT, "tests"))
 
+from harness.metrics import rel_mse  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
-from restir_engine.core.scene import Camera, Lamps, MaterialTable, Scene, TriangleSet  # noqa: E402
+from scenes_core import bounce_room  # noqa: E402
 
 ROUGHNESS = (0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0)
 
 
-def _quad(center, u, v):
-    c, u, v = (np.asarray(a, np.float32) for a in (center, u, v))
-    p = [c - u - v, c + u - v, c + u + v, c - u + v]
-    return np.array([[p[0], p[1], p[2]], [p[0], p[2], p[3]]], np.float32)
+WALL = {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}
 
 
-def _camera(eye, target, width, height, fov_y_deg=70.0, near=0.05, far=100.0) -> Camera:
-    eye, target = np.asarray(eye, float), np.asarray(target, float)
-    f = target - eye
-    f /= np.linalg.norm(f)
-    r = np.cross(f, [0, 0, 1.0])
-    r /= np.linalg.norm(r)
-    u = np.cross(r, f)
-    c2w = np.eye(4)
-    c2w[:3, 0], c2w[:3, 1], c2w[:3, 2], c2w[:3, 3] = r, u, -f, eye
-    t = 1.0 / np.tan(np.radians(fov_y_deg) / 2)
-    proj = np.array([[t * height / width, 0, 0, 0], [0, t, 0, 0],
-                     [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1, 0]])
-    return Camera(c2w, np.linalg.inv(proj), width, height, (0, 0, width, height), clip_start=near, clip_end=far)
-
-
-def room(floor: dict, width=96, height=72) -> Scene:
-    """A closed 3 x 3 x 2 m room (white Lambert walls) with a panel lying on its floor; the floor material given."""
-    wall = {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}
-    mats = MaterialTable.build([floor, wall, {"base_color": (0, 0, 0), "f0": 0.0, "emission": (10.0, 10.0, 10.0)}])
-    quads = [((0, 0, 0), (1.5, 0, 0), (0, 1.5, 0), 0), ((0, 0, 2), (0, 1.5, 0), (1.5, 0, 0), 1),
-             ((0, 1.5, 1), (0, 0, 1), (1.5, 0, 0), 1), ((0, -1.5, 1), (1.5, 0, 0), (0, 0, 1), 1),
-             ((-1.5, 0, 1), (0, 1.5, 0), (0, 0, 1), 1), ((1.5, 0, 1), (0, 0, 1), (0, 1.5, 0), 1),
-             ((0.8, 0.8, 0.05), (0.25, 0, 0), (0, 0.25, 0), 2)]
-    verts = np.concatenate([_quad(c, u, v) for c, u, v, _m in quads])
-    material = np.concatenate([np.full(2, m, np.int32) for *_x, m in quads])
-    ng = np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0])
-    ng /= np.linalg.norm(ng, axis=1)[:, None]
-    geom = TriangleSet(verts, np.repeat(ng[:, None], 3, axis=1).astype(np.float32), material)
-    cam = _camera((0.0, -1.45, 1.0), (0.0, 0.5, 0.4), width, height)
-    return Scene(geom, mats, Lamps.empty(), cam, world_radiance=np.zeros(3, np.float32))
+def room(floor: dict, width=96, height=72):
+    """The closed room of tests/scenes_core.bounce_room (white Lambert walls, a panel on the floor), the floor
+    material given, the camera looking a little lower than the tests' (more floor in view)."""
+    return bounce_room(floor, WALL, width, height, look_at=(0.0, 0.5, 0.4))
 
 
 def _indirect(scene, spp, seed, **kw):
@@ -71,11 +43,6 @@ def _indirect(scene, spp, seed, **kw):
     r = render_frame(scene, RenderSettings(samples=spp, max_bounces=1, seed=seed, integrator="RESTIR",
                                            direct_method="LIGHT_SAMPLING", **kw))
     return r.passes["Indirect"], time.perf_counter() - t0
-
-
-def rel_mse(x, ref, eps=0.01):
-    lx, lr = x.mean(axis=2), ref.mean(axis=2)
-    return float(np.mean((lx - lr) ** 2 / (lr ** 2 + eps)))
 
 
 def roughness(out, ref_spp, spp):

@@ -145,3 +145,35 @@ def _quad_uvs(n: int) -> np.ndarray:
     """UVs of quads built by :func:`quad` (two triangles each) spanning the unit square."""
     pair = np.array([[[0, 0], [1, 0], [1, 1]], [[0, 0], [1, 1], [0, 1]]], np.float32)
     return np.tile(pair, (n // 2, 1, 1))
+
+
+def bounce_room(floor: dict, wall: dict, width=40, height=30, divider=False, look_at=(0.0, 0.5, 0.6)) -> Scene:
+    """A closed 3 x 3 x 2 m room lit by a panel lying on the floor (its light reaches the floor only after a bounce
+    off the ceiling or the walls); the floor and wall materials are given, material 3 is a grey Lambert for
+    additions. ``divider``: a 1 mm wall splits the room, open at the top, and the camera looks at the unlit side;
+    else the camera looks from the front wall at ``look_at``."""
+    mats = MaterialTable.build([floor, wall, {"base_color": (0, 0, 0), "f0": 0.0, "emission": (10.0, 10.0, 10.0)},
+                                {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}])
+    parts = [tris(quad((0, 0, 0), (1.5, 0, 0), (0, 1.5, 0)), 0),                    # floor (normal +z)
+             tris(quad((0, 0, 2), (0, 1.5, 0), (1.5, 0, 0)), 1),                    # ceiling (normal -z)
+             tris(quad((0, 1.5, 1), (0, 0, 1), (1.5, 0, 0)), 1),                    # back wall
+             tris(quad((0, -1.5, 1), (1.5, 0, 0), (0, 0, 1)), 1),                   # front wall
+             tris(quad((-1.5, 0, 1), (0, 1.5, 0), (0, 0, 1)), 1),                   # left wall
+             tris(quad((1.5, 0, 1), (0, 0, 1), (0, 1.5, 0)), 1),                    # right wall
+             tris(quad((0.8, 0.8, 0.05), (0.25, 0, 0), (0, 0.25, 0)), 2)]           # panel on the floor facing up
+    cam = perspective_camera((0.0, -1.45, 1.0), look_at, width, height, fov_y_deg=70)
+    if divider:  # x = 0.3 .. 0.301, open above z = 1.8; the camera stands in the dark half
+        parts.append(tris(quad((0.3, 0, 0.9), (0, 1.5, 0), (0, 0, 0.9)), 3))
+        parts.append(tris(quad((0.301, 0, 0.9), (0, 0, 0.9), (0, 1.5, 0)), 3))
+        cam = perspective_camera((-0.8, -1.4, 1.0), (0.3, 0.6, 0.5), width, height, fov_y_deg=70)
+    return Scene(concat(parts), mats, Lamps.empty(), cam, world_radiance=np.zeros(3, np.float32))
+
+
+def one_moving_instance(scene: Scene, instances: int, moving: int, dx: float) -> None:
+    """Give ``scene`` Blender-style instance motion: ``instances`` identity world matrices, instance ``moving``
+    displaced by ``dx`` along x in the previous frame (its position then minus now); the camera does not move."""
+    from restir_engine.core.scene import Motion
+    current = np.repeat(np.eye(4)[None], instances, axis=0)
+    prev = current.copy()
+    prev[moving, 0, 3] = dx
+    scene.motion = Motion(current, prev, current.copy(), scene.camera, scene.camera)

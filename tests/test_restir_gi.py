@@ -9,8 +9,8 @@ import pytest
 
 from restir_engine.core.renderer import RenderSettings, render_frame
 from restir_engine.core.restir.gi import GIReservoirs, age_history, reconnection_jacobian
-from restir_engine.core.scene import Lamps, MaterialTable, Scene
-from scenes_core import concat, perspective_camera, quad, regression_room, tris
+from restir_engine.core.scene import MaterialTable, Scene
+from scenes_core import bounce_room, concat, one_moving_instance, quad, regression_room, tris
 from stats import compare
 
 Z = 5.0
@@ -147,27 +147,6 @@ def test_furnace_indirect_is_exact_with_gi():
     assert abs(m.mean() - exact) < 5 * se, (m.mean(), exact, se)
 
 
-def _box_room(floor: dict, wall: dict, width=40, height=30, divider=False):
-    """A closed 3 x 3 x 2 m room lit by a panel lying on the floor (its light reaches the floor only after a bounce
-    off the ceiling or the walls); the floor and wall materials are given. ``divider``: a 1 mm wall splits
-    the room, open at the top, and the camera looks at the unlit side."""
-    mats = MaterialTable.build([floor, wall, {"base_color": (0, 0, 0), "f0": 0.0, "emission": (10.0, 10.0, 10.0)},
-                                {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}])
-    parts = [tris(quad((0, 0, 0), (1.5, 0, 0), (0, 1.5, 0)), 0),                    # floor (normal +z)
-             tris(quad((0, 0, 2), (0, 1.5, 0), (1.5, 0, 0)), 1),                    # ceiling (normal -z)
-             tris(quad((0, 1.5, 1), (0, 0, 1), (1.5, 0, 0)), 1),                    # back wall
-             tris(quad((0, -1.5, 1), (1.5, 0, 0), (0, 0, 1)), 1),                   # front wall
-             tris(quad((-1.5, 0, 1), (0, 1.5, 0), (0, 0, 1)), 1),                   # left wall
-             tris(quad((1.5, 0, 1), (0, 0, 1), (0, 1.5, 0)), 1),                    # right wall
-             tris(quad((0.8, 0.8, 0.05), (0.25, 0, 0), (0, 0.25, 0)), 2)]           # panel on the floor facing up
-    cam = perspective_camera((0.0, -1.45, 1.0), (0.0, 0.5, 0.6), width, height, fov_y_deg=70)
-    if divider:  # x = 0.3 .. 0.301, open above z = 1.8; the camera stands in the dark half
-        parts.append(tris(quad((0.3, 0, 0.9), (0, 1.5, 0), (0, 0, 0.9)), 3))
-        parts.append(tris(quad((0.301, 0, 0.9), (0, 0, 0.9), (0, 1.5, 0)), 3))
-        cam = perspective_camera((-0.8, -1.4, 1.0), (0.3, 0.6, 0.5), width, height, fov_y_deg=70)
-    return Scene(concat(parts), mats, Lamps.empty(), cam, world_radiance=np.zeros(3, np.float32))
-
-
 @pytest.mark.parametrize("floor", [
     {"base_color": (0.9, 0.9, 0.9), "roughness": 0.05, "metallic": 1.0},   # mirror: x1 glossy, x2 glossy
     {"base_color": (0.6, 0.6, 0.6), "roughness": 0.15, "f0": 0.04},        # glossy dielectric below the threshold
@@ -177,7 +156,7 @@ def test_glossy_and_mirror_surfaces_stay_unbiased(floor):
     """Glossy primary surfaces resample their diffuse lobe only, and only the diffuse part of the light leaving a
     secondary surface is cached (its specular part stays path traced): the unbiased mode must still agree with the path tracer (5 standard errors per quarter; 60 runs of 8 samples each,
     able to see a 5 % bias)."""
-    scene = _box_room(floor, {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}, 48, 36)
+    scene = bounce_room(floor, {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}, 48, 36)
     ref = _runs(scene, range(500, 560), bounces=2, samples=8, indirect_method="PATH")
     a = _runs(scene, range(60), 2, bounces=2, samples=8, indirect_method="RESTIR_GI")
     z, ma, mb, rse = compare(a, ref, 2)
@@ -190,7 +169,7 @@ def test_thin_wall_does_not_leak_in_the_unbiased_mode():
     visibility rays fail to see the wall. The unbiased mode must match the path tracer in the dark half; the biased
     mode's leak there is printed (it has no visibility test in its weights, but shading is shadowed)."""
     wall = {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}
-    scene = _box_room(wall, wall, 40, 30, divider=True)
+    scene = bounce_room(wall, wall, 40, 30, divider=True)
     ref = _runs(scene, range(700, 740), bounces=1, indirect_method="PATH")
     a = _runs(scene, range(40), 2, bounces=1, indirect_method="RESTIR_GI")
     z, ma, mb, _ = compare(a, ref, 2)
@@ -238,17 +217,13 @@ def test_samples_age_out():
 def _room_with_moving_board(x: float, prev_x: float):
     """The closed Lambert room with a 0.6 x 1 m board (instance 1) standing in it at x (prev_x in the previous
     frame), facing the camera: it carries GI samples as it moves and uncovers the wall behind it."""
-    from restir_engine.core.scene import Motion
     wall = {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}
-    scene = _box_room(wall, wall, 48, 36)
+    scene = bounce_room(wall, wall, 48, 36)
     n_static = len(scene.geometry)
     board = tris(quad((x, 0.4, 0.5), (0.3, 0, 0), (0, 0, 0.5)), 3)
     scene.geometry = concat([scene.geometry, board])
     scene.geometry.instance = np.array([0] * n_static + [1, 1], np.int32)
-    current = np.repeat(np.eye(4)[None], 2, axis=0)
-    prev = current.copy()
-    prev[1, 0, 3] = prev_x - x
-    scene.motion = Motion(current, prev, current.copy(), scene.camera, scene.camera)
+    one_moving_instance(scene, 2, 1, prev_x - x)
     return scene
 
 

@@ -4,7 +4,7 @@ with the path tracer within 5 standard errors."""
 import numpy as np
 
 from restir_engine.core.renderer import RenderSettings, render_frame
-from scenes_core import add_emitters, concat, floor_with_emitter, quad, tris
+from scenes_core import add_emitters, concat, floor_with_emitter, one_moving_instance, quad, tris
 
 RESTIR = dict(max_bounces=0, integrator="RESTIR", direct_method="RESTIR", light_candidates=4, spatial_radius=6)
 
@@ -90,17 +90,13 @@ def _occluder_scene(x: float, prev_x: float):
     """Floor under an emitter at 1 m, seen from above; a 50x50 cm board (instance 2) at 45 cm, at x (prev_x
     in the previous frame: object motion from Blender-style instance matrices), and a second, small lamp at
     20 cm beside it, which the floor sees and the board's top never can."""
-    from restir_engine.core.scene import Motion
     scene = floor_with_emitter(width=32)
     (lamp,) = add_emitters(scene, [(40.0,) * 3])
     low_lamp = tris(quad((0.0, 0.4, 0.15), (0, 0.1, 0), (0.1, 0, 0)), lamp)
     board = tris(quad((x, 0.0, 0.45), (0.25, 0, 0), (0, 0.25, 0)), 0)
     scene.geometry = concat([scene.geometry, low_lamp, board])
     scene.geometry.instance = np.array([0, 0, 1, 1, 1, 1, 2, 2], np.int32)
-    current = np.repeat(np.eye(4)[None], 3, axis=0)
-    prev = current.copy()
-    prev[2, 0, 3] = prev_x - x
-    scene.motion = Motion(current, prev, current.copy(), scene.camera, scene.camera)
+    one_moving_instance(scene, 3, 2, prev_x - x)
     return scene
 
 

@@ -49,9 +49,6 @@ class TableSpace:
     def evaluate(self, terms, gathered):
         return self.table[terms.ids, gathered]
 
-    def target(self, terms, prepared, idx):
-        return self.evaluate(terms, self.gather(prepared, idx))
-
 
 def reservoirs(sid, M, W, p_hat):
     return IdSamples(sid=np.array(sid, np.int32), M=np.array(M, F), W=np.array(W, F), p_hat=np.array(p_hat, F))

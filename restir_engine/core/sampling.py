@@ -16,6 +16,10 @@ STREAM_TEMPORAL = 4
 STREAM_TILES = 5
 STREAM_INITIAL = 6
 STREAM_PIXEL_OFFSET = 7  # per-pixel rotation of the pass sequence (keyed without the pass)
+STREAM_GI_TEMPORAL = 8
+STREAM_SPATIAL = 16  # + spatial pass index
+STREAM_GI_SPATIAL = 48  # + spatial pass index
+
 
 def _sobol_2d(s: int) -> tuple[int, int]:
     """Point ``s`` of the first two Sobol dimensions as 32-bit integers: the van der Corput radical inverse in
@@ -45,9 +49,6 @@ def pass_jitter(shift: np.ndarray, s: int) -> np.ndarray:
     out *= np.float32(1.0 / (1 << 24))
     out += np.float32(0.5 / (1 << 24))  # the centre of the 24-bit cell: uniform in [0, 1), never 0 or 1
     return out
-STREAM_SPATIAL = 16  # + spatial pass index
-STREAM_GI_TEMPORAL = 8
-STREAM_GI_SPATIAL = 48  # + spatial pass index
 
 
 def rng(seed: int, frame: int, pass_index: int, stream: int, chunk: int = 0) -> np.random.Generator:

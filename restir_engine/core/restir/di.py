@@ -77,10 +77,6 @@ class LightSpace:
             pts = with_spots(pts, spot_tri, self.lights.scene.lamps, terms.p)
         return terms.evaluate(pts, want_pdf=False)[0]
 
-    def target(self, terms, prepared: FramePoints, idx) -> np.ndarray:
-        """p̂ (n,) of samples ``idx`` of ``prepared`` at surfaces ``terms``."""
-        return self.evaluate(terms, self.gather(prepared, idx))
-
 
 def _light_candidates(ctx, terms, rng, tiles, m_l: int, m_b: int, px, py):
     """Weights and targets (m_l, n) of the light candidates (from ``tiles`` or the power table), the light

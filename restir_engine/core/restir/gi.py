@@ -184,9 +184,6 @@ class GISpace:
             return radiance_target(terms, pts)
         return terms.evaluate(pts, want_pdf=False)[0]
 
-    def target(self, terms, prepared, idx) -> np.ndarray:
-        return self.evaluate(terms, self.gather(prepared, idx))
-
     @staticmethod
     def shift_ok(p_to: np.ndarray, p_from: np.ndarray, pts: PackedPoints) -> np.ndarray:
         """Biased mode: (n,) bool, the reconnection Jacobian of moving samples ``pts`` from primary hits p_from to

@@ -7,7 +7,6 @@ surface had in the previous frame. The sample type enters through a *space* obje
   space.prepare(res)                  per-frame data for gathers of the samples of ``res``
   space.gather(prepared, idx)         samples ``idx`` of ``prepared``, evaluable at any surfaces
   space.evaluate(terms, gathered)     p̂ (n,) of gathered samples at surfaces ``terms``
-  space.target(terms, prepared, idx)  both in one
   space.evaluate_mis (optional)       p̂ for the MIS weights of the neighbours' techniques (GI: with visibility)
   space.shift_ok (optional)           biased mode only: (n,) bool, whether a sample may move from the neighbour's
                                       surface to the pixel's (GI: Jacobian outlier rejection)
@@ -208,9 +207,10 @@ def spatial_reuse(space, gb, res: Reservoirs, prepared, rows: np.ndarray, cfg: S
             z = np.zeros(n, np.float32)
             neighbours.append(Neighbour(res, q, ok, m_q, z, z))
             continue
-        pc = space.target(me, prepared, q) * (ok & (res.key[q] >= 0))
+        theirs = space.gather(prepared, q)
+        pc = space.evaluate(me, theirs) * (ok & (res.key[q] >= 0))
         if not unbiased and hasattr(space, "shift_ok"):  # biased mode: drop shifts with outlying Jacobians
-            pc *= space.shift_ok(me.p, np.take(gb.terms.p, q, axis=1), space.gather(prepared, q))
+            pc *= space.shift_ok(me.p, np.take(gb.terms.p, q, axis=1), theirs)
         pq = None
         if unbiased:
             pq = _mis_target(space)(gb.terms.take(q), own) * (ok & own_ok)
@@ -253,9 +253,10 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     use = ok & (prev.key[q] >= 0)
     pc = np.zeros(n, np.float32)
     if use.any():
-        pc = space.target(gb.terms.take(rows), prepared_prev, q) * use
+        theirs = space.gather(prepared_prev, q)
+        pc = space.evaluate(gb.terms.take(rows), theirs) * use
         if bias_correction != "UNBIASED" and hasattr(space, "shift_ok"):
-            pc *= space.shift_ok(p_now, np.take(prev_gb.terms.p, q, axis=1), space.gather(prepared_prev, q))
+            pc *= space.shift_ok(p_now, np.take(prev_gb.terms.p, q, axis=1), theirs)
     pq = None
     if bias_correction == "UNBIASED":
         pq = np.zeros(n, np.float32)
