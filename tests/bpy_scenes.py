@@ -6,7 +6,8 @@ import math
 import bpy
 
 from harness.render import configure_cycles, configure_restir, render_scene
-from harness.scenes import build_cornell, camera, diffuse, emission, enable_nodes, light, plane, reset
+from harness.scenes import (black_world, build_cornell, camera, diffuse, emission, enable_nodes, light, plane,
+                            principled, reset)
 
 __all__ = ["camera", "configure_cycles", "configure_restir", "cornell_box", "diffuse", "emission", "enable_nodes",
            "light", "plane", "render_passes", "reset"]
@@ -33,3 +34,80 @@ def cornell_box(light_kind="EMISSIVE", size=(48, 48)):
 def render_passes(scene) -> dict:
     """Render the current frame and return {pass name: (h, w, c) float32, row 0 at the bottom}."""
     return render_scene(scene)[0]
+
+
+# Materials of the sphere grid (rows top to bottom): (kind, base colour, roughness, extra inputs).
+# P = Principled BSDF, G = Glossy BSDF, D = Diffuse BSDF.
+SPHERE_GRID = [
+    [("P", (0.8, 0.5, 0.3), r, {}) for r in (0.1, 0.25, 0.5, 0.75, 1.0)]
+    + [("P", (0.8, 0.5, 0.3), 0.5, {"Specular IOR Level": 0.0})],
+    [("P", (0.9, 0.6, 0.3), r, {"Metallic": 1.0}) for r in (0.1, 0.25, 0.5, 0.75, 1.0)]
+    + [("P", (0.9, 0.6, 0.3), 0.4, {"Metallic": 1.0, "Specular Tint": (0.4, 0.7, 1.0, 1.0)})],
+    [("P", (0.3, 0.5, 0.8), 0.3, {"IOR": 1.2}), ("P", (0.3, 0.5, 0.8), 0.8, {"IOR": 1.2}),
+     ("P", (0.3, 0.5, 0.8), 0.3, {"IOR": 2.0}), ("P", (0.3, 0.5, 0.8), 0.8, {"IOR": 2.0}),
+     ("P", (0.3, 0.5, 0.8), 0.3, {"Specular IOR Level": 1.0}),
+     ("P", (0.3, 0.5, 0.8), 0.3, {"Specular Tint": (1.0, 0.5, 0.5, 1.0)})],
+    [("G", (0.8, 0.8, 0.8), 0.3, {}), ("G", (0.9, 0.5, 0.2), 0.7, {}), ("D", (0.7, 0.7, 0.7), 0.0, {}),
+     ("P", (0.7, 0.7, 0.7), 0.4, {"Metallic": 0.5}), ("P", (1.0, 1.0, 1.0), 1.0, {}),
+     ("P", (0.0, 0.0, 0.0), 0.5, {})],
+]
+
+
+def _grid_material(name, kind, color, roughness, extra):
+    if kind == "D":
+        return diffuse(name, color)
+    if kind == "G":
+        m = bpy.data.materials.new(name)
+        enable_nodes(m)
+        nodes = m.node_tree.nodes
+        nodes.remove(nodes["Principled BSDF"])
+        g = nodes.new("ShaderNodeBsdfGlossy")
+        g.inputs["Color"].default_value = (*color, 1)
+        g.inputs["Roughness"].default_value = roughness
+        m.node_tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
+        return m
+    m = principled(name, color, roughness=roughness)
+    b = m.node_tree.nodes["Principled BSDF"]
+    for key, value in extra.items():
+        b.inputs[key].default_value = value
+    return m
+
+
+def material_spheres(light_kind="AREA", size=(144, 96)):
+    """A 6 x 4 grid of smooth spheres (one cell of the image each, :data:`SPHERE_GRID`) in front of a grey
+    Diffuse wall, seen by an orthographic camera along +Y, lit from the upper left front by an area light or an
+    emissive quad of the same size. Every view angle of every material is in the image (sphere rims are grazing)."""
+    scene = reset()
+    for r, row in enumerate(SPHERE_GRID):
+        for c, (kind, color, rough, extra) in enumerate(row):
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.4, location=(c - 2.5, 0, 1.5 - r), segments=32,
+                                                 ring_count=16)
+            obj = bpy.context.active_object
+            bpy.ops.object.shade_smooth()
+            obj.data.materials.append(_grid_material(f"M{r}{c}", kind, color, rough, extra))
+    plane("Wall", 1, (0, 1.5, 0), (math.pi / 2, 0, 0), material=diffuse("Wall", (0.5, 0.5, 0.5)), scale=(8, 6, 1))
+    rot = (math.radians(45), 0, math.radians(-30))
+    if light_kind == "AREA":
+        light("AREA", (-2.5, -4.5, 4.0), rot, energy=2000.0, size=3.0)
+    else:
+        plane("Lamp", 3.0, (-2.5, -4.5, 4.0), rot, material=emission("Lamp", (1, 1, 1), 60.0))
+    camera((0, -6, 0), (math.radians(90), 0, 0), ortho_scale=6.0)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene
+
+
+def grazing_floor(size=(96, 64)):
+    """Four floor strips running away from a low perspective camera (Principled roughness 1, Principled 0.5,
+    metal 0.5, Diffuse BSDF), lit by two area lights: the far image rows see the floor at grazing angles."""
+    scene = reset()
+    mats = [principled("Rough", (0.6, 0.6, 0.6), roughness=1.0), principled("Mid", (0.6, 0.6, 0.6), roughness=0.5),
+            principled("Metal", (0.9, 0.8, 0.6), roughness=0.5, metallic=1.0), diffuse("Diffuse", (0.6, 0.6, 0.6))]
+    for i, m in enumerate(mats):
+        plane(f"Strip{i}", 1, (-1.5 + i, 6, 0), material=m, scale=(1, 14, 1))
+    light("AREA", (-2, 4, 3), (math.radians(-30), 0, 0), energy=400.0, size=2.0)
+    light("AREA", (2, 12, 3), (math.radians(30), 0, 0), energy=600.0, size=3.0)
+    camera((0, -1.5, 0.6), (math.radians(70), 0, 0), lens=22)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

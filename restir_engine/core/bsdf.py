@@ -1,30 +1,38 @@
-"""Lambert diffuse + GGX specular BSDF, vectorized.
+"""The Principled BSDF as Cycles builds it (Blender 4.x/5.x), without sheen, coat, transmission and anisotropy;
+vectorized.
 
 All directions are (3, n) rows (x, y, z) in the local shading frame (z = shading normal), unit length,
-``wo`` towards the viewer, ``wi`` towards the light; colours are (3, n) rows (R, G, B). ``eval`` returns
-f (3, n) without the cosine; pdfs are in solid-angle measure.
+``wo`` towards the viewer, ``wi`` towards the light; colours are (3, n) rows (R, G, B), scene-linear.
+``eval`` returns f (3, n) without the cosine; pdfs are in solid-angle measure.
 
-Model (an approximation of the Principled BSDF):
-  diffuse  = base·(1-metallic)/π · (1 - F_d(cos_o))      F_d: Schlick with the dielectric f0
-  specular = D·G·F / (4 cos_i cos_o)   GGX D, height-correlated Smith G, Schlick F with
-             f0 = mix(f0_dielectric, base, metallic), alpha = roughness²
-The (1 - F_d) factor keeps reflectance ≤ 1 (energy-sensible). The specular lobe is scaled by
-1 + f0 (1 - E(μo, α)) / E(μo, α), E the directional albedo of single-scattering GGX with F = 1
-(Turquin 2019 energy compensation), standing in for the energy Cycles' multiscatter GGX keeps at high
-roughness: a white metal then reflects all the light it receives. Lobes are sampled by one-sample MIS:
-cosine hemisphere for the diffuse lobe, the GGX normal distribution for the specular one.
+Lobes (α = roughness², all GGX lobes share it: D, height-correlated Smith G2 = 1/(1 + Λo + Λi)):
+  metal       metallic · F_m(ωo·h) · D G2/(4 cos θo cos θi) · (1 + Fms_m (1 - E)/E)
+              F_m = F0 + (1 - F0)(1 - ωo·h)⁵ - b ωo·h (1 - ωo·h)⁶  (F82-tint; b = 0 for a white Specular Tint;
+              a Glossy BSDF has the constant F_m = its colour)
+  dielectric  (1 - metallic) · F_d(ωo·h) · D G2/(4 cos θo cos θi) · (1 + Fms_d (1 - E)/E)
+              F_d = mix(f0·tint, 1, s), s = (F_exact(ωo·h, η) - f0)/(1 - f0): the exact Fresnel of
+              η = (1 + √f0)/(1 - √f0), rescaled to start at the tinted f0
+  diffuse     base (1 - metallic)/π · saturate(1 - max_rgb[(E + Fms_d (1 - E)) · mix(f0·tint, 1, S(α, μo, η))])
+              (Lambert under the dielectric layer, weighted by one minus that layer's albedo toward the viewer)
+E(α, μo) is the single-scattering albedo, Fms = Fss E_avg/(1 - Fss (1 - E_avg)) the multiscatter Fresnel with Fss
+the lobe's average Fresnel (metal: mix(F0, 1, 1/21) - b/126; dielectric: mix(f0·tint, 1, s_ss), s_ss from the
+fitted average (η - 1)/(4.08567 + 1.00071 η); Glossy: its colour). Tables: :mod:`.microfacet_tables`. A lobe
+with the "GGX" (single-scatter) distribution has no compensation and layers with mix(f0·tint, 1, S) alone.
+Lobes are sampled by one-sample MIS: cosine hemisphere for the diffuse lobe, the GGX normal distribution for
+the specular ones.
 """
 from __future__ import annotations
 
-import os
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
+from . import microfacet_tables as tables
+from .microfacet_tables import ALPHA_MIN, smith_lambda
 from .sampling import cosine_hemisphere, dot
 
-ALPHA_MIN = 1e-3
 INV_PI = np.float32(1.0 / np.pi)
+_F82 = 6.0 / 7.0  # 1 - cos 82°-ish: the F82 model's reference angle has cos θ = 1/7
 
 
 def luminance(rgb: np.ndarray) -> np.ndarray:
@@ -37,164 +45,138 @@ def luminance_rows(rgb: np.ndarray) -> np.ndarray:
     return np.float32(0.2126) * rgb[0] + np.float32(0.7152) * rgb[1] + np.float32(0.0722) * rgb[2]
 
 
+def fss_dielectric(eta: np.ndarray) -> np.ndarray:
+    """Cycles' fit of the cosine-weighted average of the exact dielectric Fresnel (η ≥ 1)."""
+    return (eta - 1.0) / (4.08567 + 1.00071 * eta)
+
+
+def multiscatter_fresnel(fss: np.ndarray, e_avg: np.ndarray) -> np.ndarray:
+    """Fms = Fss E_avg / (1 - Fss (1 - E_avg)) (Kulla and Conty's multiple-bounce Fresnel, one Fss cancelled)."""
+    return fss * e_avg / (1.0 - fss * (1.0 - e_avg))
+
+
 @dataclass
 class SurfaceParams:
-    """Per-hit (or per-material) BSDF parameters: diffuse (3, n), f0 (3, n) (RGB rows), f0_dielectric (n,),
-    alpha (n,), p_spec (n,) probability of sampling the specular lobe, spec_on (n,) 1 where a specular
-    lobe exists (0 for Diffuse BSDF)."""
+    """Per-hit (or per-material) BSDF parameters. RGB rows (3, n): diffuse = base (1 - metallic), metal_f0, metal_b
+    (F82-tint b), diel_f0 (f0 · tint), fms_m, fms_d (multiscatter Fresnel of each lobe). Scalars (n,): metal_w
+    (metallic), metal_f90 (1: F rises to 1 at grazing, 0: constant colour), diel_w (1 - metallic where the
+    dielectric lobe exists), f0r (the untinted f0), eta (its IOR), alpha, ms (1: multiscatter GGX), p_spec
+    (probability of sampling a specular lobe), spec_on (1 where a specular lobe exists)."""
 
     diffuse: np.ndarray
-    f0: np.ndarray
-    f0_dielectric: np.ndarray
+    metal_f0: np.ndarray
+    metal_b: np.ndarray
+    diel_f0: np.ndarray
+    fms_m: np.ndarray
+    fms_d: np.ndarray
+    metal_w: np.ndarray
+    metal_f90: np.ndarray
+    diel_w: np.ndarray
+    f0r: np.ndarray
+    eta: np.ndarray
     alpha: np.ndarray
+    ms: np.ndarray
     p_spec: np.ndarray
     spec_on: np.ndarray
 
     def take(self, idx) -> "SurfaceParams":
         """Parameters of entries ``idx`` (index array or slice)."""
-        if isinstance(idx, slice):
-            return SurfaceParams(self.diffuse[:, idx], self.f0[:, idx], self.f0_dielectric[idx], self.alpha[idx],
-                                 self.p_spec[idx], self.spec_on[idx])
-        return SurfaceParams(np.take(self.diffuse, idx, axis=1), np.take(self.f0, idx, axis=1),
-                             self.f0_dielectric[idx], self.alpha[idx], self.p_spec[idx], self.spec_on[idx])
+        out = {}
+        for f in fields(self):
+            a = getattr(self, f.name)
+            if a.ndim == 2:
+                out[f.name] = a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1)
+            else:
+                out[f.name] = a[idx]
+        return SurfaceParams(**out)
 
     def assign(self, idx, other: "SurfaceParams") -> None:
         """self[idx] = other (every field)."""
-        self.diffuse[:, idx] = other.diffuse
-        self.f0[:, idx] = other.f0
-        for name in ("f0_dielectric", "alpha", "p_spec", "spec_on"):
-            getattr(self, name)[idx] = getattr(other, name)
+        for f in fields(self):
+            a = getattr(self, f.name)
+            if a.ndim == 2:
+                a[:, idx] = getattr(other, f.name)
+            else:
+                a[idx] = getattr(other, f.name)
 
     @staticmethod
-    def from_material(base: np.ndarray, metallic: np.ndarray, roughness: np.ndarray, f0_d: np.ndarray):
-        """From base colours (m, 3) (scene-linear RGB, as the material table stores them), metallic,
-        roughness and the dielectric f0 (m,)."""
-        base = np.asarray(base, np.float32).T
-        m = np.clip(metallic, 0, 1)
-        f0 = (f0_d * (1 - m) + base * m).astype(np.float32)
-        diffuse = (base * (1 - m)).astype(np.float32)
-        alpha = np.maximum(np.clip(roughness, 0, 1) ** 2, ALPHA_MIN).astype(np.float32)
-        ws = luminance_rows(f0)
-        wd = luminance_rows(diffuse) * (1 - f0_d)
+    def from_material(base, metallic, roughness, f0_d, spec_tint=None, metal_f90=None, multiscatter=None):
+        """From base colours (m, 3) (scene-linear RGB, as the material table stores them), metallic, roughness,
+        the dielectric f0 (m,) (IOR and Specular IOR Level applied; 0 = no dielectric lobe), and optionally the
+        Specular Tint (m, 3) (white), metal_f90 (m,) (1) and multiscatter (m,) (1)."""
+        m = len(metallic)
+        base = np.maximum(np.asarray(base, np.float32), 0).T
+        met = np.clip(np.asarray(metallic, np.float32), 0, 1)
+        tint = np.ones((3, m), np.float32) if spec_tint is None else np.maximum(np.asarray(spec_tint, np.float32), 0).T
+        f90 = np.ones(m, np.float32) if metal_f90 is None else np.asarray(metal_f90, np.float32)
+        ms = np.ones(m, np.float32) if multiscatter is None else np.asarray(multiscatter, np.float32)
+        f0r = np.clip(np.asarray(f0_d, np.float32), 0, 0.99 ** 2)
+        alpha = np.maximum(np.clip(np.asarray(roughness, np.float32), 0, 1) ** 2, ALPHA_MIN).astype(np.float32)
+        e_avg = tables.average_albedo(alpha)
+        # metal: F82-tint (b from the tint where metal_f90 = 1), or the Glossy BSDF's constant colour
+        metal_f0 = np.minimum(base, 1.0)
+        f5 = _F82 ** 5
+        tint82 = np.minimum(tint, 1.0)
+        metal_b = np.where(f90 > 0, (metal_f0 + (1 - metal_f0) * f5) * (7.0 / (f5 * _F82)) * (1 - tint82), 0.0)
+        fss_m = np.where(f90 > 0, metal_f0 + (1 - metal_f0) / 21.0 - metal_b / 126.0, metal_f0)
+        # dielectric: f0 tinted, η from the untinted f0
+        sq = np.sqrt(f0r)
+        eta = (1 + sq) / (1 - sq)
+        diel_f0 = np.clip(f0r * tint, 0, 1)
+        s_ss = np.clip((fss_dielectric(eta) - f0r) / np.maximum(1 - f0r, 1e-6), 0, 1)
+        fss_d = diel_f0 + (1 - diel_f0) * s_ss
+        diel_w = np.where(f0r > 0, 1 - met, 0.0)
+        diffuse = base * (1 - met)
+        ws = luminance_rows(metal_f0 + (1 - metal_f0) * (0.05 * f90)) * met + luminance_rows(diel_f0) * diel_w
+        wd = luminance_rows(diffuse) * (1 - f0r)
         tot = ws + wd
         p = np.where(tot > 0, ws / np.maximum(tot, 1e-12), 0.0)
         both = (ws > 0) & (wd > 0)
-        p = np.where(both, np.clip(p, 0.1, 0.9), p).astype(np.float32)
-        spec_on = (f0.max(axis=0) > 0).astype(np.float32)
-        return SurfaceParams(diffuse, f0, f0_d.astype(np.float32), alpha, p, spec_on)
+        p = np.where(both, np.clip(p, 0.1, 0.9), p)
+        spec_on = ((met > 0) & ((metal_f0.max(axis=0) > 0) | (f90 > 0))) | (diel_w > 0)
+        f32 = np.float32
+        return SurfaceParams(diffuse.astype(f32), metal_f0.astype(f32), metal_b.astype(f32), diel_f0.astype(f32),
+                             multiscatter_fresnel(fss_m, e_avg).astype(f32),
+                             multiscatter_fresnel(fss_d, e_avg).astype(f32), met.astype(f32), f90,
+                             diel_w.astype(f32), f0r, eta.astype(f32), alpha, ms, p.astype(f32),
+                             spec_on.astype(f32))
 
-
-def schlick(f0, cos):
-    c = np.clip(1.0 - cos, 0.0, 1.0)
-    c5 = (c * c) * (c * c) * c
-    return f0 + (1.0 - f0) * c5
-
-
-_ALBEDO_TABLE = None
-_TABLE_N = 32
-
-
-TABLE_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "ggx_albedo.npy")
-
-
-def ggx_albedo_table() -> np.ndarray:
-    """E[α index, μ index]: directional albedo of single-scattering GGX (F = 1, height-correlated Smith)
-    on a 32 x 32 grid of α in [ALPHA_MIN, 1] and μo in [1/64, 1]. Read from core/data/ggx_albedo.npy
-    (written by scripts/make_ggx_table.py from :func:`compute_ggx_albedo_table`; computed here if missing)."""
-    global _ALBEDO_TABLE
-    if _ALBEDO_TABLE is None:
-        try:
-            table = np.load(TABLE_FILE)
-        except OSError:
-            table = compute_ggx_albedo_table()
-        _ALBEDO_TABLE = table.astype(np.float32)
-    return _ALBEDO_TABLE
-
-
-def compute_ggx_albedo_table() -> np.ndarray:
-    """The table of :func:`ggx_albedo_table` by stratified NDF sampling (64 x 64 strata per entry; about a
-    second)."""
-    n = _TABLE_N
-    alphas = np.linspace(ALPHA_MIN, 1.0, n)
-    mus = np.linspace(1.0 / 64, 1.0, n)
-    k = 64
-    u1 = ((np.arange(k) + 0.5) / k)[:, None].repeat(k, 1).ravel()
-    u2 = ((np.arange(k) + 0.5) / k)[None, :].repeat(k, 0).ravel()
-    table = np.empty((n, n))
-    for i, a in enumerate(alphas):  # loop over table rows, vectorized over μ and strata
-        tan2 = a * a * u1 / np.maximum(1 - u1, 1e-9)
-        ch = 1 / np.sqrt(1 + tan2)
-        sh = np.sqrt(np.maximum(0, 1 - ch * ch))
-        h = np.stack([sh * np.cos(2 * np.pi * u2), sh * np.sin(2 * np.pi * u2), ch], axis=1)
-        mu = mus[:, None]
-        wo = np.stack([np.sqrt(1 - mu * mu), np.zeros_like(mu), mu], axis=-1)  # (n, 1, 3)
-        odh = (wo * h[None]).sum(-1)
-        wi_z = 2 * odh * h[None, :, 2] - mu
-        g = 1 / (1 + smith_lambda(a, np.broadcast_to(mu, wi_z.shape)) + smith_lambda(a, np.maximum(wi_z, 1e-6)))
-        wgt = np.where((wi_z > 0) & (odh > 0), g * odh / (mu * h[None, :, 2]), 0.0)
-        table[i] = wgt.mean(axis=1)
-    return np.clip(table, 1e-3, 1.0).astype(np.float32)
-
-
-def ggx_albedo(alpha: np.ndarray, mu: np.ndarray) -> np.ndarray:
-    """Bilinear lookup of :func:`ggx_albedo_table` at (α, μo)."""
-    t = ggx_albedo_table()
-    n = _TABLE_N
-    x = np.clip((alpha - ALPHA_MIN) / (1.0 - ALPHA_MIN) * (n - 1), 0, n - 1)
-    y = np.clip((mu - 1.0 / 64) / (1.0 - 1.0 / 64) * (n - 1), 0, n - 1)
-    x0 = np.minimum(x.astype(np.int64), n - 2)
-    y0 = np.minimum(y.astype(np.int64), n - 2)
-    fx, fy = (x - x0).astype(np.float32), (y - y0).astype(np.float32)
-    return ((t[x0, y0] * (1 - fy) + t[x0, y0 + 1] * fy) * (1 - fx)
-            + (t[x0 + 1, y0] * (1 - fy) + t[x0 + 1, y0 + 1] * fy) * fx)
-
-
-def ggx_albedo_rows(alpha: np.ndarray) -> np.ndarray:
-    """The table interpolated at fixed roughnesses α (m,) -> (m, 32) rows over μo (materials' α is constant,
-    so a hit's albedo is then one linear interpolation in μo: :func:`ggx_albedo_at`)."""
-    t = ggx_albedo_table()
-    n = _TABLE_N
-    x = np.clip((np.asarray(alpha, np.float32) - ALPHA_MIN) / (1.0 - ALPHA_MIN) * (n - 1), 0, n - 1)
-    x0 = np.minimum(x.astype(np.int64), n - 2)
-    fx = (x - x0).astype(np.float32)[:, None]
-    return (t[x0] * (1 - fx) + t[x0 + 1] * fx).astype(np.float32)
-
-
-def ggx_albedo_at(rows: np.ndarray, index: np.ndarray, mu: np.ndarray) -> np.ndarray:
-    """E(μo) (n,) from rows of :func:`ggx_albedo_rows` (row ``index`` per point): equals :func:`ggx_albedo`
-    at that row's α to float32 rounding."""
-    n = _TABLE_N
-    y = np.clip((mu - np.float32(1.0 / 64)) * np.float32((n - 1) / (1.0 - 1.0 / 64)), 0, n - 1)
-    y0 = np.minimum(y.astype(np.intp), n - 2)
-    fy = y - y0
-    k = index * n + y0
-    flat = rows.reshape(-1)
-    return flat[k] * (1 - fy) + flat[k + 1] * fy
-
-
-def smith_lambda(alpha, cos):
-    c2 = np.clip(cos * cos, 1e-12, 1.0)
-    tan2 = (1.0 - c2) / c2
-    return 0.5 * (np.sqrt(1.0 + alpha * alpha * tan2) - 1.0)
+    @staticmethod
+    def of_table(mats, idx=None, base=None) -> "SurfaceParams":
+        """Parameters of materials ``idx`` (all when None) of a scene.MaterialTable, with ``base`` (k, 3) instead
+        of their base colours when given (textures)."""
+        sel = slice(None) if idx is None else idx
+        return SurfaceParams.from_material(mats.base_color[sel] if base is None else base, mats.metallic[sel],
+                                           mats.roughness[sel], mats.f0[sel], mats.specular_tint[sel],
+                                           mats.metal_f90[sel], mats.multiscatter[sel])
 
 
 def view_albedo(p: SurfaceParams, wo: np.ndarray) -> np.ndarray:
-    """GGX directional albedo E(μo, α) (n,) of the view directions: depends on wo only, so callers that
-    evaluate many wi for the same wo compute it once and pass it to :func:`eval_bsdf`."""
-    return ggx_albedo(p.alpha, np.clip(wo[2], 0, 1))
+    """GGX single-scattering albedo E(μo, α) (n,) of the view directions."""
+    return tables.albedo(p.alpha, np.clip(wo[2], 0, 1))
+
+
+def view_layer(p: SurfaceParams, wo: np.ndarray) -> np.ndarray:
+    """The dielectric layer's Fresnel interpolation factor S(α, μo, η) (n,) toward the viewer."""
+    return tables.layer_s(p.alpha, np.clip(wo[2], 0, 1), p.f0r)
 
 
 @dataclass
 class ViewTerms:
     """The factors of f and its pdf that depend on the view direction only, per surface (n): computed once
     and reused by every wi evaluated there (next-event estimation, BSDF sampling, shading).
-    kd (3, n) = diffuse (1 - F_d(cos θ_o)) / π; spec_a, spec_b (3, n) = f0 · c, (1 - f0) · c with c the
-    energy compensation 1 + f0 (1 - E)/E (so the specular lobe is D G / (4 cos θ_o cos θ_i) · (spec_a + c⁵
-    spec_b), c⁵ = (1 - ωo·h)⁵); alpha, alpha2, lam_o = Λ(ωo), co = cos θ_o, spec_on, p_spec (n,)."""
+    kd (3, n) the diffuse lobe (layering weight applied, over π); the specular lobes are
+    D G2/(4 cos θo cos θi) · (spec_a + c⁵ spec_b + F(ωo·h) spec_c - ωo·h c⁶ spec_d) with c = 1 - ωo·h and F the
+    exact dielectric Fresnel of η (eta2m1 = η² - 1): spec_a, spec_b (3, n); spec_c, eta2m1 only where some
+    surface has a dielectric lobe, spec_d only where some metal has a Specular Tint (else None);
+    alpha, alpha2, lam_o = Λ(ωo), co = cos θo, spec_on, p_spec (n,)."""
 
     kd: np.ndarray
     spec_a: np.ndarray
     spec_b: np.ndarray
+    spec_c: np.ndarray | None
+    spec_d: np.ndarray | None
+    eta2m1: np.ndarray | None
     alpha: np.ndarray
     alpha2: np.ndarray
     lam_o: np.ndarray
@@ -204,22 +186,71 @@ class ViewTerms:
     glossy: bool = True  # False: no surface has a specular lobe (Diffuse BSDFs only): Lambert alone
 
     @staticmethod
-    def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None) -> "ViewTerms":
+    def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None,
+           layer: np.ndarray | None = None) -> "ViewTerms":
+        """``albedo``, ``layer``: :func:`view_albedo`, :func:`view_layer` if known."""
         co = wo[2]
-        # a lobe with f0 = 0 does not exist (Diffuse BSDF): no Fresnel split, no grazing specular
-        fd = np.where(p.f0_dielectric > 0, 1.0 - schlick(p.f0_dielectric, co), np.float32(1.0))
+        glossy = bool((p.spec_on > 0).any())
+        if not glossy:
+            z = np.zeros_like(p.diffuse)
+            return ViewTerms(p.diffuse * INV_PI, z, z, None, None, None, p.alpha, p.alpha * p.alpha,
+                             smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec, False)
         e = view_albedo(p, wo) if albedo is None else albedo
-        comp = 1.0 + p.f0 * ((1.0 - e) / e)
-        return ViewTerms(p.diffuse * (fd * INV_PI), p.f0 * comp, (1.0 - p.f0) * comp, p.alpha,
-                         p.alpha * p.alpha, smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec,
-                         bool((p.spec_on > 0).any() or (p.p_spec > 0).any()))
+        miss = (1.0 - e) / e
+        comp_m = 1.0 + (p.ms * miss) * p.fms_m
+        mw = comp_m * p.metal_w
+        spec_a = mw * p.metal_f0
+        spec_b = mw * (1.0 - p.metal_f0) * p.metal_f90
+        spec_d = mw * p.metal_b if (p.metal_b > 0).any() else None
+        kd = p.diffuse * INV_PI
+        spec_c = eta2m1 = None
+        if (p.diel_w > 0).any():
+            comp_d = 1.0 + (p.ms * miss) * p.fms_d
+            dw = comp_d * p.diel_w
+            # F_d = f0t + (1 - f0t)(F - f0r)/(1 - f0r): split into a constant and a multiple of F
+            inv = 1.0 / np.maximum(1.0 - p.f0r, np.float32(1e-6))
+            spec_c = dw * (1.0 - p.diel_f0) * inv
+            spec_a = spec_a + dw * p.diel_f0 - spec_c * p.f0r
+            eta2m1 = p.eta * p.eta - 1.0
+            s = view_layer(p, wo) if layer is None else layer
+            dark = p.ms * (e + p.fms_d * (1.0 - e)) + (1.0 - p.ms)
+            layer_albedo = (dark * (p.diel_f0 + (1.0 - p.diel_f0) * s)).max(axis=0)
+            kd = kd * np.where(p.diel_w > 0, np.clip(1.0 - layer_albedo, 0.0, 1.0), np.float32(1.0))
+        f32 = np.float32
+        return ViewTerms(kd.astype(f32, copy=False), spec_a.astype(f32, copy=False), spec_b.astype(f32, copy=False),
+                         None if spec_c is None else spec_c.astype(f32), None if spec_d is None else spec_d.astype(f32),
+                         None if eta2m1 is None else eta2m1.astype(f32), p.alpha, p.alpha * p.alpha,
+                         smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec, True)
 
 
 def view_terms(surf) -> ViewTerms:
     """The view terms of surfaces: ``surf.view`` when they carry them (surface.Surface computes them once),
-    else computed from ``params``, ``wo_l`` and ``albedo`` (if given)."""
+    else computed from ``params``, ``wo_l`` and ``albedo``/``layer`` (if given)."""
     v = getattr(surf, "view", None)
-    return v if v is not None else ViewTerms.of(surf.params, surf.wo_l, getattr(surf, "albedo", None))
+    return v if v is not None else ViewTerms.of(surf.params, surf.wo_l, getattr(surf, "albedo", None),
+                                                getattr(surf, "layer", None))
+
+
+def fresnel_exact(c, eta2m1):
+    """Unpolarized dielectric Fresnel at cos θ = c (> 0) for η² - 1 = ``eta2m1`` (≥ 0), float32 in place where
+    it can."""
+    g = c * c
+    g += eta2m1
+    np.sqrt(g, out=g)
+    gpc = g + c
+    gmc = g - c
+    a = gmc / np.maximum(gpc, np.float32(1e-12))
+    b = c * gpc
+    b -= 1.0
+    den = c * gmc
+    den += 1.0
+    b /= den
+    b *= b
+    b += 1.0
+    a *= a
+    a *= b
+    a *= 0.5
+    return a
 
 
 def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
@@ -243,22 +274,28 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     c5 = (c * c) * (c * c) * c
     s = v.spec_on * d * g / np.maximum(4.0 * co * ci, np.float32(1e-12))
     f = v.kd + s * v.spec_a + (s * c5) * v.spec_b
+    if v.spec_c is not None:
+        f += (s * fresnel_exact(odh, v.eta2m1)) * v.spec_c
+    if v.spec_d is not None:
+        f -= (s * odh * c5 * c) * v.spec_d
+    if v.spec_c is not None or v.spec_d is not None:
+        np.maximum(f, 0.0, out=f)  # rounding of the split dielectric Fresnel; the F82 clamp
     f *= valid
     pdf = (1 - v.p_spec) * np.maximum(ci, 0) * INV_PI + v.p_spec * (d * cos_h / (4.0 * odh))
     pdf *= valid
     return f.astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
 
 
-def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray, albedo: np.ndarray | None = None):
-    """f (3, n) and pdf (n,) of sampling wi given wo, both unit (3, n) vectors (``albedo``: :func:`view_albedo`, if
-    known). For many wi at the same surfaces build :class:`ViewTerms` once and call :func:`eval_view`."""
-    return eval_view(ViewTerms.of(p, wo, albedo), wo, wi)
+def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
+    """f (3, n) and pdf (n,) of sampling wi given wo, both unit (3, n) vectors. For many wi at the same surfaces
+    build :class:`ViewTerms` once and call :func:`eval_view`."""
+    return eval_view(ViewTerms.of(p, wo), wo, wi)
 
 
 def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.ndarray, u2: np.ndarray,
-                albedo: np.ndarray | None = None, view: ViewTerms | None = None):
-    """Sample wi; returns wi (3, n), f (3, n), pdf (n,) (the mixture pdf, so MIS-ready). ``albedo``: see
-    :func:`eval_bsdf`; ``view``: the surfaces' :class:`ViewTerms` if known."""
+                view: ViewTerms | None = None):
+    """Sample wi; returns wi (3, n), f (3, n), pdf (n,) (the mixture pdf, so MIS-ready). ``view``: the surfaces'
+    :class:`ViewTerms` if known."""
     spec = np.flatnonzero(u_lobe < p.p_spec)
     wi = cosine_hemisphere(u1, u2)
     if spec.size:
@@ -274,7 +311,7 @@ def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.nda
         h[2] = cos_t
         o = np.take(wo, spec, axis=1)
         wi[:, spec] = 2.0 * dot(o, h) * h - o
-    f, pdf = eval_view(ViewTerms.of(p, wo, albedo) if view is None else view, wo, wi)
+    f, pdf = eval_view(ViewTerms.of(p, wo) if view is None else view, wo, wi)
     ok = (pdf > 0) & (wi[2] > 0)
     f *= ok
     pdf *= ok

@@ -23,7 +23,8 @@ import numpy as np
 
 from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
-from .bsdf import SurfaceParams, eval_view, ggx_albedo_rows, sample_bsdf
+from . import microfacet_tables
+from .bsdf import SurfaceParams, eval_view, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
 from .sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
 from .scene import Scene
@@ -45,7 +46,8 @@ class TraceContext:
     max_bounces: int
     rr_start: int = 3
     film_transparent: bool = False
-    material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α (bsdf.ggx_albedo_rows)
+    material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α
+    material_layer: np.ndarray = None   # (m, 32) dielectric layer factor S rows over μo (microfacet_tables)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -405,14 +407,14 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     radius = float(np.linalg.norm(finite.max(0) - finite.min(0)) / 2) if len(finite) else 1.0
     geom_ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
     lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
-    params = SurfaceParams.from_material(scene.materials.base_color, scene.materials.metallic,
-                                         scene.materials.roughness, scene.materials.f0)
+    params = SurfaceParams.of_table(scene.materials)
     nrm = geom.normals
     flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
     return TraceContext(scene=scene, geom_accel=Accel(geom.verts), lamp_accel=Accel(lamps.tris.verts),
                         lights=LightTable(scene, max(radius, 1e-3)), geom_ng=geom_ng, lamp_ng=lamp_ng,
                         material_params=params, max_bounces=int(max(0, max_bounces)),
-                        film_transparent=film_transparent, material_albedo=ggx_albedo_rows(params.alpha),
+                        film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
+                        material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),
                         geom_flat=flat, geom_ng_rows=np.ascontiguousarray(geom_ng.T),
                         geom_normal_rows=np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32),
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T))

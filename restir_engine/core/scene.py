@@ -43,7 +43,12 @@ class MaterialTable:
     base_color  (m, 3)  linear albedo
     metallic    (m,)    0..1
     roughness   (m,)    0..1 (GGX alpha = roughness²)
-    f0          (m,)    dielectric normal-incidence reflectance (0.04 for IOR 1.5; 0 = pure Lambert)
+    f0          (m,)    dielectric normal-incidence reflectance (0.04 for IOR 1.5; Specular IOR Level applied;
+                        0 = no dielectric specular lobe)
+    specular_tint (m, 3) Principled Specular Tint: tints the dielectric f0 and is the metals' F82 tint (white)
+    metal_f90   (m,)    1: the metal lobe's Fresnel rises to white at grazing (Principled), 0: constant colour
+                        (Glossy BSDF)
+    multiscatter (m,)   1: multiscatter GGX energy compensation (Blender's default), 0: single-scatter GGX
     emission    (m, 3)  emitted radiance, W·sr⁻¹·m⁻² (colour x strength)
     base_tex    (m,) int32  index into ``textures`` multiplying base_color, -1 = none
     emit_tex    (m,) int32  index into ``textures`` multiplying emission, -1 = none
@@ -57,6 +62,9 @@ class MaterialTable:
     roughness: np.ndarray
     f0: np.ndarray
     emission: np.ndarray
+    specular_tint: np.ndarray
+    metal_f90: np.ndarray
+    multiscatter: np.ndarray
     base_tex: np.ndarray
     emit_tex: np.ndarray
     two_sided_emission: np.ndarray
@@ -71,6 +79,8 @@ class MaterialTable:
         return MaterialTable(
             base_color=col("base_color", (0.8, 0.8, 0.8)), metallic=col("metallic", 0.0),
             roughness=col("roughness", 0.5), f0=col("f0", 0.04), emission=col("emission", (0.0, 0.0, 0.0)),
+            specular_tint=col("specular_tint", (1.0, 1.0, 1.0)), metal_f90=col("metal_f90", 1.0),
+            multiscatter=col("multiscatter", 1.0),
             base_tex=col("base_tex", -1, np.int32), emit_tex=col("emit_tex", -1, np.int32),
             two_sided_emission=col("two_sided_emission", True, bool),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

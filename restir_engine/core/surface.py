@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import SurfaceParams, ViewTerms, ggx_albedo_at
+from .bsdf import SurfaceParams, ViewTerms
+from .microfacet_tables import rows_at
 from .sampling import barycentric, cols, dot, norm, orthonormal_basis
 from .textures import apply_texture
 
@@ -54,8 +55,7 @@ class Surface:
                 uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[textured][:, None], v[textured][:, None])  # (k, 2)
                 tm = mat[textured]
                 base = apply_texture(mats.base_color[tm], mats.base_tex[tm], uv, mats.textures)
-                self.params.assign(textured, SurfaceParams.from_material(base, mats.metallic[tm], mats.roughness[tm],
-                                                                         mats.f0[tm]))
+                self.params.assign(textured, SurfaceParams.of_table(mats, tm, base))
         self.t, self.bt = orthonormal_basis(self.ns)
         wo = self.wo
         wo_l = np.empty_like(wo)
@@ -65,8 +65,10 @@ class Surface:
         wo_l[2] = np.maximum(dot(wo, self.ns), np.float32(1e-4))
         wo_l /= norm(wo_l)
         self.wo_l = wo_l
-        # GGX directional albedo toward the viewer, once per hit (α is constant per material)
-        self.albedo = ggx_albedo_at(ctx.material_albedo, mat, wo_l[2])
+        # GGX albedo and the dielectric layer's Fresnel factor toward the viewer, once per hit (α and η are
+        # constant per material: one interpolation in μo)
+        self.albedo = rows_at(ctx.material_albedo, mat, wo_l[2])
+        self.layer = rows_at(ctx.material_layer, mat, wo_l[2])
 
     def __len__(self) -> int:
         return len(self.prim)
@@ -76,13 +78,13 @@ class Surface:
         """The BSDF's view-dependent factors (bsdf.ViewTerms), computed on first use."""
         v = getattr(self, "_view", None)
         if v is None:
-            v = self._view = ViewTerms.of(self.params, self.wo_l, self.albedo)
+            v = self._view = ViewTerms.of(self.params, self.wo_l, self.albedo, self.layer)
         return v
 
     def take(self, idx) -> "Surface":
         """The surfaces ``idx`` (an index array or a slice) as a new Surface."""
         out = Surface.__new__(Surface)
-        for name in ("prim", "b1", "b2", "mat", "albedo"):
+        for name in ("prim", "b1", "b2", "mat", "albedo", "layer"):
             setattr(out, name, getattr(self, name)[idx])
         for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l"):
             a = getattr(self, name)

@@ -5,14 +5,16 @@ light point y (position, unit normal n_l, radiance Le), in area measure on the l
   p̂(y) = luminance(f(ωo, ωi) · Le) · |cos θ_s| |cos θ_l| / d²      (0 below the geometric horizon,
                                                                      at a back face of a one-sided light)
   p_b(y) = p_b,ω(ωi | ωo) · |cos θ_l| / d²                            (the BSDF sampling pdf, area measure)
-with f the Lambert + GGX model of bsdf.py. Because luminance is linear, luminance(f · Le) splits into
-  Le · k_d  +  S(ωi) · (Le · A + (1 - ωo·h)⁵ · Le · B)
-where k_d, A and B are per-surface RGB vectors (luminance weights folded in) and S is the scalar
-D·G/(4 cos θ_o cos θ_i) of the GGX lobe; only S and the Fresnel power depend on the candidate. The half
+with f the Principled model of bsdf.py. Because luminance is linear, luminance(f · Le) splits into
+  Le · k_d  +  S(ωi) · (Le · A + (1 - ωo·h)⁵ · Le · B + F(ωo·h) · Le · C)
+where k_d, A, B and C are per-surface RGB vectors (luminance weights folded in), S is the scalar
+D·G/(4 cos θ_o cos θ_i) of the GGX lobes and F the exact dielectric Fresnel (η² - 1 a per-surface row); only S
+and the Fresnel terms depend on the candidate. A metal's Specular Tint (F82 term) is left out of p̂: p̂ then
+overestimates a tinted metal's grazing reflection a little, which costs variance, not bias. The half
 vector is never formed: with unit ωo, ωi, |ωo + ωi|² = 2 + 2 ωo·ωi, cos θ_h = (cos θ_o + cos θ_i)/|ωo + ωi|
 and ωo·h = (1 + ωo·ωi)/|ωo + ωi|. Agrees with bsdf.eval_bsdf to float32 rounding (tested).
 
-Layout: structure of arrays. Terms are a (27, n) float32 block (:data:`LAYOUT` rows), light points a
+Layout: structure of arrays. Terms are a (31, n) float32 block (:data:`LAYOUT` rows), light points a
 (11, ...) block (light_tiles.PackedPoints); the candidate axis broadcasts, so p̂ of m candidates at n
 surfaces is one pass over (m, n) arrays.
 """
@@ -20,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import view_terms
+from .bsdf import fresnel_exact, view_terms
 from .light_tiles import PackedPoints, light_points
 from .accel import in_worker, pool
 from .lights import spot_factor
@@ -30,20 +32,22 @@ LUM = np.array([0.2126, 0.7152, 0.0722], np.float32)
 INV_PI = np.float32(1.0 / np.pi)
 
 LAYOUT = {"p": slice(0, 3), "ng": slice(3, 6), "ns": slice(6, 9), "wo": slice(9, 12), "kd": slice(12, 15),
-          "a": slice(15, 18), "b": slice(18, 21), "co": 21, "alpha2": 22, "alpha": 23, "lam_o": 24, "p_spec": 25,
-          "spec_on": 26}
-WIDTH = 27  # float32 per surface: 108 bytes
+          "a": slice(15, 18), "b": slice(18, 21), "c": slice(21, 24), "co": 24, "alpha2": 25, "alpha": 26,
+          "lam_o": 27, "p_spec": 28, "spec_on": 29, "eta2m1": 30}
+WIDTH = 31  # float32 per surface: 124 bytes
 
 
 class ShadingTerms:
-    """Per-surface terms of p̂ as a (27, n) float32 block (:data:`LAYOUT`): each term a contiguous row, the
+    """Per-surface terms of p̂ as a (31, n) float32 block (:data:`LAYOUT`): each term a contiguous row, the
     terms of other pixels (spatial and temporal neighbours) one column gather away (:meth:`take`)."""
 
-    def __init__(self, packed: np.ndarray, glossy: bool | None = None):
+    def __init__(self, packed: np.ndarray, glossy: bool | None = None, dielectric: bool | None = None):
         self.packed = packed
         for name, rows in LAYOUT.items():
             setattr(self, name, packed[rows])
         self.glossy = bool((self.spec_on > 0).any()) if glossy is None else glossy
+        # whether some surface has a dielectric lobe (its exact Fresnel is evaluated per candidate)
+        self.dielectric = (self.glossy and bool((self.c > 0).any())) if dielectric is None else dielectric
 
     def __len__(self) -> int:
         return self.packed.shape[1]
@@ -51,7 +55,7 @@ class ShadingTerms:
     @staticmethod
     def of_surfaces(surf, out: np.ndarray | None = None) -> "ShadingTerms":
         """Terms of surfaces ``surf`` (a surface.Surface: p, ng, ns, wo, wo_l, params), written into ``out``
-        ((27, n) float32, e.g. a slice of a frame's block) when given."""
+        ((31, n) float32, e.g. a slice of a frame's block) when given."""
         prm = surf.params
         packed = np.empty((WIDTH, surf.p.shape[1]), np.float32) if out is None else out
         packed[LAYOUT["p"]] = surf.p
@@ -66,25 +70,32 @@ class ShadingTerms:
         packed[LAYOUT["kd"]] = v.kd * LUM[:, None]
         packed[LAYOUT["a"]] = v.spec_a * LUM[:, None]
         packed[LAYOUT["b"]] = v.spec_b * LUM[:, None]
+        if v.spec_c is None:
+            packed[LAYOUT["c"]] = 0.0
+            packed[LAYOUT["eta2m1"]] = 0.0
+        else:
+            packed[LAYOUT["c"]] = v.spec_c * LUM[:, None]
+            packed[LAYOUT["eta2m1"]] = v.eta2m1
         packed[LAYOUT["lam_o"]] = v.lam_o
         packed[LAYOUT["spec_on"]] = prm.spec_on
         packed[LAYOUT["p_spec"]] = prm.p_spec
         packed[LAYOUT["alpha"]] = prm.alpha
         packed[LAYOUT["alpha2"]] = v.alpha2
-        return ShadingTerms(packed)
+        return ShadingTerms(packed, dielectric=v.spec_c is not None and v.glossy)
 
     def take(self, idx) -> "ShadingTerms":
         """Terms of surfaces ``idx`` (index array or slice). Without a glossy surface among them only the
-        rows the diffuse target and pdf read are gathered (p, ng, ns, kd, p_spec: 13 of 27)."""
+        rows the diffuse target and pdf read are gathered (p, ng, ns, kd, p_spec: 13 of 31)."""
         if isinstance(idx, slice):
-            return ShadingTerms(self.packed[:, idx], self.glossy)
+            return ShadingTerms(self.packed[:, idx], self.glossy, self.dielectric)
         if self.glossy:
-            return ShadingTerms(np.take(self.packed, idx, axis=1), True)
+            return ShadingTerms(np.take(self.packed, idx, axis=1), True, self.dielectric)
         out = np.empty((WIDTH, len(idx)), np.float32)
         np.take(self.packed[0:9], idx, axis=1, out=out[0:9])
         np.take(self.packed[12:15], idx, axis=1, out=out[12:15])
-        np.take(self.packed[25], idx, out=out[25])  # p_spec (the BSDF pdf)
-        return ShadingTerms(out, False)
+        p_spec = LAYOUT["p_spec"]
+        np.take(self.packed[p_spec], idx, out=out[p_spec])  # the BSDF pdf
+        return ShadingTerms(out, False, False)
 
     def evaluate(self, pts: PackedPoints, want_pdf: bool = True):
         """p̂ and the BSDF pdf in area measure (None unless ``want_pdf``) of light points ``pts`` whose
@@ -175,6 +186,11 @@ class ShadingTerms:
             spec += le[0] * self.a[0]
             spec += le[1] * self.a[1]
             spec += le[2] * self.a[2]
+            if self.dielectric:
+                fr = fresnel_exact(odh, self.eta2m1)
+                fr *= le[0] * self.c[0] + le[1] * self.c[1] + le[2] * self.c[2]
+                spec += fr
+                np.maximum(spec, 0.0, out=spec)      # rounding of the split Fresnel (bsdf.ViewTerms)
             spec *= s
             lum += spec
             if want_pdf:

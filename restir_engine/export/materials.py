@@ -81,7 +81,7 @@ class MaterialRegistry:
         if not socket.is_linked:
             return tuple(socket.default_value[:3])
         node = socket.links[0].from_node
-        if node.type == "TEX_IMAGE" and node.image is not None:
+        if node.type == "TEX_IMAGE" and node.image is not None and key_tex is not None:
             if node.inputs["Vector"].is_linked:
                 self._warn(material, f"'{node.name}' has a mapped vector input; the active UV map is used instead")
             row[key_tex] = self._texture(material, node.image)
@@ -90,6 +90,14 @@ class MaterialRegistry:
             return tuple(node.outputs[0].default_value[:3])
         self._warn(material, f"'{node.name}' ({node.type}) drives '{socket.name}'; approximated by the socket's value")
         return tuple(socket.default_value[:3]) if hasattr(socket, "default_value") else fallback
+
+    def _multiscatter(self, material, node) -> float:
+        """1 for Multiscatter GGX (Blender's default), 0 for GGX; other distributions are approximated by one."""
+        dist = getattr(node, "distribution", "MULTI_GGX")
+        if dist in {"MULTI_GGX", "GGX"}:
+            return 1.0 if dist == "MULTI_GGX" else 0.0
+        self._warn(material, f"'{node.name}' distribution {dist} is approximated by Multiscatter GGX")
+        return 1.0
 
     def _float_input(self, material, socket) -> float:
         if socket.is_linked:
@@ -109,7 +117,12 @@ class MaterialRegistry:
             row["roughness"] = self._float_input(material, inp["Roughness"])
             ior = self._float_input(material, inp["IOR"]) if "IOR" in inp else 1.5
             level = self._float_input(material, inp["Specular IOR Level"]) if "Specular IOR Level" in inp else 0.5
-            row["f0"] = float(np.clip(((ior - 1) / (ior + 1)) ** 2 * 2 * level, 0, 1))
+            row["f0"] = float(np.clip(((ior - 1) / (ior + 1)) ** 2 * 2 * max(level, 0.0), 0, 1))
+            if "Specular Tint" in inp:
+                row["specular_tint"] = self._color_input(material, inp["Specular Tint"], None, row, (1, 1, 1))
+            row["multiscatter"] = self._multiscatter(material, node)
+            if "Anisotropic" in inp and (inp["Anisotropic"].is_linked or float(inp["Anisotropic"].default_value) > 0):
+                self._warn(material, "Principled 'Anisotropic' is not supported; rendered isotropic")
             strength = self._float_input(material, inp["Emission Strength"])
             ec = self._color_input(material, inp["Emission Color"], "emit_tex", row, (0, 0, 0))
             row["emission"] = tuple(np.array(ec, np.float32) * strength)
@@ -133,9 +146,14 @@ class MaterialRegistry:
             row["emission"] = tuple(np.array(c, np.float32) * self._float_input(material, node.inputs["Strength"]))
             return row
         if t in {"BSDF_GLOSSY", "BSDF_ANISOTROPIC"}:
-            row = {"metallic": 1.0, "f0": 0.04}
+            # Cycles: GGX with the constant Fresnel "colour" (f0 = 0: no dielectric layer, no diffuse)
+            row = {"metallic": 1.0, "f0": 0.0, "metal_f90": 0.0}
             row["base_color"] = self._color_input(material, node.inputs["Color"], "base_tex", row, (0.8, 0.8, 0.8))
             row["roughness"] = self._float_input(material, node.inputs["Roughness"])
+            row["multiscatter"] = self._multiscatter(material, node)
+            if "Anisotropy" in node.inputs and (node.inputs["Anisotropy"].is_linked
+                                                or abs(float(node.inputs["Anisotropy"].default_value)) > 1e-4):
+                self._warn(material, "Glossy BSDF anisotropy is not supported; rendered isotropic")
             return row
         if t in {"MIX_SHADER", "ADD_SHADER"} and depth < 8:
             shaders = [s for s in node.inputs if s.type == "SHADER"]
@@ -185,7 +203,8 @@ class MaterialRegistry:
 
 
 def _blend(parts: list[dict], weights) -> dict:
-    keys = {"base_color": (0.8, 0.8, 0.8), "metallic": 0.0, "roughness": 0.5, "f0": 0.04, "emission": (0, 0, 0)}
+    keys = {"base_color": (0.8, 0.8, 0.8), "metallic": 0.0, "roughness": 0.5, "f0": 0.04, "emission": (0, 0, 0),
+            "specular_tint": (1, 1, 1), "metal_f90": 1.0, "multiscatter": 1.0}
     out = {}
     wsum = sum(weights) or 1.0
     for k, default in keys.items():

@@ -17,8 +17,9 @@ another pixel keeps x2 (the reconnection shift); in solid angle its Jacobian is
 Caching Lo assumes x2 reflects the same radiance toward every receiver (Lambertian). So the path splits the
 light leaving x2 by lobe (pathtracer.FirstBounce.lo_d: the same light samples weighed by x2's diffuse lobe
 alone): only that diffuse part is cached and reused; the specular part (all of it on metals) goes to the pixel
-as the path traced it. The split is exact; the one approximation left is the Principled diffuse lobe's Fresnel
-weight 1 − F(cos θ) at x2, taken at the direction the sample was made for (Diffuse BSDF: exact). At a glossy x1
+as the path traced it. The split is exact; the one approximation left is the Principled diffuse lobe's layering
+weight at x2 (one minus the specular layer's albedo toward the viewer), taken at the direction the sample was made
+for (Diffuse BSDF: exact; at roughness 1 the weight varies by ~4 % over the hemisphere). At a glossy x1
 (roughness below the threshold) the reservoirs resample the diffuse lobe only and the specular lobe keeps the
 path-traced sample: f = f_d + f_s splits the integral exactly there too.
 

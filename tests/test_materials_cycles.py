@@ -1,0 +1,114 @@
+"""Materials against Cycles (same bpy, CPU): the Principled BSDF at every view angle, Glossy and Diffuse BSDFs.
+
+Scenes (tests/bpy_scenes.py): a 6 x 4 grid of spheres (SPHERE_GRID: Principled dielectrics at roughness 0.1-1,
+IOR 1.2/1.5/2.0, Specular IOR Level 0/0.5/1, Specular Tint; metals at roughness 0.1-1 and a tinted metal; Glossy
+BSDFs; a Diffuse BSDF; a half-metal; a white and a black dielectric) lit by an area light or an emissive quad, and
+a floor of four materials seen at grazing angles by a low camera. Each side renders REPS independent seeds; per
+sphere (its pixels only) or per floor cell the means are compared with Welch z-scores, with the bound of
+tests/test_cycles_accuracy.py: |ours - Cycles| < 5 SE + 0.5 % of Cycles (two-sided p ≈ 2e-5 per cell at
+the SE bound; the margin is 4x tighter than the 2 % the materials issue asks for).
+
+Power: the cells that isolate a lobe (diffuse, the layered diffuse of a white dielectric, the dielectric specular
+of a black one, rough metals, a Glossy BSDF, rough dielectrics of IOR 1.2 and 2.0) must each fail the same test
+when our mean is scaled by 1.03: a 3 % error in any of those lobes cannot pass.
+Before the Cycles layering (diffuse weighted by 1 - Schlick(f0, cos θ_view)) the floor's rough dielectrics read
+38 % dark in the far cells and spheres were off by up to 8 % (docs/RESULTS.md "Principled BSDF").
+"""
+import numpy as np
+import pytest
+from bpy_scenes import SPHERE_GRID, configure_cycles, configure_restir, grazing_floor, material_spheres, render_passes
+
+REPS = 16
+Z_MAX = 5.0
+MARGIN = 0.005
+ROWS, COLS = len(SPHERE_GRID), len(SPHERE_GRID[0])
+SIZE = (144, 96)
+# (row, col) of the cells that isolate one lobe each (see the module docstring)
+LOBE_CELLS = {"diffuse": (3, 2), "layered diffuse": (3, 4), "dielectric specular": (3, 5), "metal 0.5": (1, 2),
+              "metal 1.0": (1, 4), "glossy": (3, 1), "IOR 1.2": (2, 1), "IOR 2.0": (2, 3)}
+
+
+def sphere_masks(size=SIZE):
+    """(ROWS*COLS, h, w) bool: the pixels inside each sphere (orthographic camera, 6 units across, radius 0.4,
+    half a pixel in from the silhouette), row 0 of the image at the top."""
+    w, h = size
+    yy, xx = np.mgrid[0:h, 0:w] + 0.5
+    r = 0.4 * w / COLS - 0.5
+    return np.array([(yy - (i + 0.5) * h / ROWS) ** 2 + (xx - (j + 0.5) * w / COLS) ** 2 < r * r
+                     for i in range(ROWS) for j in range(COLS)])
+
+
+def cell_means(images, masks):
+    """(k, cells) means of the channel-averaged images (k, h, w, c) (row 0 at the bottom) over each mask."""
+    flat = images.mean(axis=3)[:, ::-1]
+    return np.stack([flat[:, m].mean(axis=1) for m in masks], axis=1)
+
+
+def render_reps(build, engine, bounces, samples, **settings):
+    scene = build()
+    out = []
+    for seed in range(REPS):
+        if engine == "RESTIR":
+            configure_restir(scene, samples, bounces, seed, **settings)
+        else:
+            configure_cycles(scene, samples, bounces, seed)
+        out.append(render_passes(scene)["Combined"][..., :3])
+    return np.array(out)
+
+
+def agree(mean_ours, mean_ref, se):
+    return np.abs(mean_ours - mean_ref) <= Z_MAX * se + MARGIN * np.abs(mean_ref)
+
+
+def assert_cells_match(ours, ref, names, power=()):
+    """Every cell within the bound; every cell in ``power`` (indices) able to see a 3 % error."""
+    assert np.isfinite(ours).all()
+    ma, mb = ours.mean(axis=0), ref.mean(axis=0)
+    se = np.sqrt(ours.var(axis=0, ddof=1) / len(ours) + ref.var(axis=0, ddof=1) / len(ref))
+    ok = agree(ma, mb, se)
+    report = [f"{n}: ours/cycles {a / b:.4f} (rel SE {s / b:.4f})" for n, a, b, s in zip(names, ma, mb, se)]
+    assert ok.all(), "\n".join(r for r, good in zip(report, ok) if not good)
+    for i in power:
+        se3 = np.sqrt(1.03 ** 2 * ours[:, i].var(ddof=1) / len(ours) + ref[:, i].var(ddof=1) / len(ref))
+        assert not agree(1.03 * ma[i], mb[i], se3), f"cannot see a 3 % error in {report[i]}"
+
+
+def grid_names():
+    return [f"{kind} base {base} roughness {rough} {extra}" for row in SPHERE_GRID for kind, base, rough, extra in row]
+
+
+POWER = [r * COLS + c for r, c in LOBE_CELLS.values()]
+
+
+@pytest.mark.parametrize("light,bounces", [("AREA", 0), ("QUAD", 0), ("AREA", 3)])
+def test_material_grid_path_tracer_matches_cycles(addon, light, bounces):
+    masks = sphere_masks()
+    ours = render_reps(lambda: material_spheres(light, SIZE), "RESTIR", bounces, 32, integrator="PATH")
+    ref = render_reps(lambda: material_spheres(light, SIZE), "CYCLES", bounces, 64)
+    assert_cells_match(cell_means(ours, masks), cell_means(ref, masks), grid_names(), POWER)
+
+
+def test_material_grid_restir_di_matches_cycles(addon):
+    """ReSTIR DI's target and shading use the same material model: unbiased mode converges to Cycles per sphere."""
+    masks = sphere_masks()
+    ours = render_reps(lambda: material_spheres("AREA", SIZE), "RESTIR", 0, 16, integrator="RESTIR",
+                       direct_method="RESTIR", bias_correction="UNBIASED", temporal_reuse=True, spatial_neighbors=5)
+    ref = render_reps(lambda: material_spheres("AREA", SIZE), "CYCLES", 0, 64)
+    assert_cells_match(cell_means(ours, masks), cell_means(ref, masks), grid_names(), POWER)
+
+
+def test_grazing_floor_matches_cycles(addon):
+    """Rough Principled floors seen at grazing angles (the issue's 11-12 % dark case; 38 % in this scene's far
+    cells before the fix): 4 x 4 image cells, the sky cells (black in Cycles) left out."""
+    size = (96, 64)
+    ours = render_reps(lambda: grazing_floor(size), "RESTIR", 0, 32, integrator="PATH")
+    ref = render_reps(lambda: grazing_floor(size), "CYCLES", 0, 64)
+    w, h = size
+    cells = np.zeros((16, h, w), bool)
+    for i in range(4):
+        for j in range(4):
+            cells[i * 4 + j, i * h // 4:(i + 1) * h // 4, j * w // 4:(j + 1) * w // 4] = True
+    a, b = cell_means(ours, cells), cell_means(ref, cells)
+    lit = np.flatnonzero(b.mean(axis=0) > 0.02)
+    assert len(lit) >= 10
+    assert_cells_match(a[:, lit], b[:, lit], [f"cell {k}" for k in lit])
