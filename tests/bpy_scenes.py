@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 
 import bpy
+import numpy as np
 
 from harness.render import configure_cycles, configure_restir, render_scene
 from harness.scenes import (black_world, build_cornell, camera, diffuse, emission, enable_nodes, light, plane,
@@ -53,6 +54,80 @@ SPHERE_GRID = [
 ]
 
 
+# Mix and Add shaders (one row): ("MIX", fac or "TEX" (a checker image), A, B) / ("ADD", A, B), leaves as above.
+MIX_GRID = [[
+    ("MIX", 0.3, ("D", (0.8, 0.2, 0.1), 0.0, {}), ("G", (1.0, 1.0, 1.0), 0.3, {})),
+    ("ADD", ("D", (0.4, 0.4, 0.4), 0.0, {}), ("G", (0.5, 0.5, 0.5), 0.5, {})),
+    ("MIX", 0.5, ("P", (0.2, 0.6, 0.3), 0.2, {}), ("P", (0.9, 0.7, 0.4), 0.8, {"Metallic": 1.0})),
+    ("MIX", "TEX", ("D", (0.8, 0.1, 0.1), 0.0, {}), ("D", (0.1, 0.2, 0.8), 0.0, {})),
+    ("MIX", 0.6, ("MIX", 0.5, ("D", (0.6, 0.6, 0.2), 0.0, {}), ("G", (0.8, 0.8, 0.8), 0.2, {})),
+     ("P", (0.3, 0.3, 0.9), 0.6, {})),
+    ("ADD", ("E", (1.0, 0.5, 0.2), 0.5, {}), ("P", (0.5, 0.5, 0.5), 0.4, {})),
+]]
+
+
+def checker_image(name="Checker", n=8):
+    """An n x n black/white checker (Non-Color), made in memory."""
+    img = bpy.data.images.new(name, n, n, float_buffer=True)
+    img.colorspace_settings.name = "Non-Color"
+    ij = np.add.outer(np.arange(n), np.arange(n)) % 2
+    px = np.repeat(ij.astype(np.float32)[..., None], 4, axis=2)
+    px[..., 3] = 1
+    img.pixels.foreach_set(px.ravel())
+    img.pack()
+    return img
+
+
+def _shader_node(tree, spec):
+    """A shader node for a grid spec (leaf or MIX/ADD), linked below; returns the node."""
+    nodes, links = tree.nodes, tree.links
+    kind = spec[0]
+    if kind in ("MIX", "ADD"):
+        node = nodes.new("ShaderNodeMixShader" if kind == "MIX" else "ShaderNodeAddShader")
+        subs = spec[2:] if kind == "MIX" else spec[1:]
+        shader_inputs = [s for s in node.inputs if s.type == "SHADER"]
+        for socket, sub_spec in zip(shader_inputs, subs):
+            links.new(_shader_node(tree, sub_spec).outputs[0], socket)
+        if kind == "MIX":
+            if spec[1] == "TEX":
+                tex = nodes.new("ShaderNodeTexImage")
+                tex.image = bpy.data.images.get("Checker") or checker_image()
+                tex.interpolation = "Closest"
+                links.new(tex.outputs["Color"], node.inputs["Fac"])
+            else:
+                node.inputs["Fac"].default_value = spec[1]
+        return node
+    _k, color, roughness, extra = spec
+    if kind == "D":
+        node = nodes.new("ShaderNodeBsdfDiffuse")
+        node.inputs["Color"].default_value = (*color, 1)
+        node.inputs["Roughness"].default_value = 0.0
+    elif kind == "G":
+        node = nodes.new("ShaderNodeBsdfGlossy")
+        node.inputs["Color"].default_value = (*color, 1)
+        node.inputs["Roughness"].default_value = roughness
+    elif kind == "E":
+        node = nodes.new("ShaderNodeEmission")
+        node.inputs["Color"].default_value = (*color, 1)
+        node.inputs["Strength"].default_value = roughness
+    else:
+        node = nodes.new("ShaderNodeBsdfPrincipled")
+        node.inputs["Base Color"].default_value = (*color, 1)
+        node.inputs["Roughness"].default_value = roughness
+        for key, value in extra.items():
+            node.inputs[key].default_value = value
+    return node
+
+
+def _spec_material(name, spec):
+    m = bpy.data.materials.new(name)
+    enable_nodes(m)
+    tree = m.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    tree.links.new(_shader_node(tree, spec).outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    return m
+
+
 def _grid_material(name, kind, color, roughness, extra):
     if kind == "D":
         return diffuse(name, color)
@@ -73,18 +148,22 @@ def _grid_material(name, kind, color, roughness, extra):
     return m
 
 
-def material_spheres(light_kind="AREA", size=(144, 96)):
-    """A 6 x 4 grid of smooth spheres (one cell of the image each, :data:`SPHERE_GRID`) in front of a grey
-    Diffuse wall, seen by an orthographic camera along +Y, lit from the upper left front by an area light or an
-    emissive quad of the same size. Every view angle of every material is in the image (sphere rims are grazing)."""
+def material_spheres(light_kind="AREA", size=(144, 96), grid=None):
+    """A 6-column grid of smooth spheres (one cell of the image each; :data:`SPHERE_GRID` by default, 4 rows, or
+    :data:`MIX_GRID`) in front of a grey Diffuse wall, seen by an orthographic camera along +Y, lit from the upper
+    left front by an area light or an emissive quad of the same size. Every view angle of every material is in
+    the image (sphere rims are grazing). ``size`` must keep one cell square (width / 6 = height / rows)."""
     scene = reset()
-    for r, row in enumerate(SPHERE_GRID):
-        for c, (kind, color, rough, extra) in enumerate(row):
-            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.4, location=(c - 2.5, 0, 1.5 - r), segments=32,
+    grid = SPHERE_GRID if grid is None else grid
+    top = (len(grid) - 1) / 2
+    for r, row in enumerate(grid):
+        for c, spec in enumerate(row):
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.4, location=(c - 2.5, 0, top - r), segments=32,
                                                  ring_count=16)
             obj = bpy.context.active_object
             bpy.ops.object.shade_smooth()
-            obj.data.materials.append(_grid_material(f"M{r}{c}", kind, color, rough, extra))
+            mat = _spec_material(f"M{r}{c}", spec) if spec[0] in ("MIX", "ADD") else _grid_material(f"M{r}{c}", *spec)
+            obj.data.materials.append(mat)
     plane("Wall", 1, (0, 1.5, 0), (math.pi / 2, 0, 0), material=diffuse("Wall", (0.5, 0.5, 0.5)), scale=(8, 6, 1))
     rot = (math.radians(45), 0, math.radians(-30))
     if light_kind == "AREA":

@@ -23,7 +23,7 @@ the specular ones.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -55,49 +55,57 @@ def multiscatter_fresnel(fss: np.ndarray, e_avg: np.ndarray) -> np.ndarray:
     return fss * e_avg / (1.0 - fss * (1.0 - e_avg))
 
 
-@dataclass
-class SurfaceParams:
-    """Per-hit (or per-material) BSDF parameters. RGB rows (3, n): diffuse = base (1 - metallic), metal_f0, metal_b
-    (F82-tint b), diel_f0 (f0 · tint), fms_m, fms_d (multiscatter Fresnel of each lobe). Scalars (n,): metal_w
-    (metallic), metal_f90 (1: F rises to 1 at grazing, 0: constant colour), diel_w (1 - metallic where the
-    dielectric lobe exists), f0r (the untinted f0), eta (its IOR), alpha, ms (1: multiscatter GGX), p_spec
-    (probability of sampling a specular lobe), spec_on (1 where a specular lobe exists)."""
+#: Rows of a SurfaceParams block: RGB triples, then scalars (see :class:`SurfaceParams`).
+PARAM_ROWS = {"diffuse": slice(0, 3), "a_m": slice(3, 6), "b_m": slice(6, 9), "d_m": slice(9, 12),
+              "fm": slice(12, 15), "a_d": slice(15, 18), "c_d": slice(18, 21), "fd": slice(21, 24),
+              "msd": slice(24, 27), "diel_f0": slice(27, 30), "alpha": 30, "eta2m1": 31, "f0r": 32, "p_spec": 33,
+              "spec_on": 34, "metal": 35, "diel": 36}
+PARAM_WIDTH = 37
+#: The rows that scale with a lobe's weight (Mix/Add components: core/mix.py)
+WEIGHT_ROWS = (slice(0, 12), slice(15, 21))
 
-    diffuse: np.ndarray
-    metal_f0: np.ndarray
-    metal_b: np.ndarray
-    diel_f0: np.ndarray
-    fms_m: np.ndarray
-    fms_d: np.ndarray
-    metal_w: np.ndarray
-    metal_f90: np.ndarray
-    diel_w: np.ndarray
-    f0r: np.ndarray
-    eta: np.ndarray
-    alpha: np.ndarray
-    ms: np.ndarray
-    p_spec: np.ndarray
-    spec_on: np.ndarray
+
+class SurfaceParams:
+    """Per-hit (or per-material) BSDF parameters as one (37, n) float32 block of named rows (:data:`PARAM_ROWS`),
+    so a gather by material or by hit is one ``np.take``. The lobes' weights are folded into their Fresnel terms:
+      diffuse (3) base (1 - metallic)
+      a_m, b_m, d_m (3) metal: metallic · F0, metallic · (1 - F0) · f90, metallic · b  (F_m = F0 + (f90 - F0) c⁵
+                     - b ωo·h c⁶ with c = 1 - ωo·h; f90 = 1 for Principled metals, F0 for the Glossy BSDF)
+      fm, fd (3)     multiscatter terms ms · Fms of the metal and the dielectric lobe (ms = 1 for Multiscatter GGX)
+      a_d, c_d (3)   dielectric: F_d = mix(f0t, 1, (F - f0)/(1 - f0)) = a_d + c_d · (F - f0), times (1 - metallic)
+      msd (3)        ms - fd: the dielectric layer's albedo is (1 - (1 - E) msd) · mix(f0t, 1, S)
+      diel_f0 (3)    f0t = f0 · Specular Tint (0 without a dielectric lobe)
+      alpha, eta2m1 = η² - 1, f0r = f0 (untinted), p_spec (probability of sampling a specular lobe), spec_on (1
+      where a specular lobe exists), metal, diel (1 where that lobe exists)."""
+
+    __slots__ = ("block",)
+
+    def __init__(self, block: np.ndarray):
+        self.block = block
+
+    def __getattr__(self, name):
+        try:
+            return object.__getattribute__(self, "block")[PARAM_ROWS[name]]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def __len__(self) -> int:
+        return self.block.shape[1]
 
     def take(self, idx) -> "SurfaceParams":
         """Parameters of entries ``idx`` (index array or slice)."""
-        out = {}
-        for f in fields(self):
-            a = getattr(self, f.name)
-            if a.ndim == 2:
-                out[f.name] = a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1)
-            else:
-                out[f.name] = a[idx]
-        return SurfaceParams(**out)
+        if isinstance(idx, slice):
+            return SurfaceParams(self.block[:, idx])
+        return SurfaceParams(np.take(self.block, idx, axis=1))
 
     def assign(self, idx, other: "SurfaceParams") -> None:
-        """self[idx] = other (every field)."""
-        for f in fields(self):
-            a = getattr(self, f.name)
-            if a.ndim == 2:
-                a[:, idx] = getattr(other, f.name)
-            else:
-                a[idx] = getattr(other, f.name)
+        """self[idx] = other (every row)."""
+        self.block[:, idx] = other.block
+
+    def scale(self, factor: np.ndarray) -> None:
+        """Scale every lobe by ``factor`` (n,) in place (Fresnel and layering terms are ratios: unchanged)."""
+        for rows in WEIGHT_ROWS:
+            self.block[rows] *= factor
 
     @staticmethod
     def from_material(base, metallic, roughness, f0_d, spec_tint=None, metal_f90=None, multiscatter=None):
@@ -111,9 +119,9 @@ class SurfaceParams:
         f90 = np.ones(m, np.float32) if metal_f90 is None else np.asarray(metal_f90, np.float32)
         ms = np.ones(m, np.float32) if multiscatter is None else np.asarray(multiscatter, np.float32)
         f0r = np.clip(np.asarray(f0_d, np.float32), 0, 0.99 ** 2)
-        alpha = np.maximum(np.clip(np.asarray(roughness, np.float32), 0, 1) ** 2, ALPHA_MIN).astype(np.float32)
+        alpha = np.maximum(np.clip(np.asarray(roughness, np.float32), 0, 1) ** 2, ALPHA_MIN)
         e_avg = tables.average_albedo(alpha)
-        # metal: F82-tint (b from the tint where metal_f90 = 1), or the Glossy BSDF's constant colour
+        # metal: F82-tint (b from the tint where f90 = 1), or the Glossy BSDF's constant colour
         metal_f0 = np.minimum(base, 1.0)
         f5 = _F82 ** 5
         tint82 = np.minimum(tint, 1.0)
@@ -122,24 +130,38 @@ class SurfaceParams:
         # dielectric: f0 tinted, η from the untinted f0
         sq = np.sqrt(f0r)
         eta = (1 + sq) / (1 - sq)
-        diel_f0 = np.clip(f0r * tint, 0, 1)
+        diel = f0r > 0
+        diel_f0 = np.clip(f0r * tint, 0, 1) * diel
         s_ss = np.clip((fss_dielectric(eta) - f0r) / np.maximum(1 - f0r, 1e-6), 0, 1)
         fss_d = diel_f0 + (1 - diel_f0) * s_ss
-        diel_w = np.where(f0r > 0, 1 - met, 0.0)
-        diffuse = base * (1 - met)
+        diel_w = np.where(diel, 1 - met, 0.0)
+        metal = (met > 0) & ((metal_f0.max(axis=0) > 0) | (f90 > 0))
+        out = SurfaceParams(np.zeros((PARAM_WIDTH, m), np.float32))
+        b = out.block
+        b[PARAM_ROWS["diffuse"]] = base * (1 - met)
+        b[PARAM_ROWS["a_m"]] = met * metal_f0
+        b[PARAM_ROWS["b_m"]] = met * (1 - metal_f0) * f90
+        b[PARAM_ROWS["d_m"]] = met * metal_b
+        b[PARAM_ROWS["fm"]] = ms * multiscatter_fresnel(fss_m, e_avg)
+        b[PARAM_ROWS["a_d"]] = diel_w * diel_f0
+        b[PARAM_ROWS["c_d"]] = diel_w * (1 - diel_f0) / np.maximum(1.0 - f0r, 1e-6)
+        fd = ms * multiscatter_fresnel(fss_d, e_avg)
+        b[PARAM_ROWS["fd"]] = fd
+        b[PARAM_ROWS["msd"]] = ms - fd
+        b[PARAM_ROWS["diel_f0"]] = diel_f0
+        b[PARAM_ROWS["alpha"]] = alpha
+        b[PARAM_ROWS["eta2m1"]] = eta * eta - 1
+        b[PARAM_ROWS["f0r"]] = f0r
         ws = luminance_rows(metal_f0 + (1 - metal_f0) * (0.05 * f90)) * met + luminance_rows(diel_f0) * diel_w
-        wd = luminance_rows(diffuse) * (1 - f0r)
+        wd = luminance_rows(base * (1 - met)) * (1 - f0r)
         tot = ws + wd
         p = np.where(tot > 0, ws / np.maximum(tot, 1e-12), 0.0)
         both = (ws > 0) & (wd > 0)
-        p = np.where(both, np.clip(p, 0.1, 0.9), p)
-        spec_on = ((met > 0) & ((metal_f0.max(axis=0) > 0) | (f90 > 0))) | (diel_w > 0)
-        f32 = np.float32
-        return SurfaceParams(diffuse.astype(f32), metal_f0.astype(f32), metal_b.astype(f32), diel_f0.astype(f32),
-                             multiscatter_fresnel(fss_m, e_avg).astype(f32),
-                             multiscatter_fresnel(fss_d, e_avg).astype(f32), met.astype(f32), f90,
-                             diel_w.astype(f32), f0r, eta.astype(f32), alpha, ms, p.astype(f32),
-                             spec_on.astype(f32))
+        b[PARAM_ROWS["p_spec"]] = np.where(both, np.clip(p, 0.1, 0.9), p)
+        b[PARAM_ROWS["spec_on"]] = metal | (diel_w > 0)
+        b[PARAM_ROWS["metal"]] = metal
+        b[PARAM_ROWS["diel"]] = diel_w > 0
+        return out
 
     @staticmethod
     def of_table(mats, idx=None, base=None) -> "SurfaceParams":
@@ -166,9 +188,10 @@ class ViewTerms:
     """The factors of f and its pdf that depend on the view direction only, per surface (n): computed once
     and reused by every wi evaluated there (next-event estimation, BSDF sampling, shading).
     kd (3, n) the diffuse lobe (layering weight applied, over π); the specular lobes are
-    D G2/(4 cos θo cos θi) · (spec_a + c⁵ spec_b + F(ωo·h) spec_c - ωo·h c⁶ spec_d) with c = 1 - ωo·h and F the
-    exact dielectric Fresnel of η (eta2m1 = η² - 1): spec_a, spec_b (3, n); spec_c, eta2m1 only where some
-    surface has a dielectric lobe, spec_d only where some metal has a Specular Tint (else None);
+    D G2/(4 cos θo cos θi) · (spec_a + c⁵ spec_b + max(F(ωo·h) - f0r, 0) spec_c - ωo·h c⁶ spec_d) with
+    c = 1 - ωo·h and F the exact dielectric Fresnel of η (eta2m1 = η² - 1): spec_a (3, n); spec_b only where some
+    surface has a metal lobe, spec_c, eta2m1, f0r only where some has a dielectric lobe, spec_d only where some
+    metal has a Specular Tint (else None);
     alpha, alpha2, lam_o = Λ(ωo), co = cos θo, spec_on, p_spec (n,)."""
 
     kd: np.ndarray
@@ -184,43 +207,52 @@ class ViewTerms:
     spec_on: np.ndarray
     p_spec: np.ndarray
     glossy: bool = True  # False: no surface has a specular lobe (Diffuse BSDFs only): Lambert alone
+    f0r: np.ndarray | None = None  # (n,) untinted dielectric f0 (with spec_c)
 
     @staticmethod
     def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None,
            layer: np.ndarray | None = None) -> "ViewTerms":
         """``albedo``, ``layer``: :func:`view_albedo`, :func:`view_layer` if known."""
         co = wo[2]
-        glossy = bool((p.spec_on > 0).any())
-        if not glossy:
-            z = np.zeros_like(p.diffuse)
-            return ViewTerms(p.diffuse * INV_PI, z, z, None, None, None, p.alpha, p.alpha * p.alpha,
-                             smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec, False)
-        e = view_albedo(p, wo) if albedo is None else albedo
-        miss = (1.0 - e) / e
-        comp_m = 1.0 + (p.ms * miss) * p.fms_m
-        mw = comp_m * p.metal_w
-        spec_a = mw * p.metal_f0
-        spec_b = mw * (1.0 - p.metal_f0) * p.metal_f90
-        spec_d = mw * p.metal_b if (p.metal_b > 0).any() else None
+        alpha = p.alpha
+        lam_o = smith_lambda(alpha, co)
         kd = p.diffuse * INV_PI
-        spec_c = eta2m1 = None
-        if (p.diel_w > 0).any():
-            comp_d = 1.0 + (p.ms * miss) * p.fms_d
-            dw = comp_d * p.diel_w
-            # F_d = f0t + (1 - f0t)(F - f0r)/(1 - f0r): split into a constant and a multiple of F
-            inv = 1.0 / np.maximum(1.0 - p.f0r, np.float32(1e-6))
-            spec_c = dw * (1.0 - p.diel_f0) * inv
-            spec_a = spec_a + dw * p.diel_f0 - spec_c * p.f0r
-            eta2m1 = p.eta * p.eta - 1.0
+        has_metal = bool(p.metal.any())
+        has_diel = bool(p.diel.any())
+        if not (has_metal or has_diel):
+            return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha * alpha, lam_o, co, p.spec_on,
+                             p.p_spec, False)
+        e = view_albedo(p, wo) if albedo is None else albedo
+        one_e = 1.0 - e
+        miss = one_e / e
+        spec_a = spec_b = spec_c = spec_d = eta2m1 = None
+        if has_metal:
+            cm = p.fm * miss
+            cm += 1.0
+            spec_a = cm * p.a_m
+            spec_b = cm * p.b_m
+            if p.d_m.any():
+                spec_d = cm * p.d_m
+        if has_diel:
+            cd = p.fd * miss
+            cd += 1.0
+            spec_c = cd * p.c_d
+            ad = cd * p.a_d
+            spec_a = ad if spec_a is None else spec_a + ad
+            eta2m1 = p.eta2m1
             s = view_layer(p, wo) if layer is None else layer
-            dark = p.ms * (e + p.fms_d * (1.0 - e)) + (1.0 - p.ms)
-            layer_albedo = (dark * (p.diel_f0 + (1.0 - p.diel_f0) * s)).max(axis=0)
-            kd = kd * np.where(p.diel_w > 0, np.clip(1.0 - layer_albedo, 0.0, 1.0), np.float32(1.0))
-        f32 = np.float32
-        return ViewTerms(kd.astype(f32, copy=False), spec_a.astype(f32, copy=False), spec_b.astype(f32, copy=False),
-                         None if spec_c is None else spec_c.astype(f32), None if spec_d is None else spec_d.astype(f32),
-                         None if eta2m1 is None else eta2m1.astype(f32), p.alpha, p.alpha * p.alpha,
-                         smith_lambda(p.alpha, co), co, p.spec_on, p.p_spec, True)
+            f0t = p.diel_f0
+            la = (1.0 - f0t) * s
+            la += f0t
+            dark = one_e * p.msd
+            np.subtract(1.0, dark, out=dark)
+            la *= dark                                  # the dielectric layer's albedo toward the viewer
+            w = la.max(axis=0)
+            np.subtract(1.0, w, out=w)
+            np.clip(w, 0.0, 1.0, out=w)                 # 1 where there is no dielectric layer (f0t = 0, S = 0)
+            kd *= w
+        return ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha * alpha, lam_o, co, p.spec_on,
+                         p.p_spec, True, p.f0r if has_diel else None)
 
 
 def view_terms(surf) -> ViewTerms:
@@ -264,22 +296,49 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         pdf = np.maximum(ci, np.float32(0.0)) * INV_PI * valid
         return (v.kd * valid).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
     wdw = dot(wo, wi)
-    hinv = 1.0 / np.sqrt(np.maximum(2.0 + 2.0 * wdw, np.float32(1e-24)))
-    cos_h = np.clip((co + ci) * hinv, 0, 1)
-    odh = np.clip((1.0 + wdw) * hinv, 1e-6, 1.0)
-    den = cos_h * cos_h * (v.alpha2 - 1.0) + 1.0
-    d = v.alpha2 / (np.float32(np.pi) * den * den)
-    g = 1.0 / (1.0 + v.lam_o + smith_lambda(v.alpha, ci))
-    c = np.clip(1.0 - odh, 0.0, 1.0)
-    c5 = (c * c) * (c * c) * c
-    s = v.spec_on * d * g / np.maximum(4.0 * co * ci, np.float32(1e-12))
-    f = v.kd + s * v.spec_a + (s * c5) * v.spec_b
+    hinv = 2.0 + 2.0 * wdw
+    np.maximum(hinv, np.float32(1e-24), out=hinv)
+    np.sqrt(hinv, out=hinv)
+    np.divide(np.float32(1.0), hinv, out=hinv)
+    cos_h = (co + ci) * hinv
+    np.clip(cos_h, 0, 1, out=cos_h)
+    odh = wdw
+    odh += 1.0
+    odh *= hinv
+    np.clip(odh, 1e-6, 1.0, out=odh)
+    den = cos_h * cos_h
+    den *= v.alpha2 - 1.0
+    den += 1.0
+    d = den * den
+    d *= np.float32(np.pi)
+    np.divide(v.alpha2, d, out=d)                    # GGX D(h)
+    s = 1.0 + v.lam_o + smith_lambda(v.alpha, ci)
+    den4 = 4.0 * co * ci
+    np.maximum(den4, np.float32(1e-12), out=den4)
+    s *= den4
+    np.divide(d, s, out=s)
+    s *= v.spec_on                                   # D G2 / (4 cos θo cos θi)
+    f = v.spec_a * s
+    f += v.kd
+    if v.spec_b is not None or v.spec_d is not None:
+        c = 1.0 - odh
+        np.clip(c, 0.0, 1.0, out=c)
+        c5 = c * c
+        c5 *= c5
+        c5 *= c
+        c5 *= s
+        if v.spec_b is not None:
+            f += c5 * v.spec_b
+        if v.spec_d is not None:
+            c5 *= odh * c
+            f -= c5 * v.spec_d
+            np.maximum(f, 0.0, out=f)                # the F82-tint clamp
     if v.spec_c is not None:
-        f += (s * fresnel_exact(odh, v.eta2m1)) * v.spec_c
-    if v.spec_d is not None:
-        f -= (s * odh * c5 * c) * v.spec_d
-    if v.spec_c is not None or v.spec_d is not None:
-        np.maximum(f, 0.0, out=f)  # rounding of the split dielectric Fresnel; the F82 clamp
+        fr = fresnel_exact(odh, v.eta2m1)
+        fr -= v.f0r
+        np.maximum(fr, 0.0, out=fr)
+        fr *= s
+        f += fr * v.spec_c
     f *= valid
     pdf = (1 - v.p_spec) * np.maximum(ci, 0) * INV_PI + v.p_spec * (d * cos_h / (4.0 * odh))
     pdf *= valid

@@ -48,6 +48,7 @@ class TraceContext:
     film_transparent: bool = False
     material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α
     material_layer: np.ndarray = None   # (m, 32) dielectric layer factor S rows over μo (microfacet_tables)
+    has_mix: bool = False  # some material is a Mix/Add shader (core/mix.py)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -415,6 +416,7 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         material_params=params, max_bounces=int(max(0, max_bounces)),
                         film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
                         material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),
+                        has_mix=scene.materials.mix_first is not None and bool((scene.materials.mix_first >= 0).any()),
                         geom_flat=flat, geom_ng_rows=np.ascontiguousarray(geom_ng.T),
                         geom_normal_rows=np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32),
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T))

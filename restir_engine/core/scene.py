@@ -53,6 +53,12 @@ class MaterialTable:
     base_tex    (m,) int32  index into ``textures`` multiplying base_color, -1 = none
     emit_tex    (m,) int32  index into ``textures`` multiplying emission, -1 = none
     two_sided_emission (m,) bool  mesh emission leaves both faces (Cycles); lamps emit from the front only
+    mix_first, mix_count (m,) int32  a Mix/Add shader: its components are entries mix_first .. + mix_count of
+                        the mix_* arrays (-1, 0: not a mix; its own BSDF parameters are then unused)
+    mix_comp    (k,) int32  component material (never itself a mix)
+    mix_weight  (k,) constant weight of the component (product of the Mix factors on its path; Add: 1)
+    mix_tex     (k,) int32  texture index whose value t (first channel) further weighs it, -1 = none
+    mix_sign    (k,) +1: weight x t, -1: weight x (1 - t)
     textures    list of (h, w, 3) float32 linear images, row 0 at the bottom (Blender's order)
     names       material names, for messages
     """
@@ -68,6 +74,12 @@ class MaterialTable:
     base_tex: np.ndarray
     emit_tex: np.ndarray
     two_sided_emission: np.ndarray
+    mix_first: np.ndarray = None
+    mix_count: np.ndarray = None
+    mix_comp: np.ndarray = None
+    mix_weight: np.ndarray = None
+    mix_tex: np.ndarray = None
+    mix_sign: np.ndarray = None
     textures: list = field(default_factory=list)
     names: list = field(default_factory=list)
 
@@ -83,7 +95,23 @@ class MaterialTable:
             multiscatter=col("multiscatter", 1.0),
             base_tex=col("base_tex", -1, np.int32), emit_tex=col("emit_tex", -1, np.int32),
             two_sided_emission=col("two_sided_emission", True, bool),
+            **_mix_arrays(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
+
+
+def _mix_arrays(rows: list[dict]) -> dict:
+    """The mix_* fields of :class:`MaterialTable` from rows' "mix" lists of (component, weight, texture, sign)."""
+    first = np.full(len(rows), -1, np.int32)
+    count = np.zeros(len(rows), np.int32)
+    comps = []
+    for i, r in enumerate(rows):
+        if r.get("mix"):
+            first[i], count[i] = len(comps), len(r["mix"])
+            comps += list(r["mix"])
+    cols = list(zip(*comps)) if comps else [(), (), (), ()]
+    return {"mix_first": first, "mix_count": count, "mix_comp": np.array(cols[0], np.int32),
+            "mix_weight": np.array(cols[1], np.float32), "mix_tex": np.array(cols[2], np.int32),
+            "mix_sign": np.array(cols[3], np.float32)}
 
 
 DEFAULT_MATERIAL = {"name": "(default grey)", "base_color": (0.8, 0.8, 0.8), "roughness": 0.5, "f0": 0.04}

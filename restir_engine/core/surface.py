@@ -9,6 +9,7 @@ import numpy as np
 
 from .bsdf import SurfaceParams, ViewTerms
 from .microfacet_tables import rows_at
+from .mix import hash_uniform, pick_components
 from .sampling import barycentric, cols, dot, norm, orthonormal_basis
 from .textures import apply_texture
 
@@ -46,7 +47,21 @@ class Surface:
         self.ns = ns * s_ns
         self.wo = -d
         mat = geom.material[prim].astype(np.intp)
-        self.mat = mat
+        self.mat = mat  # the triangle's material (a Mix/Add shader stays itself here)
+        scale = None
+        if ctx.has_mix:  # Mix/Add shaders: one component per hit, scaled by the weights' sum (core/mix.py)
+            mixed = np.flatnonzero(mats.mix_first[mat] >= 0)
+            if mixed.size:
+                uv = None
+                if geom.uvs is not None:
+                    c = np.take(geom.uvs, prim[mixed], axis=0)
+                    uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[mixed][:, None], v[mixed][:, None])
+                comp, w = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv)
+                mat = mat.copy()
+                mat[mixed] = comp
+                scale = np.ones(len(mat), np.float32)
+                scale[mixed] = w
+        self.bsdf_mat = mat  # the material whose BSDF the hit uses
         self.params = ctx.material_params.take(mat)
         if geom.uvs is not None:
             textured = np.flatnonzero(mats.base_tex[mat] >= 0)
@@ -56,6 +71,8 @@ class Surface:
                 tm = mat[textured]
                 base = apply_texture(mats.base_color[tm], mats.base_tex[tm], uv, mats.textures)
                 self.params.assign(textured, SurfaceParams.of_table(mats, tm, base))
+        if scale is not None:
+            self.params.scale(scale)
         self.t, self.bt = orthonormal_basis(self.ns)
         wo = self.wo
         wo_l = np.empty_like(wo)
@@ -84,7 +101,7 @@ class Surface:
     def take(self, idx) -> "Surface":
         """The surfaces ``idx`` (an index array or a slice) as a new Surface."""
         out = Surface.__new__(Surface)
-        for name in ("prim", "b1", "b2", "mat", "albedo", "layer"):
+        for name in ("prim", "b1", "b2", "mat", "bsdf_mat", "albedo", "layer"):
             setattr(out, name, getattr(self, name)[idx])
         for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l"):
             a = getattr(self, name)

@@ -6,15 +6,15 @@ light point y (position, unit normal n_l, radiance Le), in area measure on the l
                                                                      at a back face of a one-sided light)
   p_b(y) = p_b,ω(ωi | ωo) · |cos θ_l| / d²                            (the BSDF sampling pdf, area measure)
 with f the Principled model of bsdf.py. Because luminance is linear, luminance(f · Le) splits into
-  Le · k_d  +  S(ωi) · (Le · A + (1 - ωo·h)⁵ · Le · B + F(ωo·h) · Le · C)
+  Le · k_d  +  S(ωi) · (Le · A + (1 - ωo·h)⁵ · Le · B + max(F(ωo·h) - f0, 0) · Le · C)
 where k_d, A, B and C are per-surface RGB vectors (luminance weights folded in), S is the scalar
-D·G/(4 cos θ_o cos θ_i) of the GGX lobes and F the exact dielectric Fresnel (η² - 1 a per-surface row); only S
+D·G/(4 cos θ_o cos θ_i) of the GGX lobes and F the exact dielectric Fresnel (η² - 1 and f0 per-surface rows); only S
 and the Fresnel terms depend on the candidate. A metal's Specular Tint (F82 term) is left out of p̂: p̂ then
 overestimates a tinted metal's grazing reflection a little, which costs variance, not bias. The half
 vector is never formed: with unit ωo, ωi, |ωo + ωi|² = 2 + 2 ωo·ωi, cos θ_h = (cos θ_o + cos θ_i)/|ωo + ωi|
 and ωo·h = (1 + ωo·ωi)/|ωo + ωi|. Agrees with bsdf.eval_bsdf to float32 rounding (tested).
 
-Layout: structure of arrays. Terms are a (31, n) float32 block (:data:`LAYOUT` rows), light points a
+Layout: structure of arrays. Terms are a (32, n) float32 block (:data:`LAYOUT` rows), light points a
 (11, ...) block (light_tiles.PackedPoints); the candidate axis broadcasts, so p̂ of m candidates at n
 surfaces is one pass over (m, n) arrays.
 """
@@ -33,12 +33,12 @@ INV_PI = np.float32(1.0 / np.pi)
 
 LAYOUT = {"p": slice(0, 3), "ng": slice(3, 6), "ns": slice(6, 9), "wo": slice(9, 12), "kd": slice(12, 15),
           "a": slice(15, 18), "b": slice(18, 21), "c": slice(21, 24), "co": 24, "alpha2": 25, "alpha": 26,
-          "lam_o": 27, "p_spec": 28, "spec_on": 29, "eta2m1": 30}
-WIDTH = 31  # float32 per surface: 124 bytes
+          "lam_o": 27, "p_spec": 28, "spec_on": 29, "eta2m1": 30, "f0r": 31}
+WIDTH = 32  # float32 per surface: 128 bytes
 
 
 class ShadingTerms:
-    """Per-surface terms of p̂ as a (31, n) float32 block (:data:`LAYOUT`): each term a contiguous row, the
+    """Per-surface terms of p̂ as a (32, n) float32 block (:data:`LAYOUT`): each term a contiguous row, the
     terms of other pixels (spatial and temporal neighbours) one column gather away (:meth:`take`)."""
 
     def __init__(self, packed: np.ndarray, glossy: bool | None = None, dielectric: bool | None = None):
@@ -55,7 +55,7 @@ class ShadingTerms:
     @staticmethod
     def of_surfaces(surf, out: np.ndarray | None = None) -> "ShadingTerms":
         """Terms of surfaces ``surf`` (a surface.Surface: p, ng, ns, wo, wo_l, params), written into ``out``
-        ((31, n) float32, e.g. a slice of a frame's block) when given."""
+        ((32, n) float32, e.g. a slice of a frame's block) when given."""
         prm = surf.params
         packed = np.empty((WIDTH, surf.p.shape[1]), np.float32) if out is None else out
         packed[LAYOUT["p"]] = surf.p
@@ -69,13 +69,18 @@ class ShadingTerms:
         packed[LAYOUT["co"]] = v.co
         packed[LAYOUT["kd"]] = v.kd * LUM[:, None]
         packed[LAYOUT["a"]] = v.spec_a * LUM[:, None]
-        packed[LAYOUT["b"]] = v.spec_b * LUM[:, None]
+        if v.spec_b is None:
+            packed[LAYOUT["b"]] = 0.0
+        else:
+            packed[LAYOUT["b"]] = v.spec_b * LUM[:, None]
         if v.spec_c is None:
             packed[LAYOUT["c"]] = 0.0
             packed[LAYOUT["eta2m1"]] = 0.0
+            packed[LAYOUT["f0r"]] = 0.0
         else:
             packed[LAYOUT["c"]] = v.spec_c * LUM[:, None]
             packed[LAYOUT["eta2m1"]] = v.eta2m1
+            packed[LAYOUT["f0r"]] = v.f0r
         packed[LAYOUT["lam_o"]] = v.lam_o
         packed[LAYOUT["spec_on"]] = prm.spec_on
         packed[LAYOUT["p_spec"]] = prm.p_spec
@@ -85,7 +90,7 @@ class ShadingTerms:
 
     def take(self, idx) -> "ShadingTerms":
         """Terms of surfaces ``idx`` (index array or slice). Without a glossy surface among them only the
-        rows the diffuse target and pdf read are gathered (p, ng, ns, kd, p_spec: 13 of 31)."""
+        rows the diffuse target and pdf read are gathered (p, ng, ns, kd, p_spec: 13 of 32)."""
         if isinstance(idx, slice):
             return ShadingTerms(self.packed[:, idx], self.glossy, self.dielectric)
         if self.glossy:
@@ -188,9 +193,10 @@ class ShadingTerms:
             spec += le[2] * self.a[2]
             if self.dielectric:
                 fr = fresnel_exact(odh, self.eta2m1)
+                fr -= self.f0r
+                np.maximum(fr, 0.0, out=fr)
                 fr *= le[0] * self.c[0] + le[1] * self.c[1] + le[2] * self.c[2]
                 spec += fr
-                np.maximum(spec, 0.0, out=spec)      # rounding of the split Fresnel (bsdf.ViewTerms)
             spec *= s
             lum += spec
             if want_pdf:

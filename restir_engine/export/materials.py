@@ -1,9 +1,10 @@
-"""Blender materials -> MaterialTable rows (Lambert + GGX parameters, emission radiance).
+"""Blender materials -> MaterialTable rows (Principled parameters, emission radiance, Mix/Add components).
 
-Supported exactly: Principled BSDF (Base Color, Metallic, Roughness, IOR, Specular IOR Level,
-Emission Color x Strength), Diffuse BSDF, Emission, Glossy BSDF, and an Image Texture (UV) feeding
-Base Color / Color / Emission Color. Anything else is approximated by its closest parameters and
-reported once per render, naming the material and the reason.
+Supported exactly: Principled BSDF (Base Color, Metallic, Roughness, IOR, Specular IOR Level, Specular Tint,
+Emission Color x Strength; Multiscatter GGX or GGX), Diffuse BSDF, Emission, Glossy BSDF, Mix Shader (constant
+factor or an Image Texture's Color/Alpha) and Add Shader of these, and an Image Texture (UV) feeding Base Color /
+Color / Emission Color. Anything else is approximated by its closest parameters and reported once per render,
+naming the material and the reason.
 """
 from __future__ import annotations
 
@@ -55,7 +56,11 @@ class MaterialRegistry:
         return len(self.rows) - 1
 
     def uses_textures(self, indices) -> bool:
-        return any(self.rows[i].get("base_tex", -1) >= 0 or self.rows[i].get("emit_tex", -1) >= 0 for i in indices)
+        def textured(row: dict) -> bool:
+            if row.get("base_tex", -1) >= 0 or row.get("emit_tex", -1) >= 0:
+                return True
+            return any(tex >= 0 or textured(self.rows[comp]) for comp, _w, tex, _s in row.get("mix", ()))
+        return any(textured(self.rows[i]) for i in indices)
 
     def table(self) -> MaterialTable:
         return MaterialTable.build(self.rows, self.textures)
@@ -155,23 +160,80 @@ class MaterialRegistry:
                                                 or abs(float(node.inputs["Anisotropy"].default_value)) > 1e-4):
                 self._warn(material, "Glossy BSDF anisotropy is not supported; rendered isotropic")
             return row
-        if t in {"MIX_SHADER", "ADD_SHADER"} and depth < 8:
-            shaders = [s for s in node.inputs if s.type == "SHADER"]
-            parts = [self._shader(material, s.links[0].from_node, depth + 1) if s.is_linked
-                     else {"base_color": (0, 0, 0), "f0": 0.0} for s in shaders]
-            if t == "MIX_SHADER":
-                fac = float(node.inputs["Fac"].default_value) if not node.inputs["Fac"].is_linked else 0.5
-                weights = (1 - fac, fac)
-            else:
-                weights = (1.0, 1.0)
-            self._warn(material, f"'{node.name}' ({t}) approximated by blending the parameters of its inputs")
-            return _blend(parts, weights)
+        if t in {"MIX_SHADER", "ADD_SHADER"}:
+            return self._mix(material, node, depth)
         self._warn(material, f"shader '{node.name}' ({t}) is not supported; approximated by the viewport colour")
         return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                 "roughness": float(material.roughness), "f0": 0.04}
 
-    def _texture(self, material, image) -> int:
-        key = image.name_full
+    # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/mix.py) ---------
+    def _mix(self, material, node, depth: int) -> dict:
+        """A row whose BSDF is the weighted sum of its flattened components (each its own table row); its emission
+        is the weighted sum of theirs. Components without a BSDF (Emission, empty sockets) drop out of the sum."""
+        parts = self._flatten(material, node, depth, 1.0, -1, 0.0)
+        comps, emission, emit_tex = [], np.zeros(3, np.float32), -1
+        for row, weight, tex, sign in parts:
+            e = np.asarray(row.get("emission", (0, 0, 0)), np.float32)
+            if e.any():
+                if tex >= 0:
+                    self._warn(material, "emission under a textured Mix factor is approximated by half its strength")
+                emission += e * weight * (0.5 if tex >= 0 else 1.0)
+                if row.get("emit_tex", -1) >= 0:
+                    emit_tex = row["emit_tex"]
+            if _has_bsdf(row):
+                comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, name=f"{material.name} ({len(comps) + 1})")
+                comps.append((self.add_row(comp), float(weight), int(tex), float(sign)))
+        out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "emission": tuple(emission.tolist()), "mix": comps}
+        if emit_tex >= 0:
+            out["emit_tex"] = emit_tex
+        return out
+
+    def _flatten(self, material, node, depth: int, weight: float, tex: int, sign: float) -> list:
+        """[(row, weight, factor texture, sign)]: the leaves of a Mix/Add tree with the products of their constant
+        weights; sign +1 weighs a leaf by the factor texture t, -1 by 1 - t (0: no texture). One textured factor
+        per leaf is supported; deeper ones use their socket's value (reported)."""
+        if node.type not in {"MIX_SHADER", "ADD_SHADER"}:
+            return [(self._shader(material, node, depth + 1), weight, tex, sign)]
+        if depth >= 8:
+            self._warn(material, "shader mixes nested deeper than 8 levels are cut off")
+            return []
+        shaders = [s for s in node.inputs if s.type == "SHADER"]
+        if node.type == "ADD_SHADER":
+            ws = [(weight, tex, sign)] * 2
+        else:
+            fac_socket = node.inputs["Fac"]
+            fac_tex = self._factor_texture(material, fac_socket) if tex < 0 else -1
+            if fac_tex >= 0:
+                ws = [(weight, fac_tex, -1.0), (weight, fac_tex, 1.0)]
+            else:
+                if fac_socket.is_linked and tex >= 0:
+                    self._warn(material, f"'{node.name}': a second textured Mix factor is approximated by its value")
+                fac = float(np.clip(self._float_input(material, fac_socket), 0, 1))
+                ws = [(weight * (1 - fac), tex, sign), (weight * fac, tex, sign)]
+        out = []
+        for socket, (w, tx, sg) in zip(shaders, ws):
+            if socket.is_linked and w > 0:
+                out += self._flatten(material, socket.links[0].from_node, depth + 1, w, tx, sg)
+        return out
+
+    def _factor_texture(self, material, socket) -> int:
+        """Texture index of an Image Texture driving a float socket (its Color as luminance, or its Alpha), or -1."""
+        if not socket.is_linked:
+            return -1
+        link = socket.links[0]
+        node = link.from_node
+        if node.type != "TEX_IMAGE" or node.image is None:
+            return -1
+        if node.inputs["Vector"].is_linked:
+            self._warn(material, f"'{node.name}' has a mapped vector input; the active UV map is used instead")
+        if link.from_socket.name == "Alpha":
+            return self._texture(material, node.image, alpha=True)
+        return self._texture(material, node.image, luminance=True)
+
+    def _texture(self, material, image, alpha: bool = False, luminance: bool = False) -> int:
+        """Index of an image in the texture list: its RGB (scene-linear), or its alpha / luminance replicated to
+        three channels."""
+        key = (image.name_full, "alpha" if alpha else "luminance" if luminance else "rgb")
         if key in self.texture_index:
             return self.texture_index[key]
         w, h = image.size[:]
@@ -186,6 +248,9 @@ class MaterialRegistry:
         if data is None or data.size == 0:
             self._warn(material, f"image '{image.name}' could not be loaded; rendered magenta")
             data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+        elif alpha:
+            a = data[..., 3:4] if data.shape[2] == 4 else np.ones(data.shape[:2] + (1,), np.float32)
+            data = np.ascontiguousarray(np.repeat(a, 3, axis=2), dtype=np.float32)
         else:
             ch = data.shape[2]
             rgb = data[..., :3] if ch >= 3 else np.repeat(data[..., :1], 3, axis=2)
@@ -196,25 +261,15 @@ class MaterialRegistry:
                     and not image.is_float:
                 self._warn(material, f"image '{image.name}' colour space '{space}' treated as sRGB")
                 rgb = srgb_to_linear(rgb)
+            if luminance:  # Blender's implicit colour -> float conversion
+                rgb = np.repeat((rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32))[..., None], 3, axis=2)
             data = np.ascontiguousarray(rgb, dtype=np.float32)
         self.texture_index[key] = len(self.textures)
         self.textures.append(data)
         return self.texture_index[key]
 
 
-def _blend(parts: list[dict], weights) -> dict:
-    keys = {"base_color": (0.8, 0.8, 0.8), "metallic": 0.0, "roughness": 0.5, "f0": 0.04, "emission": (0, 0, 0),
-            "specular_tint": (1, 1, 1), "metal_f90": 1.0, "multiscatter": 1.0}
-    out = {}
-    wsum = sum(weights) or 1.0
-    for k, default in keys.items():
-        vals = [np.array(p.get(k, default), np.float32) * w for p, w in zip(parts, weights)]
-        total = sum(vals)
-        out[k] = tuple(total.tolist()) if np.ndim(total) else float(total)
-        if k != "emission":  # reflectance parameters average; emission adds up
-            out[k] = tuple((np.array(total) / wsum).tolist()) if np.ndim(total) else float(total / wsum)
-    for tex in ("base_tex", "emit_tex"):
-        for p in parts:
-            if p.get(tex, -1) >= 0:
-                out[tex] = p[tex]
-    return out
+def _has_bsdf(row: dict) -> bool:
+    """Whether a row reflects any light (a black non-metal without specular, e.g. an Emission shader, does not)."""
+    return (row.get("base_tex", -1) >= 0 or any(c > 0 for c in row.get("base_color", (0.8, 0.8, 0.8)))
+            or row.get("f0", 0.04) > 0 or row.get("metallic", 0.0) > 0 or bool(row.get("mix")))

@@ -1,0 +1,49 @@
+"""Mix and Add shaders: a weighted sum of BSDFs, f = Σ w_k f_k, estimated by picking one component per hit.
+
+A hit on a mixed material picks component k with probability w_k / W (W = Σ w_k) and takes that component's BSDF
+scaled by W: the expectation over the pick is f exactly (as pbrt-v4's MixMaterial does, with a hash of the hit so
+every use of the same hit agrees). Weights are the Mix factors along the component's path in the node tree
+(constant, or an image texture's value at the hit's UV), Add shaders weigh both sides by 1; components without a
+BSDF (Emission shaders, empty sockets) have been dropped from the sum by the exporter.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .textures import sample_bilinear
+
+
+def hash_uniform(prim: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """A uniform number in [0, 1) per hit from its triangle and barycentrics (float32 bits), well mixed."""
+    with np.errstate(over="ignore"):
+        h = prim.astype(np.uint32) * np.uint32(0x9E3779B1)
+        h ^= np.ascontiguousarray(u, np.float32).view(np.uint32) * np.uint32(0x85EBCA77)
+        h ^= np.ascontiguousarray(v, np.float32).view(np.uint32) * np.uint32(0xC2B2AE3D)
+        h ^= h >> np.uint32(16)
+        h *= np.uint32(0x7FEB352D)
+        h ^= h >> np.uint32(15)
+        h *= np.uint32(0x846CA68B)
+        h ^= h >> np.uint32(16)
+    return (h >> np.uint32(8)).astype(np.float32) * np.float32(1.0 / (1 << 24))
+
+
+def pick_components(mats, mat: np.ndarray, rows: np.ndarray, xi: np.ndarray, uv: np.ndarray | None):
+    """For hits ``rows`` (k,) on mixed materials ``mat[rows]``: the picked component material (k,) and the BSDF scale
+    W (k,) (0 where every weight is 0). ``xi`` (k,) uniforms; ``uv`` (k, 2) the hits' UVs (None: no textures)."""
+    m = mat[rows]
+    first, count = mats.mix_first[m], mats.mix_count[m]
+    width = int(count.max())
+    slot = np.arange(width)[None, :]
+    valid = slot < count[:, None]
+    k = np.where(valid, first[:, None] + slot, 0)
+    w = mats.mix_weight[k] * valid
+    tex = np.where(valid, mats.mix_tex[k], -1)
+    if uv is not None and (tex >= 0).any():
+        for t in np.unique(tex[tex >= 0]):  # loop over textures, not hits
+            r, c = np.nonzero(tex == t)
+            val = np.clip(sample_bilinear(mats.textures[t], uv[r])[:, 0], 0, 1)
+            w[r, c] *= np.where(mats.mix_sign[k[r, c]] > 0, val, 1 - val)
+    total = w.sum(axis=1)
+    cdf = np.cumsum(w, axis=1)
+    pick = np.minimum((cdf <= (xi * total)[:, None]).sum(axis=1), count - 1)
+    return mats.mix_comp[first + pick], total.astype(np.float32)

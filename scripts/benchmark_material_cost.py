@@ -1,0 +1,151 @@
+"""What the material model costs: frame time of the path tracer and of ReSTIR DI on the demo room (Principled
+materials only) and the many_lights street, and the share of the CPU time spent evaluating materials.
+
+Runs the same frames as scripts/benchmark_stages.py (640x360, 1 sample per frame, steady frames of a sequence,
+fastest kept). The material share is measured with per-thread CPU clocks (time.thread_time) around the material
+code — building per-hit parameters (SurfaceParams.take/of_table, Mix picks), the view terms (ViewTerms.of),
+evaluating and sampling the BSDF (eval_view, sample_bsdf) and the exact-Fresnel part of the ReSTIR target — as a
+fraction of the process CPU time of the frame. Run it from another checkout to measure a "before" (what exists
+of those functions there is wrapped); ``--frames-only`` skips the clocks (their overhead is ~1 %).
+
+Writes docs/results/materials/cost.json (or cost_before.json with --label before) and, when both exist,
+cost.png. Usage:
+  python scripts/benchmark_material_cost.py [--frames 5] [--label after|before] [--frames-only] [--out DIR]
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import os
+import sys
+import threading
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+
+import bpy  # noqa: E402
+
+from benchmark_stages import blend_path, warm_up  # noqa: E402
+from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
+from restir_engine.export import export_scene  # noqa: E402
+
+RUNS = [
+    ("demo path", "demo", dict(integrator="PATH", max_bounces=4)),
+    ("demo ReSTIR DI", "demo", dict(integrator="RESTIR", direct_method="RESTIR", indirect_method="PATH",
+                                    max_bounces=4)),
+    ("many_lights path", "many_lights", dict(integrator="PATH", max_bounces=0)),
+    ("many_lights ReSTIR DI", "many_lights", dict(integrator="RESTIR", direct_method="RESTIR", max_bounces=0)),
+]
+
+_local = threading.local()
+_lock = threading.Lock()
+_spent = [0.0]
+
+
+def _timed(fn):
+    """Add the calling thread's CPU time inside ``fn`` to the total (outermost call only)."""
+    @functools.wraps(fn)
+    def wrapper(*a, **k):
+        depth = getattr(_local, "depth", 0)
+        if depth:
+            return fn(*a, **k)
+        _local.depth = 1
+        t = time.thread_time()
+        try:
+            return fn(*a, **k)
+        finally:
+            dt = time.thread_time() - t
+            _local.depth = 0
+            with _lock:
+                _spent[0] += dt
+    return wrapper
+
+
+def instrument() -> None:
+    """Wrap the material code wherever it was imported (what exists of it: an older checkout has less)."""
+    from restir_engine.core import bsdf, pathtracer, surface, target
+    from restir_engine.core.restir import di, gi
+    sp = bsdf.SurfaceParams
+    sp.take = _timed(sp.take)
+    for name in ("of_table", "from_material"):
+        if hasattr(sp, name):
+            setattr(sp, name, staticmethod(_timed(getattr(sp, name))))
+    bsdf.ViewTerms.of = staticmethod(_timed(bsdf.ViewTerms.of))
+    for mod in (bsdf, pathtracer, di, gi):
+        for name in ("eval_view", "sample_bsdf"):
+            if hasattr(mod, name):
+                setattr(mod, name, _timed(getattr(mod, name)))
+    for mod, name in ((surface, "pick_components"), (target, "fresnel_exact")):
+        if hasattr(mod, name):
+            setattr(mod, name, _timed(getattr(mod, name)))
+
+
+def run(name, scene_name, kw, frames):
+    bpy.ops.wm.open_mainfile(filepath=blend_path(scene_name))
+    scene = export_scene(bpy.context.evaluated_depsgraph_get())
+    hist, rows = None, []
+    for f in range(frames):
+        _spent[0] = 0.0
+        c0, t = time.process_time(), time.perf_counter()
+        r = render_frame(scene, RenderSettings(**kw, samples=1, seed=0, frame=f, data_passes=False), history=hist)
+        wall, cpu = time.perf_counter() - t, time.process_time() - c0
+        hist = r.history
+        rows.append({"frame_s": wall, "cpu_s": cpu, "material_cpu_s": _spent[0]})
+    best = min(rows[1:] or rows, key=lambda r: r["frame_s"])
+    out = {"name": name, "frame_s": best["frame_s"], "frames_s": [r["frame_s"] for r in rows],
+           "material_share": best["material_cpu_s"] / max(best["cpu_s"], 1e-9)}
+    print(f"{name:<24} frame {out['frame_s']:6.3f}s  material share {100 * out['material_share']:4.1f}%", flush=True)
+    return out
+
+
+def chart(after, before, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    names = [r["name"] for r in after["runs"]]
+    b = {r["name"]: r["frame_s"] for r in before["runs"]}
+    x = np.arange(len(names))
+    fig, ax = plt.subplots(figsize=(8, 3.6))
+    ax.bar(x - 0.2, [b.get(n, np.nan) for n in names], 0.4, label="before (Lambert + GGX approximation)")
+    ax.bar(x + 0.2, [r["frame_s"] for r in after["runs"]], 0.4, label="after (Principled as Cycles)")
+    for i, r in enumerate(after["runs"]):
+        ax.text(i + 0.2, r["frame_s"], f"{100 * r['material_share']:.0f}%", ha="center", va="bottom", fontsize=8)
+    ax.set_xticks(x, names, fontsize=8)
+    ax.set_ylabel("seconds per frame (640x360, 1 spp)")
+    ax.set_title("Frame time before/after; labels: CPU share of material evaluation")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--frames", type=int, default=5)
+    ap.add_argument("--label", default="after", choices=("after", "before"))
+    ap.add_argument("--frames-only", action="store_true", help="frame times only, no material clocks")
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "results", "materials"))
+    args = ap.parse_args()
+    if not args.frames_only:
+        instrument()
+    warm_up()
+    runs = [run(n, s, kw, args.frames) for n, s, kw in RUNS]
+    os.makedirs(args.out, exist_ok=True)
+    data = {"label": args.label, "runs": runs, "cores": os.cpu_count(), "date": time.strftime("%Y-%m-%d")}
+    path = os.path.join(args.out, "cost.json" if args.label == "after" else "cost_before.json")
+    with open(path, "w") as f:
+        json.dump(data, f, indent=1)
+    other = os.path.join(args.out, "cost_before.json" if args.label == "after" else "cost.json")
+    if os.path.exists(other):
+        with open(other) as f:
+            o = json.load(f)
+        chart(data if args.label == "after" else o, o if args.label == "after" else data,
+              os.path.join(args.out, "cost.png"))
+    print("wrote", path)
+
+
+if __name__ == "__main__":
+    main()
