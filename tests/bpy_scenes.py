@@ -190,3 +190,43 @@ def grazing_floor(size=(96, 64)):
     black_world(scene)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def _with_uvs(obj):
+    """Give a quad made by ``plane`` a UV map covering it once."""
+    uv = obj.data.uv_layers.new(name="UVMap")
+    uv.data.foreach_set("uv", np.array([0, 0, 1, 0, 1, 1, 0, 1], np.float32))
+    return obj
+
+
+def alpha_scene(size=(96, 64)):
+    """Cut-outs: a Principled plane of Alpha 0.4 and a plane whose Mix(Transparent, Diffuse) factor is a checker
+    image, standing on a floor in front of an orange wall; an area light above and in front casts their shadows on
+    the floor, and the camera sees the wall through them."""
+    scene = reset()
+    plane("Floor", 8, (0, 0, 0), material=diffuse("Floor", (0.7, 0.7, 0.7)))
+    plane("Wall", 8, (0, 2, 2), (math.pi / 2, 0, 0), material=diffuse("Wall", (0.8, 0.5, 0.2)))
+    glass = principled("Veil", (0.2, 0.4, 0.9), roughness=0.6)
+    glass.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = 0.4
+    plane("Veil", 1.6, (-1.0, 0.5, 0.9), (math.pi / 2, 0, 0.3), material=glass)
+    fence = bpy.data.materials.new("Fence")
+    enable_nodes(fence)
+    tree = fence.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    clear = tree.nodes.new("ShaderNodeBsdfTransparent")
+    green = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    green.inputs["Color"].default_value = (0.2, 0.8, 0.3, 1)
+    tex = tree.nodes.new("ShaderNodeTexImage")
+    tex.image = bpy.data.images.get("Checker") or checker_image()
+    tex.interpolation = "Closest"
+    tree.links.new(tex.outputs["Color"], mix.inputs["Fac"])
+    tree.links.new(clear.outputs[0], mix.inputs[1])
+    tree.links.new(green.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    _with_uvs(plane("Fence", 1.6, (1.0, 0.5, 0.9), (math.pi / 2, 0, -0.3), material=fence))
+    light("AREA", (0, -1.5, 3.5), (math.radians(35), 0, 0), energy=500.0, size=1.5)
+    camera((0, -4, 1.0), (math.radians(90), 0, 0), lens=30)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

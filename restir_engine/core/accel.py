@@ -16,9 +16,10 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from .profile import add_embree_seconds
-from .sampling import dot, norm, vmax
+from .sampling import cols, dot, norm, vmax
 
 CHUNK_RAYS = 32768  # rays per Embree call: large enough to amortize the call, small for load balance
+MAX_CUTOUT_LAYERS = 32  # transparent cut-out points one ray passes at most (the next hit then counts as opaque)
 
 _POOL: ThreadPoolExecutor | None = None
 
@@ -99,10 +100,14 @@ class Hits:
 
 
 class Accel:
-    """A static triangle scene. ``triangles`` is (n, 3, 3) float32 world-space vertices."""
+    """A static triangle scene. ``triangles`` is (n, 3, 3) float32 world-space vertices. With ``cutout`` (a
+    cutout.Cutout) rays pass through the transparent points of cut-out surfaces (``ng_rows``: the triangles'
+    geometric normals (3, n), to step past them)."""
 
-    def __init__(self, triangles: np.ndarray):
+    def __init__(self, triangles: np.ndarray, cutout=None, ng_rows: np.ndarray | None = None):
         self.n_triangles = len(triangles)
+        self.cutout = cutout
+        self._ng_rows = ng_rows
         self._scene = None
         if self.n_triangles:
             from embreex import rtcore_scene
@@ -116,7 +121,35 @@ class Accel:
 
     def intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
         """Closest hit of each ray (origins/directions (3, n) float32 rows; directions need not be unit,
-        ``t`` is then in units of the direction length)."""
+        ``t`` is then in units of the direction length), through transparent cut-out points."""
+        hits = self._intersect(origins, directions, tmax)
+        if self.cutout is not None:
+            self._pass_through(hits, origins, directions, tmax)
+        return hits
+
+    def _pass_through(self, hits: Hits, o: np.ndarray, d: np.ndarray, tmax) -> None:
+        """Replace hits on transparent cut-out points by what lies behind them (in place; t stays measured from
+        the original origins)."""
+        for _layer in range(MAX_CUTOUT_LAYERS):
+            live = np.flatnonzero(hits.prim >= 0)
+            if live.size == 0:
+                return
+            go = live[~self.cutout.opaque(hits.prim[live], hits.u[live], hits.v[live])]
+            if go.size == 0:
+                return
+            t = hits.t[go]
+            dg = cols(d, go)
+            p = cols(o, go) + dg * t
+            o2 = offset_origin(p, cols(self._ng_rows, hits.prim[go]), dg)
+            far = None if tmax is None else np.maximum(tmax[go] - t, np.float32(0.0))
+            sub = self._intersect(o2, dg, far)
+            hit = sub.prim >= 0
+            hits.prim[go] = sub.prim
+            hits.t[go] = np.where(hit, sub.t + t, np.inf)
+            hits.u[go] = sub.u
+            hits.v[go] = sub.v
+
+    def _intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
         n = origins.shape[1]
         hits = Hits(n)
         if self._scene is None or n == 0:
@@ -141,7 +174,17 @@ class Accel:
         return hits
 
     def occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
-        """True where something lies on the segment origin + t*direction, 0 < t < tmax (rays as (3, n) rows)."""
+        """True where something opaque lies on the segment origin + t*direction, 0 < t < tmax (rays as (3, n)
+        rows). Blocked rays are traced again through cut-out points when there are any."""
+        out = self._occluded(origins, directions, tmax)
+        if self.cutout is not None:
+            rows = np.flatnonzero(out)
+            if rows.size:
+                far = np.ascontiguousarray(tmax, dtype=np.float32)[rows]
+                out[rows] = self.intersect(cols(origins, rows), cols(directions, rows), far).prim >= 0
+        return out
+
+    def _occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
         n = origins.shape[1]
         out = np.zeros(n, dtype=bool)
         if self._scene is None or n == 0:

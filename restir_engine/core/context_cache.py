@@ -25,7 +25,7 @@ def fingerprint(*parts) -> bytes:
 
     def walk(x):
         if isinstance(x, np.ndarray):
-            h.update(f"{x.dtype}{x.shape}".encode())
+            h.update(f"{type(x).__name__}{x.dtype}{x.shape}".encode())
             h.update(np.ascontiguousarray(x).data)
         elif dataclasses.is_dataclass(x) and not isinstance(x, type):
             h.update(type(x).__name__.encode())

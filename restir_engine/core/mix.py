@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .textures import sample_bilinear
+from .textures import sample
 
 
 def hash_uniform(prim: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -29,7 +29,7 @@ def hash_uniform(prim: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def pick_components(mats, mat: np.ndarray, rows: np.ndarray, xi: np.ndarray, uv: np.ndarray | None):
     """For hits ``rows`` (k,) on mixed materials ``mat[rows]``: the picked component material (k,) and the BSDF scale
-    W (k,) (0 where every weight is 0). ``xi`` (k,) uniforms; ``uv`` (k, 2) the hits' UVs (None: no textures)."""
+    W (k,) (0 where every weight is 0; 1 for renormalized mixes, whose transparent share is a cut-out). ``xi`` (k,) uniforms; ``uv`` (k, 2) the hits' UVs (None: no textures)."""
     m = mat[rows]
     first, count = mats.mix_first[m], mats.mix_count[m]
     width = int(count.max())
@@ -41,9 +41,13 @@ def pick_components(mats, mat: np.ndarray, rows: np.ndarray, xi: np.ndarray, uv:
     if uv is not None and (tex >= 0).any():
         for t in np.unique(tex[tex >= 0]):  # loop over textures, not hits
             r, c = np.nonzero(tex == t)
-            val = np.clip(sample_bilinear(mats.textures[t], uv[r])[:, 0], 0, 1)
+            val = np.clip(sample(mats.textures[t], uv[r])[:, 0], 0, 1)
             w[r, c] *= np.where(mats.mix_sign[k[r, c]] > 0, val, 1 - val)
     total = w.sum(axis=1)
     cdf = np.cumsum(w, axis=1)
     pick = np.minimum((cdf <= (xi * total)[:, None]).sum(axis=1), count - 1)
-    return mats.mix_comp[first + pick], total.astype(np.float32)
+    scale = total
+    norm = getattr(mats, "mix_normalize", None)
+    if norm is not None:
+        scale = np.where(norm[m] & (total > 0), np.float32(1.0), total)
+    return mats.mix_comp[first + pick], scale.astype(np.float32)

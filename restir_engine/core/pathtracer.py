@@ -24,6 +24,7 @@ import numpy as np
 from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
 from . import microfacet_tables
+from .cutout import Cutout
 from .bsdf import SurfaceParams, eval_view, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
 from .sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
@@ -411,12 +412,15 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     params = SurfaceParams.of_table(scene.materials)
     nrm = geom.normals
     flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
-    return TraceContext(scene=scene, geom_accel=Accel(geom.verts), lamp_accel=Accel(lamps.tris.verts),
+    geom_ng_rows = np.ascontiguousarray(geom_ng.T)
+    cut = Cutout.of(geom, scene.materials)
+    return TraceContext(scene=scene, geom_accel=Accel(geom.verts, cut, geom_ng_rows if cut else None),
+                        lamp_accel=Accel(lamps.tris.verts),
                         lights=LightTable(scene, max(radius, 1e-3)), geom_ng=geom_ng, lamp_ng=lamp_ng,
                         material_params=params, max_bounces=int(max(0, max_bounces)),
                         film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
                         material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),
                         has_mix=scene.materials.mix_first is not None and bool((scene.materials.mix_first >= 0).any()),
-                        geom_flat=flat, geom_ng_rows=np.ascontiguousarray(geom_ng.T),
+                        geom_flat=flat, geom_ng_rows=geom_ng_rows,
                         geom_normal_rows=np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32),
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T))

@@ -55,10 +55,15 @@ class MaterialTable:
     two_sided_emission (m,) bool  mesh emission leaves both faces (Cycles); lamps emit from the front only
     mix_first, mix_count (m,) int32  a Mix/Add shader: its components are entries mix_first .. + mix_count of
                         the mix_* arrays (-1, 0: not a mix; its own BSDF parameters are then unused)
+    mix_normalize (m,) bool  the components' weights are renormalized to sum 1 (a Mix with a Transparent BSDF:
+                        the cut-out takes the transparent share)
     mix_comp    (k,) int32  component material (never itself a mix)
     mix_weight  (k,) constant weight of the component (product of the Mix factors on its path; Add: 1)
     mix_tex     (k,) int32  texture index whose value t (first channel) further weighs it, -1 = none
     mix_sign    (k,) +1: weight x t, -1: weight x (1 - t)
+    alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
+    alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
+    alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
     textures    list of (h, w, 3) float32 linear images, row 0 at the bottom (Blender's order)
     names       material names, for messages
     """
@@ -74,6 +79,10 @@ class MaterialTable:
     base_tex: np.ndarray
     emit_tex: np.ndarray
     two_sided_emission: np.ndarray
+    alpha: np.ndarray = None
+    alpha_tex: np.ndarray = None
+    alpha_sign: np.ndarray = None
+    mix_normalize: np.ndarray = None
     mix_first: np.ndarray = None
     mix_count: np.ndarray = None
     mix_comp: np.ndarray = None
@@ -95,6 +104,8 @@ class MaterialTable:
             multiscatter=col("multiscatter", 1.0),
             base_tex=col("base_tex", -1, np.int32), emit_tex=col("emit_tex", -1, np.int32),
             two_sided_emission=col("two_sided_emission", True, bool),
+            alpha=col("alpha", 1.0), alpha_tex=col("alpha_tex", -1, np.int32), alpha_sign=col("alpha_sign", 1.0),
+            mix_normalize=col("mix_normalize", False, bool),
             **_mix_arrays(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
 

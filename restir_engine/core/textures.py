@@ -1,4 +1,5 @@
-"""Bilinear texture lookups (repeat wrap), vectorized over hits.
+"""Texture lookups (repeat wrap), vectorized over hits: bilinear, or nearest for images marked
+:class:`NearestImage` (an Image Texture node's "Closest" interpolation).
 
 Images are (h, w, 3) float32 scene-linear, row 0 at the bottom as Blender stores them,
 so uv (0, 0) is the bottom-left corner and texel (i, j) is centred at ((j+0.5)/w, (i+0.5)/h).
@@ -6,6 +7,24 @@ so uv (0, 0) is the bottom-left corner and texel (i, j) is centred at ((j+0.5)/w
 from __future__ import annotations
 
 import numpy as np
+
+
+class NearestImage(np.ndarray):
+    """An image sampled with nearest-texel lookups (``array.view(NearestImage)``)."""
+
+
+def sample(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """(n, 3) texels of ``image`` at ``uv`` (n, 2), by the image's interpolation."""
+    if isinstance(image, NearestImage):
+        return sample_nearest(np.asarray(image), uv)
+    return sample_bilinear(image, uv)
+
+
+def sample_nearest(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    h, w = image.shape[:2]
+    x = np.where(np.isfinite(uv[:, 0]), uv[:, 0] * w, 0.0)
+    y = np.where(np.isfinite(uv[:, 1]), uv[:, 1] * h, 0.0)
+    return image[np.floor(y).astype(np.int64) % h, np.floor(x).astype(np.int64) % w].astype(np.float32)
 
 
 def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
@@ -35,7 +54,7 @@ def apply_texture(values: np.ndarray, tex_index: np.ndarray, uv: np.ndarray | No
     for t, image in enumerate(textures):  # loop over textures, not over hits
         sel = np.flatnonzero(tex_index == t)
         if sel.size:
-            out[sel] *= sample_bilinear(image, uv[sel])
+            out[sel] *= sample(image, uv[sel])
     return out
 
 

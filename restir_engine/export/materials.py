@@ -12,6 +12,7 @@ import bpy
 import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
+from ..core.textures import NearestImage
 
 MAGENTA = (1.0, 0.0, 1.0)
 
@@ -57,7 +58,7 @@ class MaterialRegistry:
 
     def uses_textures(self, indices) -> bool:
         def textured(row: dict) -> bool:
-            if row.get("base_tex", -1) >= 0 or row.get("emit_tex", -1) >= 0:
+            if row.get("base_tex", -1) >= 0 or row.get("emit_tex", -1) >= 0 or row.get("alpha_tex", -1) >= 0:
                 return True
             return any(tex >= 0 or textured(self.rows[comp]) for comp, _w, tex, _s in row.get("mix", ()))
         return any(textured(self.rows[i]) for i in indices)
@@ -89,7 +90,7 @@ class MaterialRegistry:
         if node.type == "TEX_IMAGE" and node.image is not None and key_tex is not None:
             if node.inputs["Vector"].is_linked:
                 self._warn(material, f"'{node.name}' has a mapped vector input; the active UV map is used instead")
-            row[key_tex] = self._texture(material, node.image)
+            row[key_tex] = self._texture(material, node.image, closest=node.interpolation == "Closest")
             return (1.0, 1.0, 1.0)
         if node.type == "RGB":
             return tuple(node.outputs[0].default_value[:3])
@@ -136,9 +137,14 @@ class MaterialRegistry:
             for name in ("Transmission Weight", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
                 if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
                     self._warn(material, f"Principled '{name}' is not supported and was ignored")
-            if "Alpha" in inp and (inp["Alpha"].is_linked or float(inp["Alpha"].default_value) < 1):
-                self._warn(material, "alpha/transparency is not supported; rendered opaque")
+            if "Alpha" in inp:
+                self._alpha(material, inp["Alpha"], row)
             return row
+        if t == "BSDF_TRANSPARENT":
+            c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
+            if min(c) < 0.999:
+                self._warn(material, "a coloured Transparent BSDF is approximated by a white one (a cut-out)")
+            return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transparent": True, "alpha": 0.0}
         if t == "BSDF_DIFFUSE":
             row = {"f0": 0.0, "metallic": 0.0}
             row["base_color"] = self._color_input(material, node.inputs["Color"], "base_tex", row, (0.8, 0.8, 0.8))
@@ -167,12 +173,41 @@ class MaterialRegistry:
                 "roughness": float(material.roughness), "f0": 0.04}
 
     # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/mix.py) ---------
+    def _alpha(self, material, socket, row: dict) -> None:
+        """Principled Alpha: constant, or an Image Texture's Alpha (or Color, as luminance) -> row alpha fields."""
+        tex = self._factor_texture(material, socket)
+        if tex >= 0:
+            row.update(alpha=1.0, alpha_tex=tex, alpha_sign=1.0)
+            return
+        a = float(np.clip(self._float_input(material, socket), 0, 1))
+        if a < 1:
+            row["alpha"] = a
+
     def _mix(self, material, node, depth: int) -> dict:
         """A row whose BSDF is the weighted sum of its flattened components (each its own table row); its emission
-        is the weighted sum of theirs. Components without a BSDF (Emission, empty sockets) drop out of the sum."""
+        is the weighted sum of theirs. Components without a BSDF (Emission, empty sockets) drop out of the sum.
+        A Transparent BSDF leaf becomes the row's alpha cut-out (opacity 1 - its weight) and the other components
+        are renormalized (opaque points reflect with the full BSDF; exact for Mix trees, whose weights sum to 1)."""
         parts = self._flatten(material, node, depth, 1.0, -1, 0.0)
         comps, emission, emit_tex = [], np.zeros(3, np.float32), -1
+        out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
+        clear = [p for p in parts if p[0].get("transparent")]
+        if clear:
+            if len(clear) > 1 or node.type == "ADD_SHADER":
+                self._warn(material, "transparency added to other shaders or in several places is approximated")
+            _row, w, tex, sign = clear[0]
+            if tex >= 0 and abs(w - 1) < 1e-6:
+                out.update(alpha=1.0, alpha_tex=tex, alpha_sign=-sign)
+            else:
+                if tex >= 0:
+                    self._warn(material, "a textured transparency under a constant Mix factor is approximated")
+                out["alpha"] = float(np.clip(1 - w * (0.5 if tex >= 0 else 1.0), 0, 1))
+            out["mix_normalize"] = True
         for row, weight, tex, sign in parts:
+            if row.get("transparent"):
+                continue
+            if row.get("alpha", 1.0) < 1 or row.get("alpha_tex", -1) >= 0:
+                self._warn(material, "alpha inside a Mix/Add shader is ignored (rendered opaque)")
             e = np.asarray(row.get("emission", (0, 0, 0)), np.float32)
             if e.any():
                 if tex >= 0:
@@ -181,9 +216,10 @@ class MaterialRegistry:
                 if row.get("emit_tex", -1) >= 0:
                     emit_tex = row["emit_tex"]
             if _has_bsdf(row):
-                comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, name=f"{material.name} ({len(comps) + 1})")
+                comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, alpha=1.0, alpha_tex=-1,
+                            name=f"{material.name} ({len(comps) + 1})")
                 comps.append((self.add_row(comp), float(weight), int(tex), float(sign)))
-        out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "emission": tuple(emission.tolist()), "mix": comps}
+        out.update(emission=tuple(emission.tolist()), mix=comps)
         if emit_tex >= 0:
             out["emit_tex"] = emit_tex
         return out
@@ -226,14 +262,16 @@ class MaterialRegistry:
             return -1
         if node.inputs["Vector"].is_linked:
             self._warn(material, f"'{node.name}' has a mapped vector input; the active UV map is used instead")
+        closest = node.interpolation == "Closest"
         if link.from_socket.name == "Alpha":
-            return self._texture(material, node.image, alpha=True)
-        return self._texture(material, node.image, luminance=True)
+            return self._texture(material, node.image, alpha=True, closest=closest)
+        return self._texture(material, node.image, luminance=True, closest=closest)
 
-    def _texture(self, material, image, alpha: bool = False, luminance: bool = False) -> int:
+    def _texture(self, material, image, alpha: bool = False, luminance: bool = False, closest: bool = False) -> int:
         """Index of an image in the texture list: its RGB (scene-linear), or its alpha / luminance replicated to
-        three channels."""
-        key = (image.name_full, "alpha" if alpha else "luminance" if luminance else "rgb")
+        three channels; sampled bilinearly, or by the nearest texel with ``closest`` (other interpolations:
+        bilinear)."""
+        key = (image.name_full, "alpha" if alpha else "luminance" if luminance else "rgb", closest)
         if key in self.texture_index:
             return self.texture_index[key]
         w, h = image.size[:]
@@ -265,11 +303,13 @@ class MaterialRegistry:
                 rgb = np.repeat((rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32))[..., None], 3, axis=2)
             data = np.ascontiguousarray(rgb, dtype=np.float32)
         self.texture_index[key] = len(self.textures)
-        self.textures.append(data)
+        self.textures.append(data.view(NearestImage) if closest else data)
         return self.texture_index[key]
 
 
 def _has_bsdf(row: dict) -> bool:
     """Whether a row reflects any light (a black non-metal without specular, e.g. an Emission shader, does not)."""
+    if row.get("transparent"):
+        return False
     return (row.get("base_tex", -1) >= 0 or any(c > 0 for c in row.get("base_color", (0.8, 0.8, 0.8)))
             or row.get("f0", 0.04) > 0 or row.get("metallic", 0.0) > 0 or bool(row.get("mix")))

@@ -1,0 +1,63 @@
+"""Alpha cut-outs: surfaces that rays pass through where they are transparent (Principled Alpha, a Mix with a
+Transparent BSDF), for camera, shadow and bounce rays alike.
+
+A hit on a cut-out material is opaque with probability α (the material's constant alpha, times an image texture's
+value t or 1 - t at the hit's UV) and otherwise the ray continues behind it. The decision is a hash of the hit
+(triangle and barycentrics, salted apart from the Mix pick), so every ray that reaches the same point agrees (a
+shadow ray is blocked exactly where a camera ray would stop), and over the points of a pixel the surface covers a
+fraction α of them: Cycles' transparency of a white Transparent BSDF, on average.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .mix import hash_uniform
+from .sampling import barycentric
+from .textures import sample
+
+SALT = 0x5BD1E995
+
+
+class Cutout:
+    """Which hits of a triangle set are opaque. ``geometry`` (scene.TriangleSet), ``materials`` (MaterialTable with
+    alpha, alpha_tex, alpha_sign)."""
+
+    def __init__(self, geometry, materials):
+        mat = geometry.material
+        self.alpha = materials.alpha[mat].astype(np.float32)
+        self.tex = materials.alpha_tex[mat]
+        self.sign = materials.alpha_sign[mat]
+        self.cut = (self.alpha < 1) | (self.tex >= 0)
+        self.uvs = geometry.uvs
+        self.textures = materials.textures
+
+    @staticmethod
+    def of(geometry, materials) -> "Cutout | None":
+        """The cut-out test of a scene's geometry, or None when no material is transparent anywhere."""
+        a = getattr(materials, "alpha", None)
+        if a is None or len(geometry) == 0:
+            return None
+        if not ((a < 1).any() or (materials.alpha_tex >= 0).any()):
+            return None
+        c = Cutout(geometry, materials)
+        return c if c.cut.any() else None
+
+    def opaque(self, prim: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """(n,) bool for hits (prim >= 0) at barycentrics (u, v)."""
+        out = np.ones(len(prim), bool)
+        sel = np.flatnonzero(self.cut[prim])
+        if sel.size == 0:
+            return out
+        p = prim[sel]
+        a = self.alpha[p].copy()
+        tex = self.tex[p]
+        if self.uvs is not None and (tex >= 0).any():
+            for t in np.unique(tex[tex >= 0]):  # loop over textures, not hits
+                rows = np.flatnonzero(tex == t)
+                c = np.take(self.uvs, p[rows], axis=0)
+                uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[sel][rows][:, None], v[sel][rows][:, None])
+                val = np.clip(sample(self.textures[t], uv)[:, 0], 0, 1)
+                a[rows] *= np.where(self.sign[p[rows]] > 0, val, 1 - val)
+        xi = hash_uniform(p ^ SALT, u[sel], v[sel])
+        out[sel] = xi < a
+        return out
