@@ -59,7 +59,7 @@ def scene_problems(core_scene, light_count: int) -> list[str]:
     problems = []
     if len(core_scene.geometry) == 0 and len(core_scene.lamps.tris) == 0:
         problems.append("The scene has nothing to render (no visible geometry)")
-    if light_count == 0 and not np.any(core_scene.world_radiance > 0):
+    if light_count == 0 and not np.any(core_scene.world_radiance > 0) and getattr(core_scene, "world_image", None) is None:
         problems.append("The scene has no lights, no emissive materials and a black world: the image is black")
     return problems
 

@@ -230,3 +230,52 @@ def alpha_scene(size=(96, 64)):
     black_world(scene)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def sky_image(name="Sky", h=64, w=128, sun=(0.0, 40.0)):
+    """An equirectangular float image: a dim blue sky, dark ground and a small bright sun at (azimuth, elevation)
+    degrees (Blender's Environment Texture convention: u = 1/2 - atan2(y, x)/2π, v = 1 - θ/π), packed."""
+    img = bpy.data.images.new(name, w, h, float_buffer=True)
+    px = np.zeros((h, w, 4), np.float32)
+    px[..., 3] = 1
+    px[h // 2:, :, :3] = (0.15, 0.25, 0.45)
+    px[:h // 2, :, :3] = (0.05, 0.04, 0.03)
+    az, el = np.radians(sun[0]), np.radians(sun[1])
+    col = int((0.5 - az / (2 * np.pi)) % 1.0 * w)
+    row = int((1.0 - (np.pi / 2 - el) / np.pi) * h)
+    px[row:row + 2, col:col + 2, :3] = (400.0, 350.0, 300.0)
+    img.pixels.foreach_set(px.ravel())
+    img.pack()
+    return img
+
+
+def world_scene(kind="IMAGE", size=(96, 64), rotation_z=0.0):
+    """Spheres (diffuse, rough Principled, metal) on a grey floor under the world: an environment image (sky with
+    a sun, :func:`sky_image`, its Mapping rotated by ``rotation_z`` radians) or a constant colour; no lamps."""
+    scene = reset()
+    plane("Floor", 20, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
+    for x, mat in ((-1.2, diffuse("D", (0.8, 0.3, 0.2))), (0.0, principled("P", (0.3, 0.6, 0.8), roughness=0.4)),
+                   (1.2, principled("M", (0.9, 0.8, 0.6), roughness=0.3, metallic=1.0))):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(x, 0, 0.5), segments=32, ring_count=16)
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(mat)
+    world = bpy.data.worlds.new("World")
+    enable_nodes(world)
+    tree = world.node_tree
+    bg = tree.nodes["Background"]
+    if kind == "IMAGE":
+        env = tree.nodes.new("ShaderNodeTexEnvironment")
+        env.image = sky_image()
+        mapping = tree.nodes.new("ShaderNodeMapping")
+        mapping.inputs["Rotation"].default_value = (0.0, 0.0, rotation_z)
+        coords = tree.nodes.new("ShaderNodeTexCoord")
+        tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+        tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+        tree.links.new(env.outputs["Color"], bg.inputs["Color"])
+    else:
+        bg.inputs["Color"].default_value = (0.4, 0.5, 0.7, 1)
+    bg.inputs["Strength"].default_value = 1.0
+    scene.world = world
+    camera((0, -4.5, 1.6), (math.radians(75), 0, 0), lens=35)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

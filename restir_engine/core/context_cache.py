@@ -50,7 +50,8 @@ def fingerprint(*parts) -> bytes:
 
 def scene_key(scene) -> bytes:
     """What the acceleration structures and the light table depend on (not the camera or the motion)."""
-    return fingerprint(scene.geometry, scene.materials, scene.lamps, scene.world_radiance)
+    return fingerprint(scene.geometry, scene.materials, scene.lamps, scene.world_radiance,
+                       getattr(scene, "world_image", None), getattr(scene, "world_rotation", None))
 
 
 def context_for(scene, max_bounces: int, film_transparent: bool, build):

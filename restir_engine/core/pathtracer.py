@@ -6,8 +6,9 @@ Estimator per pixel sample (wavefront form, vectorized over the rays of a chunk)
 with power-heuristic MIS weights w = p²/(p_light² + p_bsdf²), both pdfs in solid angle.
 ``max_bounces`` = 0 is direct light only (as in Cycles); Russian roulette from bounce ``rr_start``.
 Lamps (Blender Light objects) emit but do not occlude; a ray collects the nearest lamp in front
-of its geometry hit and continues. The world colour is collected by escaping rays (weight 1:
-it is not light-sampled). Suns are light-sampled only.
+of its geometry hit and continues. The world (core/world.py: a constant colour or an environment image) is a
+light too: next-event estimation samples it besides the lights (:func:`world_event`, its own shadow ray) and
+escaping BSDF rays collect it MIS-weighted against that. Suns are light-sampled only.
 
 The path is split in three calls so that another direct-light estimator can take the place of the first
 vertex's next-event estimation: :func:`primary` (camera rays, emission seen directly), :func:`next_event`
@@ -25,6 +26,7 @@ from . import camera as camera_mod
 from .accel import Accel, offset_origin, shadow_rays
 from . import microfacet_tables
 from .cutout import Cutout
+from .world import World
 from .bsdf import SurfaceParams, eval_view, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
 from .sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
@@ -50,6 +52,7 @@ class TraceContext:
     material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α
     material_layer: np.ndarray = None   # (m, 32) dielectric layer factor S rows over μo (microfacet_tables)
     has_mix: bool = False  # some material is a Mix/Add shader (core/mix.py)
+    world: World = None    # the background as a light (core/world.py)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -155,8 +158,9 @@ def _seen(ctx: TraceContext, o, d, tmax, hits):
     miss = hits.prim < 0
     if ctx.film_transparent:
         alpha[miss] = 0.0
-    else:
-        emitted += ctx.scene.world_radiance.astype(np.float32)[:, None] * miss
+    elif miss.any():
+        m = np.flatnonzero(miss)
+        emitted[:, m] += ctx.world.radiance(cols(d, m))
     if ctx.lights.n_geom:  # emissive surfaces (mesh emission is two-sided by default)
         prim = np.maximum(hits.prim, 0)
         em = np.flatnonzero((hits.prim >= 0) & (ctx.lights.geom_to_light[prim] >= 0))
@@ -171,8 +175,14 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
     (delta lights weight 1), one shadow ray. Radiance (3, n), times ``throughput`` (3, n) if given. With
     ``diffuse`` also the part reflected by the diffuse lobe alone: (radiance, diffuse part)."""
     n = len(s)
+    if ctx.world.sampled and n:
+        w_out = world_event(ctx, s, rng, throughput, diffuse)
+    else:
+        w_out = None
     out = np.zeros((3, n), np.float32)
     if ctx.lights.empty or n == 0:
+        if w_out is not None:
+            return w_out
         return (out, out.copy()) if diffuse else out
     ls = ctx.lights.sample(s.p, rng.random((4, n), dtype=np.float32))
     wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
@@ -190,13 +200,45 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         lv = live[~ctx.geom_accel.occluded(so, sd, far)]
         out[:, lv] = finite(cols(contrib, lv))
     if not diffuse:
-        return out
+        return out if w_out is None else out + w_out
     out_d = np.zeros((3, n), np.float32)
     if lv.size:
         valid = (wi_l[2, lv] > 0) & (s.view.co[lv] > 0)
         kd = np.take(s.view.kd, lv, axis=1) * valid
         out_d[:, lv] = finite(kd * cols(ls.le, lv) * (np.abs(wi_l[2, lv]) * w[lv] /
                                                        np.maximum(ls.pdf[lv], np.float32(1e-30))))
+    if w_out is not None:
+        return out + w_out[0], out_d + w_out[1]
+    return out, out_d
+
+
+def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False):
+    """Next-event estimation of the world at surfaces s (n): one direction sampled from the world's distribution,
+    MIS-weighted against BSDF sampling, one shadow ray to infinity. Radiance (3, n) (times ``throughput``), and
+    with ``diffuse`` also the part the diffuse lobe alone reflects."""
+    n = len(s)
+    u = rng.random((2, n), dtype=np.float32)
+    wi, pdf, le = ctx.world.sample(u[0], u[1], (s.ns, s.t, s.bt))
+    wi_l = to_local(wi, s.ns, s.t, s.bt)
+    f, pdf_b = eval_view(s.view, s.wo_l, wi_l)
+    w = power_heuristic(pdf, pdf_b)
+    scale = np.abs(wi_l[2]) * w / np.maximum(pdf, np.float32(1e-30))
+    contrib = f * le * scale
+    if throughput is not None:
+        contrib *= throughput
+    out = np.zeros((3, n), np.float32)
+    live = np.flatnonzero((dot(wi, s.ng) > 0) & (pdf > 0) & (vmax(contrib) > 0))
+    if live.size:
+        so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), np.zeros((3, live.size), np.float32),
+                                  cols(wi, live), np.full(live.size, np.inf, np.float32))
+        live = live[~ctx.geom_accel.occluded(so, sd, far)]
+        out[:, live] = finite(cols(contrib, live))
+    if not diffuse:
+        return out
+    out_d = np.zeros((3, n), np.float32)
+    if live.size:
+        valid = (wi_l[2, live] > 0) & (s.view.co[live] > 0)
+        out_d[:, live] = finite(np.take(s.view.kd, live, axis=1) * valid * cols(le, live) * scale[live])
     return out, out_d
 
 
@@ -229,7 +271,7 @@ def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
 def needs_continuation(ctx: TraceContext, direct_resampled: bool) -> bool:
     """Whether :func:`continue_paths` has anything to add: bounces, or the first BSDF ray's emitter hits (when
     the direct light is not resampled) or the world it escapes to."""
-    return ctx.max_bounces > 0 or not direct_resampled or bool(np.any(ctx.scene.world_radiance > 0))
+    return ctx.max_bounces > 0 or not direct_resampled or ctx.world.sampled
 
 
 @dataclass
@@ -266,7 +308,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     idx = np.arange(n)
     throughput = np.ones((3, n), np.float32)
     lamps = ctx.scene.lamps
-    world = ctx.scene.world_radiance.astype(np.float32)[:, None]
+    world_on = ctx.world.sampled or bool((ctx.world.mean > 0).any())
     first = None
     dthr = None  # with first_bounce, after x2's BSDF sample: the throughput through x2's diffuse lobe alone
     for bounce in range(ctx.max_bounces + 1):
@@ -303,6 +345,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         keep = np.flatnonzero(ok)
         if keep.size == 0:
             break
+        if ctx.world.sampled:
+            origin_n = cols(s.ns, rows[keep])  # the receivers' normals, for a constant world's light-sample pdf
         idx, throughput, prev_pdf = idx[rows[keep]], cols(thr, keep), pdf[keep]
         if dthr is not None:
             dthr = cols(dthr, keep)
@@ -324,10 +368,14 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
                     first.lo_d[:, idx[sel]] += finite(cols(dthr, sel) * le)
         hit = hits.prim >= 0
         esc = np.flatnonzero(~hit)
-        if esc.size:  # film transparency affects camera rays only
-            target[:, idx[esc]] += finite(cols(throughput, esc) * world)
+        if esc.size and world_on:  # film transparency affects camera rays only
+            de = cols(d, esc)
+            le = ctx.world.radiance(de)
+            if ctx.world.sampled:  # the world was light-sampled at this vertex too
+                le *= power_heuristic(prev_pdf[esc], ctx.world.pdf(de, cols(origin_n, esc)))
+            target[:, idx[esc]] += finite(cols(throughput, esc) * le)
             if dthr is not None:
-                first.lo_d[:, idx[esc]] += finite(cols(dthr, esc) * world)
+                first.lo_d[:, idx[esc]] += finite(cols(dthr, esc) * le)
         hsel = np.flatnonzero(hit)
         if hsel.size == 0:
             break
@@ -421,6 +469,8 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
                         material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),
                         has_mix=scene.materials.mix_first is not None and bool((scene.materials.mix_first >= 0).any()),
+                        world=World(scene.world_radiance, getattr(scene, "world_image", None),
+                                    getattr(scene, "world_rotation", None)),
                         geom_flat=flat, geom_ng_rows=geom_ng_rows,
                         geom_normal_rows=np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32),
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T))

@@ -247,7 +247,8 @@ class FrameRenderer:
                 # any change of what emits light (a lamp moved, switched, re-coloured) drops the GI history:
                 # its cached radiance would be stale
                 self.gi_light_key = fingerprint(lights.tri_verts, lights.rows_le, lights.power, lamps.sun_dir,
-                                                lamps.sun_irradiance, self.ctx.scene.world_radiance)
+                                                lamps.sun_irradiance, self.ctx.scene.world_radiance,
+                                                getattr(self.ctx.scene, "world_image", None))
         self.space = di.LightSpace(self.ctx.lights)
         self.coverage, self.coverage_reason = coverage_samples(settings.coverage_samples, self.ctx.lights,
                                                                self.ctx.scene.lamps)
@@ -494,7 +495,12 @@ class FrameRenderer:
 
         def shade(c: _Chunk):
             r = rng(st.seed, st.frame, s, STREAM_SHADE, c.index)
-            direct = di.shade(ctx, c.hits.surf, c.res, r) if resampled else pathtracer.next_event(ctx, c.hits.surf, r)
+            if resampled:  # the lights from the reservoirs, the world by its own light sample
+                direct = di.shade(ctx, c.hits.surf, c.res, r)
+                if ctx.world.sampled:
+                    direct = direct + pathtracer.world_event(ctx, c.hits.surf, r)
+            else:
+                direct = pathtracer.next_event(ctx, c.hits.surf, r)
             c.direct = direct if c.direct is None else c.direct + direct
             if gi_on:
                 # the unbiased mode's reservoirs hold only samples their surface sees (gi.clear_occluded)

@@ -56,9 +56,9 @@ def export_scene(depsgraph, camera_override=None, camera=None) -> Scene:
     registry = MaterialRegistry(warnings)
     geometry, stats = export_geometry(depsgraph, registry, warnings)
     lamps = export_lamps(depsgraph, registry, warnings)
-    world = export_world(scene, warnings)
+    world, world_image, world_rotation = export_world(scene, warnings)
     materials = registry.table()
     out = Scene(geometry=geometry, materials=materials, lamps=lamps, camera=camera,
-                world_radiance=world, warnings=warnings)
+                world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings)
     out.export_stats = dict(stats, seconds=time.perf_counter() - t0)
     return out

@@ -1,0 +1,115 @@
+"""The world (background) as a light: a constant radiance or an equirectangular environment image, with importance
+sampling for next-event estimation (solid-angle pdfs, MIS against BSDF sampling in the path tracer).
+
+Radiance is W·sr⁻¹·m⁻², scene-linear. Image convention (Cycles' equirectangular mapping): for a direction d in the
+texture's frame, u = 1/2 - atan2(d_y, d_x)/(2π), v = 1 - acos(d_z)/π; the image's row 0 is its bottom (v = 0,
+straight down). ``rotation`` maps world directions into the texture's frame (a Mapping node's rotation).
+Sampling an image picks a texel with probability ∝ its luminance times sin θ (one cumulative table over the texels),
+then a uniform point in it: pdf_ω = p(texel) · w h / (2π² sin θ), θ the direction's own polar angle. The luminance is taken
+as the largest of each texel and its 8 neighbours, so bilinear lookups never light a direction of pdf 0. A constant
+world is sampled by the cosine about the receiver's normal (pdf cos⁺θ/π): for a diffuse receiver that is the
+integrand's own shape (zero variance under an open sky, as BSDF sampling alone would be), and MIS with a glossy
+BSDF's samples keeps the best of both.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .sampling import cosine_hemisphere, to_world
+from .textures import sample_bilinear
+
+LUM = np.array([0.2126, 0.7152, 0.0722], np.float32)
+
+
+class World:
+    """``color`` (3,) constant radiance (used when ``image`` is None), ``image`` (h, w, 3) radiance (strength
+    applied) or None, ``rotation`` (3, 3) world -> texture frame or None."""
+
+    def __init__(self, color, image: np.ndarray | None = None, rotation: np.ndarray | None = None):
+        self.color = np.asarray(color, np.float32).reshape(3)
+        self.image = None if image is None else np.ascontiguousarray(image, np.float32)
+        self.rotation = None if rotation is None else np.asarray(rotation, np.float32)
+        if self.image is None:
+            self.mean = self.color
+            self.sampled = bool((self.color > 0).any())
+            return
+        h, w = self.image.shape[:2]
+        lum = np.maximum(self.image @ LUM, 0)
+        # the largest of each texel and its 8 neighbours (a bilinear lookup reads up to one texel away), wrap in u
+        lum = np.maximum(lum, np.maximum(np.roll(lum, -1, axis=1), np.roll(lum, 1, axis=1)))
+        lum = np.maximum(lum, np.maximum(np.vstack([lum[1:], lum[-1:]]), np.vstack([lum[:1], lum[:-1]])))
+        sin_t = np.sin(np.pi * (np.arange(h) + 0.5) / h)[:, None]
+        weight = (lum * sin_t).astype(np.float64)
+        total = weight.sum()
+        self.sampled = bool(total > 0)
+        sin_w = np.broadcast_to(sin_t, (h, w))
+        self.mean = (self.image * sin_w[..., None]).sum(axis=(0, 1)) / sin_w.sum()  # solid-angle mean radiance
+        if not self.sampled:
+            return
+        self._cdf = np.concatenate([[0.0], np.cumsum(weight.ravel())]) / total  # over texels, row-major (h w + 1,)
+        self._p = weight / total                                               # texel probabilities (h, w)
+        self._wh = w * h
+
+    # -- lookups ---------------------------------------------------------------------------------------------
+    def _to_texture(self, d: np.ndarray) -> np.ndarray:
+        return d if self.rotation is None else (self.rotation @ d).astype(np.float32)
+
+    def _uv(self, d: np.ndarray):
+        t = self._to_texture(d)
+        ln = np.sqrt((t * t).sum(axis=0))
+        z = np.clip(t[2] / np.maximum(ln, 1e-30), -1.0, 1.0)
+        u = 0.5 - np.arctan2(t[1], t[0]) / (2 * np.pi)
+        v = 1.0 - np.arccos(z) / np.pi
+        return np.mod(u, 1.0), np.clip(v, 0.0, 1.0)
+
+    def radiance(self, d: np.ndarray) -> np.ndarray:
+        """Radiance (3, n) arriving from directions d (3, n) (need not be unit)."""
+        n = d.shape[1]
+        if self.image is None:
+            return np.broadcast_to(self.color[:, None], (3, n)).astype(np.float32)
+        u, v = self._uv(d)
+        # v = 1 is the top row: clamp the bilinear lookup in v rather than wrap it
+        h = self.image.shape[0]
+        v = np.clip(v, 0.5 / h, 1 - 0.5 / h)
+        return sample_bilinear(self.image, np.stack([u, v], axis=1)).T.copy()
+
+    def pdf(self, d: np.ndarray, normal: np.ndarray | None = None) -> np.ndarray:
+        """Solid-angle density (n,) of :meth:`sample` producing unit directions d (3, n) at receivers of unit
+        ``normal`` (3, n) (a constant world's density depends on it)."""
+        n = d.shape[1]
+        if not self.sampled:
+            return np.zeros(n, np.float32)
+        if self.image is None:
+            c = (d * normal).sum(axis=0)
+            return (np.maximum(c, 0) / np.pi).astype(np.float32)
+        h, w = self._p.shape
+        u, v = self._uv(d)
+        col = np.minimum((u * w).astype(np.intp), w - 1)
+        row = np.minimum((v * h).astype(np.intp), h - 1)
+        sin_t = np.maximum(np.sin(np.pi * v), 1e-6)
+        return (self._p[row, col] * self._wh / (2 * np.pi * np.pi * sin_t)).astype(np.float32)
+
+    def sample(self, u1: np.ndarray, u2: np.ndarray, frame=None):
+        """Directions (3, n) (unit, world space), their solid-angle pdf (n,) and radiance (3, n) from uniforms
+        u1, u2 (n,); ``frame`` = (normal, tangent, bitangent) (3, n) each: the receivers' shading frames (used by a
+        constant world)."""
+        n = len(u1)
+        if self.image is None:
+            local = cosine_hemisphere(u1.astype(np.float32), u2.astype(np.float32))
+            d = to_world(local, *frame)
+            d /= np.maximum(np.sqrt((d * d).sum(axis=0)), np.float32(1e-12))
+            return d, (np.maximum(local[2], 0) / np.pi).astype(np.float32), self.radiance(d)
+        h, w = self._p.shape
+        flat = np.clip(np.searchsorted(self._cdf, u1, side="right") - 1, 0, h * w - 1)
+        lo, hi = self._cdf[flat], self._cdf[flat + 1]
+        fu = np.clip((u1 - lo) / np.maximum(hi - lo, 1e-300), 0, 1)     # u1's position within the texel's interval
+        row, col = np.divmod(flat, w)
+        u = (col + fu) / w
+        v = (row + u2) / h
+        phi = np.pi - 2 * np.pi * u
+        theta = np.pi - np.pi * v
+        st = np.sin(theta)
+        t = np.stack([st * np.cos(phi), st * np.sin(phi), np.cos(theta)])
+        d = (t if self.rotation is None else self.rotation.T.astype(np.float64) @ t).astype(np.float32)
+        pdf = (self._p[row, col] * self._wh / (2 * np.pi * np.pi * np.maximum(st, 1e-6))).astype(np.float32)
+        return d, pdf, self.radiance(d)
