@@ -279,3 +279,50 @@ def world_scene(kind="IMAGE", size=(96, 64), rotation_z=0.0):
     camera((0, -4.5, 1.6), (math.radians(75), 0, 0), lens=35)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def bump_normal_image(name="Bumps", n=64, waves=4, slope=0.6):
+    """A tangent-space normal map (Non-Color) of ridges along u: normal ∝ (-slope cos(2π waves u), 0, 1)."""
+    img = bpy.data.images.new(name, n, n, float_buffer=True)
+    img.colorspace_settings.name = "Non-Color"
+    u = (np.arange(n) + 0.5) / n
+    nx = -slope * np.cos(2 * np.pi * waves * u)
+    nrm = np.stack([nx, np.zeros(n), np.ones(n)], axis=1)
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    px = np.ones((n, n, 4), np.float32)
+    px[..., :3] = (0.5 + 0.5 * nrm)[None, :, :]
+    img.pixels.foreach_set(px.ravel())
+    img.pack()
+    return img
+
+
+def _ridged(name, strength):
+    m = principled(name, (0.7, 0.6, 0.5), roughness=0.4)
+    tree = m.node_tree
+    tex = tree.nodes.new("ShaderNodeTexImage")
+    tex.image = bpy.data.images.get("Bumps") or bump_normal_image()
+    nmap = tree.nodes.new("ShaderNodeNormalMap")
+    nmap.inputs["Strength"].default_value = strength
+    tree.links.new(tex.outputs["Color"], nmap.inputs["Color"])
+    tree.links.new(nmap.outputs["Normal"], tree.nodes["Principled BSDF"].inputs["Normal"])
+    return m
+
+
+def normal_map_scene(size=(96, 64), sphere=False):
+    """A floor (Normal Map strength 1) and a wall behind it (rotated 90° about its normal, strength 0.5) whose
+    Principled BSDFs (roughness 0.4) have a tangent-space Normal Map of ridges (:func:`bump_normal_image`), lit by
+    a low area light from the side: the ridges' facets light up or not. ``sphere`` adds a normal-mapped UV sphere
+    (smooth MikkTSpace tangents; see docs/CONVENTIONS.md for what differs from Cycles there)."""
+    scene = reset()
+    _with_uvs(plane("Floor", 4, (0, 0, 0), material=_ridged("Ridged", 1.0)))
+    _with_uvs(plane("Wall", 4, (0, 2, 2), (math.pi / 2, 0, 0), material=_ridged("Ridged wall", 0.5)))
+    bpy.data.objects["Wall"].rotation_euler = (math.pi / 2, math.pi / 2, 0)
+    if sphere:
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.6, location=(0.6, 0.4, 0.6), segments=32, ring_count=16)
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(_ridged("Ridged sphere", 1.0))
+    light("AREA", (-3, 0.5, 1.2), (0, math.radians(-70), 0), energy=300.0, size=1.0)
+    camera((0, -3.2, 2.4), (math.radians(55), 0, 0), lens=30)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

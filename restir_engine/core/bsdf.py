@@ -29,7 +29,7 @@ import numpy as np
 
 from . import microfacet_tables as tables
 from .microfacet_tables import ALPHA_MIN, smith_lambda
-from .sampling import cosine_hemisphere, dot
+from .sampling import cosine_hemisphere, dot, orthonormal_basis
 
 INV_PI = np.float32(1.0 / np.pi)
 _F82 = 6.0 / 7.0  # 1 - cos 82°-ish: the F82 model's reference angle has cos θ = 1/7
@@ -208,6 +208,16 @@ class ViewTerms:
     p_spec: np.ndarray
     glossy: bool = True  # False: no surface has a specular lobe (Diffuse BSDFs only): Lambert alone
     f0r: np.ndarray | None = None  # (n,) untinted dielectric f0 (with spec_c)
+    bump_n: np.ndarray | None = None   # (3, n) normal-mapped surfaces: the unmapped normal in the local frame
+    bump_a2: np.ndarray | None = None  # (n,) and its bump-shadowing roughness (:func:`bump_factor`)
+    spec_n: np.ndarray | None = None   # (3, n) the specular lobes' normal in the local frame (surface.py), or None
+    co_s: np.ndarray | None = None     # (n,) cos θo about spec_n
+
+    def with_spec_normal(self, spec_n: np.ndarray, wo: np.ndarray) -> None:
+        """Give the specular lobes their own normal ``spec_n`` (local, unit (3, n)): their cos θo and Λ(ωo)."""
+        self.spec_n = spec_n
+        self.co_s = np.clip(dot(wo, spec_n), np.float32(1e-4), 1.0).astype(np.float32)
+        self.lam_o = smith_lambda(self.alpha, self.co_s)
 
     @staticmethod
     def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None,
@@ -292,9 +302,19 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     co = v.co
     ci = wi[2]
     valid = (co > 0) & (ci > 0)
+    kd = v.kd
+    if v.bump_n is not None:
+        ok, g = bump_factor(v, wi)
+        valid = valid & (ok > 0)
+        kd = kd * g
     if not v.glossy:
         pdf = np.maximum(ci, np.float32(0.0)) * INV_PI * valid
-        return (v.kd * valid).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
+        return (kd * valid).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
+    valid_s = valid
+    if v.spec_n is not None:  # the specular lobes about their own normal
+        co = v.co_s
+        ci = dot(wi, v.spec_n)
+        valid_s = valid & (ci > 0)
     wdw = dot(wo, wi)
     hinv = 2.0 + 2.0 * wdw
     np.maximum(hinv, np.float32(1e-24), out=hinv)
@@ -318,8 +338,10 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     s *= den4
     np.divide(d, s, out=s)
     s *= v.spec_on                                   # D G2 / (4 cos θo cos θi)
+    if v.spec_n is not None:
+        s *= valid_s
     f = v.spec_a * s
-    f += v.kd
+    f += kd
     if v.spec_b is not None or v.spec_d is not None:
         c = 1.0 - odh
         np.clip(c, 0.0, 1.0, out=c)
@@ -340,9 +362,39 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         fr *= s
         f += fr * v.spec_c
     f *= valid
-    pdf = (1 - v.p_spec) * np.maximum(ci, 0) * INV_PI + v.p_spec * (d * cos_h / (4.0 * odh))
+    pdf_s = d * cos_h / (4.0 * odh)
+    if v.spec_n is not None:
+        ci = wi[2]
+        pdf_s *= valid_s
+    pdf = (1 - v.p_spec) * np.maximum(ci, 0) * INV_PI + v.p_spec * pdf_s
     pdf *= valid
     return f.astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
+
+
+def bump_factor(v: ViewTerms, wi: np.ndarray):
+    """Cycles' bump-map correction at normal-mapped surfaces (1 elsewhere): (valid (n,) 0/1: directions on the
+    wrong side of the unmapped normal N_s are rejected for every lobe, the diffuse factor (n,): the Smith G1 of a
+    GGX of α² = min(1, tan²θ_d / 8) at |N_s·ωi|, θ_d the angle between the mapped and unmapped normals)."""
+    bn = v.bump_n
+    cos_si = bn[0] * wi[0] + bn[1] * wi[1] + bn[2] * wi[2]
+    ok = (cos_si * bn[2] * wi[2]) >= 0
+    c2 = np.clip(cos_si * cos_si, 1e-12, 1.0)
+    g = 2.0 / (1.0 + np.sqrt(1.0 + v.bump_a2 * (1.0 - c2) / c2))
+    return ok.astype(np.float32), np.where(np.abs(cos_si) < 1e-6, np.float32(0.0), g).astype(np.float32)
+
+
+def diffuse_f(v: ViewTerms, wi: np.ndarray, rows=None) -> np.ndarray:
+    """The diffuse lobe alone (3, k) toward local directions wi (3, k) at surfaces ``rows`` (all when None) of view
+    terms ``v``, with the bump-map correction where there is one."""
+    kd = v.kd if rows is None else np.take(v.kd, rows, axis=1)
+    co = v.co if rows is None else v.co[rows]
+    valid = ((wi[2] > 0) & (co > 0)).astype(np.float32)
+    if v.bump_n is not None:
+        sub = v if rows is None else ViewTerms(None, None, None, None, None, None, None, None, None, None, None, None,
+                                               bump_n=np.take(v.bump_n, rows, axis=1), bump_a2=v.bump_a2[rows])
+        ok, g = bump_factor(sub, wi)
+        valid *= ok * g
+    return kd * valid
 
 
 def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
@@ -368,6 +420,10 @@ def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.nda
         h[0] = sin_t * np.cos(phi)
         h[1] = sin_t * np.sin(phi)
         h[2] = cos_t
+        if view is not None and view.spec_n is not None:  # about the specular normal: rotate h into its frame
+            sn = np.take(view.spec_n, spec, axis=1)
+            t2, b2 = orthonormal_basis(sn)
+            h = h[0] * t2 + h[1] * b2 + h[2] * sn
         o = np.take(wo, spec, axis=1)
         wi[:, spec] = 2.0 * dot(o, h) * h - o
     f, pdf = eval_view(ViewTerms.of(p, wo) if view is None else view, wo, wi)

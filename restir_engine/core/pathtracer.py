@@ -27,7 +27,7 @@ from .accel import Accel, offset_origin, shadow_rays
 from . import microfacet_tables
 from .cutout import Cutout
 from .world import World
-from .bsdf import SurfaceParams, eval_view, sample_bsdf
+from .bsdf import SurfaceParams, diffuse_f, eval_view, sample_bsdf
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
 from .sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
 from .scene import Scene
@@ -53,6 +53,7 @@ class TraceContext:
     material_layer: np.ndarray = None   # (m, 32) dielectric layer factor S rows over μo (microfacet_tables)
     has_mix: bool = False  # some material is a Mix/Add shader (core/mix.py)
     world: World = None    # the background as a light (core/world.py)
+    normal_maps: bool = False  # some material has a tangent-space normal map (surface.normal_map)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -203,8 +204,7 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         return out if w_out is None else out + w_out
     out_d = np.zeros((3, n), np.float32)
     if lv.size:
-        valid = (wi_l[2, lv] > 0) & (s.view.co[lv] > 0)
-        kd = np.take(s.view.kd, lv, axis=1) * valid
+        kd = diffuse_f(s.view, cols(wi_l, lv), lv)
         out_d[:, lv] = finite(kd * cols(ls.le, lv) * (np.abs(wi_l[2, lv]) * w[lv] /
                                                        np.maximum(ls.pdf[lv], np.float32(1e-30))))
     if w_out is not None:
@@ -237,8 +237,7 @@ def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, through
         return out
     out_d = np.zeros((3, n), np.float32)
     if live.size:
-        valid = (wi_l[2, live] > 0) & (s.view.co[live] > 0)
-        out_d[:, live] = finite(np.take(s.view.kd, live, axis=1) * valid * cols(le, live) * scale[live])
+        out_d[:, live] = finite(diffuse_f(s.view, cols(wi_l, live), live) * cols(le, live) * scale[live])
     return out, out_d
 
 
@@ -331,8 +330,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         scale = wi_l[2] / np.maximum(pdf, np.float32(1e-30))
         thr *= scale
         if bounce == 1 and first is not None:  # x2's diffuse lobe alone (throughput 1 before it)
-            kd = cols(s.view.kd, rows) * ((wi_l[2] > 0) & (s.view.co[rows] > 0))
-            dthr = kd * scale
+            dthr = diffuse_f(s.view, wi_l, rows) * scale
         elif dthr is not None:
             dthr = cols(dthr, rows) * f * scale
         ok = vfinite(thr)
@@ -469,6 +467,8 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
                         material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),
                         has_mix=scene.materials.mix_first is not None and bool((scene.materials.mix_first >= 0).any()),
+                        normal_maps=scene.materials.normal_tex is not None
+                        and bool((scene.materials.normal_tex >= 0).any()),
                         world=World(scene.world_radiance, getattr(scene, "world_image", None),
                                     getattr(scene, "world_rotation", None)),
                         geom_flat=flat, geom_ng_rows=geom_ng_rows,

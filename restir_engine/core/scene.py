@@ -26,6 +26,8 @@ class TriangleSet:
     material: np.ndarray
     uvs: np.ndarray | None = None
     instance: np.ndarray | None = None  # (n,) int32 index into Scene.motion's instance matrices
+    tangents: np.ndarray | None = None  # (n, 3, 4) per-corner UV tangent (xyz, world space) and bitangent sign,
+    #                                     or None when no material has a normal map
 
     @staticmethod
     def empty() -> TriangleSet:
@@ -61,6 +63,8 @@ class MaterialTable:
     mix_weight  (k,) constant weight of the component (product of the Mix factors on its path; Add: 1)
     mix_tex     (k,) int32  texture index whose value t (first channel) further weighs it, -1 = none
     mix_sign    (k,) +1: weight x t, -1: weight x (1 - t)
+    normal_tex  (m,) int32  tangent-space normal map texture (a Normal Map node on the BSDF's Normal), -1 = none
+    normal_strength (m,) its Strength
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
@@ -79,6 +83,8 @@ class MaterialTable:
     base_tex: np.ndarray
     emit_tex: np.ndarray
     two_sided_emission: np.ndarray
+    normal_tex: np.ndarray = None
+    normal_strength: np.ndarray = None
     alpha: np.ndarray = None
     alpha_tex: np.ndarray = None
     alpha_sign: np.ndarray = None
@@ -106,6 +112,7 @@ class MaterialTable:
             two_sided_emission=col("two_sided_emission", True, bool),
             alpha=col("alpha", 1.0), alpha_tex=col("alpha_tex", -1, np.int32), alpha_sign=col("alpha_sign", 1.0),
             mix_normalize=col("mix_normalize", False, bool),
+            normal_tex=col("normal_tex", -1, np.int32), normal_strength=col("normal_strength", 1.0),
             **_mix_arrays(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
 

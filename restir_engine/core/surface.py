@@ -10,6 +10,7 @@ import numpy as np
 from .bsdf import SurfaceParams, ViewTerms
 from .microfacet_tables import rows_at
 from .mix import hash_uniform, pick_components
+from .textures import sample
 from .sampling import barycentric, cols, dot, norm, orthonormal_basis
 from .textures import apply_texture
 
@@ -25,27 +26,6 @@ class Surface:
         self.prim = prim
         self.b1, self.b2 = u, v
         self.p = (o + d * t).astype(np.float32, copy=False)
-        ng = cols(ctx.geom_ng_rows, prim)
-        smooth = np.flatnonzero(~ctx.geom_flat[prim])
-        if smooth.size == len(prim):
-            c = cols(ctx.geom_normal_rows, prim)
-            ns = barycentric(c[0:3], c[3:6], c[6:9], u, v)
-        else:  # flat-shaded triangles: the corner normal as it is
-            ns = cols(ctx.geom_normal_rows[0:3], prim)
-            if smooth.size:
-                c = cols(ctx.geom_normal_rows, prim[smooth])
-                ns[:, smooth] = barycentric(c[0:3], c[3:6], c[6:9], u[smooth], v[smooth])
-        ln = norm(ns)
-        ns /= np.maximum(ln, np.float32(1e-12))
-        bad = ~np.isfinite(ln) | (ln < 0.5)
-        if bad.any():
-            ns[:, bad] = ng[:, bad]
-        # shading normal on the geometric normal's side, both facing the incoming ray
-        s_ng = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
-        s_ns = np.where(dot(ns, ng) < 0, -s_ng, s_ng)
-        self.ng = ng * s_ng
-        self.ns = ns * s_ns
-        self.wo = -d
         mat = geom.material[prim].astype(np.intp)
         self.mat = mat  # the triangle's material (a Mix/Add shader stays itself here)
         scale = None
@@ -61,6 +41,35 @@ class Surface:
                 mat[mixed] = comp
                 scale = np.ones(len(mat), np.float32)
                 scale[mixed] = w
+        ng = cols(ctx.geom_ng_rows, prim)
+        smooth = np.flatnonzero(~ctx.geom_flat[prim])
+        if smooth.size == len(prim):
+            c = cols(ctx.geom_normal_rows, prim)
+            ns = barycentric(c[0:3], c[3:6], c[6:9], u, v)
+        else:  # flat-shaded triangles: the corner normal as it is
+            ns = cols(ctx.geom_normal_rows[0:3], prim)
+            if smooth.size:
+                c = cols(ctx.geom_normal_rows, prim[smooth])
+                ns[:, smooth] = barycentric(c[0:3], c[3:6], c[6:9], u[smooth], v[smooth])
+        ln = norm(ns)
+        ns /= np.maximum(ln, np.float32(1e-12))
+        bad = ~np.isfinite(ln) | (ln < 0.5)
+        if bad.any():
+            ns[:, bad] = ng[:, bad]
+        mapped = None
+        if ctx.normal_maps and geom.tangents is not None:
+            mapped = np.flatnonzero(mats.normal_tex[mat] >= 0)
+            if mapped.size:
+                smooth_n = ns[:, mapped].copy()
+                ns[:, mapped] = normal_map(mats, geom, mat, prim, u, v, ns, mapped)
+            else:
+                mapped = None
+        # shading normal on the geometric normal's side, both facing the incoming ray
+        s_ng = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
+        s_ns = np.where(dot(ns, ng) < 0, -s_ng, s_ng)
+        self.ng = ng * s_ng
+        self.ns = ns * s_ns
+        self.wo = -d
         self.bsdf_mat = mat  # the material whose BSDF the hit uses
         self.params = ctx.material_params.take(mat)
         if geom.uvs is not None:
@@ -74,6 +83,16 @@ class Surface:
         if scale is not None:
             self.params.scale(scale)
         self.t, self.bt = orthonormal_basis(self.ns)
+        self.bump_n = self.bump_a2 = None
+        if mapped is not None:  # the unmapped (smooth) normal in the local frame, for Cycles' bump shadowing
+            sn = smooth_n * s_ng[mapped]
+            self.bump_n = np.zeros((3, len(prim)), np.float32)
+            self.bump_n[2] = 1.0
+            self.bump_n[0, mapped] = dot(sn, cols(self.t, mapped))
+            self.bump_n[1, mapped] = dot(sn, cols(self.bt, mapped))
+            self.bump_n[2, mapped] = dot(sn, cols(self.ns, mapped))
+            cos_d = np.clip(np.abs(self.bump_n[2]), 1e-6, 1.0)
+            self.bump_a2 = np.clip(0.125 * (1.0 / (cos_d * cos_d) - 1.0), 0.0, 1.0).astype(np.float32)
         wo = self.wo
         wo_l = np.empty_like(wo)
         wo_l[0] = dot(wo, self.t)
@@ -82,10 +101,27 @@ class Surface:
         wo_l[2] = np.maximum(dot(wo, self.ns), np.float32(1e-4))
         wo_l /= norm(wo_l)
         self.wo_l = wo_l
-        # GGX albedo and the dielectric layer's Fresnel factor toward the viewer, once per hit (α and η are
-        # constant per material: one interpolation in μo)
-        self.albedo = rows_at(ctx.material_albedo, mat, wo_l[2])
-        self.layer = rows_at(ctx.material_layer, mat, wo_l[2])
+        # Cycles' specular normal: where the mirror reflection of the view about the shading normal would leave
+        # below the geometric surface, the specular lobes use a normal bent toward ng just enough (the diffuse
+        # lobe keeps the shading normal)
+        self.spec_n = None
+        mu = wo_l[2]
+        bent = np.flatnonzero(dot(self.ns, self.ng) < np.float32(0.99999))
+        if bent.size:
+            n2, changed = valid_reflection_normal(cols(self.ng, bent), cols(self.wo, bent), cols(self.ns, bent))
+            rows = bent[changed]
+            if rows.size:
+                n2 = n2[:, changed]
+                self.spec_n = np.zeros((3, len(prim)), np.float32)
+                self.spec_n[2] = 1.0
+                self.spec_n[0, rows] = dot(n2, cols(self.t, rows))
+                self.spec_n[1, rows] = dot(n2, cols(self.bt, rows))
+                self.spec_n[2, rows] = dot(n2, cols(self.ns, rows))
+                mu = dot(wo_l, self.spec_n)
+        # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal), once
+        # per hit (α and η are constant per material: one interpolation in μo)
+        self.albedo = rows_at(ctx.material_albedo, mat, mu)
+        self.layer = rows_at(ctx.material_layer, mat, mu)
 
     def __len__(self) -> int:
         return len(self.prim)
@@ -96,6 +132,9 @@ class Surface:
         v = getattr(self, "_view", None)
         if v is None:
             v = self._view = ViewTerms.of(self.params, self.wo_l, self.albedo, self.layer)
+            v.bump_n, v.bump_a2 = self.bump_n, self.bump_a2
+            if self.spec_n is not None:
+                v.with_spec_normal(self.spec_n, self.wo_l)
         return v
 
     def take(self, idx) -> "Surface":
@@ -103,8 +142,64 @@ class Surface:
         out = Surface.__new__(Surface)
         for name in ("prim", "b1", "b2", "mat", "bsdf_mat", "albedo", "layer"):
             setattr(out, name, getattr(self, name)[idx])
-        for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l"):
+        for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l", "bump_n", "spec_n"):
             a = getattr(self, name)
-            setattr(out, name, a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1))
+            setattr(out, name, None if a is None else a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1))
+        out.bump_a2 = None if self.bump_a2 is None else self.bump_a2[idx]
         out.params = self.params.take(idx)
         return out
+
+
+def normal_map(mats, geom, mat, prim, u, v, ns, rows) -> np.ndarray:
+    """Shading normals (3, k) of hits ``rows`` whose material has a tangent-space Normal Map (Cycles' node): the
+    texel c in [0, 1]³ becomes m = 2c - 1, scaled by the strength s (m_xy · s, m_z → mix(1, m_z, s)), and the
+    normal is normalize(m_x T + m_y B + m_z N) with T the interpolated UV tangent, B = sign · N x T and N the
+    interpolated normal ``ns`` (unit, not yet turned to face the ray)."""
+    p = prim[rows]
+    m = mat[rows]
+    c = np.take(geom.uvs, p, axis=0)
+    uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[rows][:, None], v[rows][:, None])
+    tex = np.empty((len(rows), 3), np.float32)
+    for t in np.unique(mats.normal_tex[m]):  # loop over textures, not hits
+        sel = np.flatnonzero(mats.normal_tex[m] == t)
+        tex[sel] = sample(mats.textures[t], uv[sel])
+    col = (2.0 * tex - 1.0).T                                  # (3, k)
+    strength = mats.normal_strength[m]
+    col[0] *= strength
+    col[1] *= strength
+    col[2] = 1.0 + (col[2] - 1.0) * np.clip(strength, 0, 1)
+    tg = np.take(geom.tangents, p, axis=0)                     # (k, 3 corners, 4): xyz, sign
+    tan = barycentric(tg[:, 0, :3].T, tg[:, 1, :3].T, tg[:, 2, :3].T, u[rows], v[rows])
+    n = ns[:, rows]
+    b = np.cross(n.T, tan.T).T * tg[:, 0, 3]
+    out = col[0] * tan + col[1] * b + col[2] * n
+    ln = norm(out)
+    ok = np.isfinite(ln) & (ln > 1e-12)
+    return np.where(ok, out / np.where(ok, ln, 1.0), n).astype(np.float32)
+
+
+def valid_reflection_normal(ng: np.ndarray, wo: np.ndarray, n: np.ndarray):
+    """Cycles' ensure_valid_specular_reflection, vectorized over (3, k) unit rows: where the mirror reflection
+    R = 2 (n·wo) n - wo of the view direction wo about the shading normal n falls below min(0.9 wo·ng, 0.01) over
+    the geometric normal ng, n is rotated toward ng (in their plane) just enough to lift R to that height.
+    Returns (normals (3, k), changed (k,) bool)."""
+    iz = dot(wo, ng)
+    r_z = 2 * dot(n, wo) * dot(n, ng) - iz
+    t = np.minimum(0.9 * iz, np.float32(0.01))
+    changed = r_z < t
+    if not changed.any():
+        return n, changed
+    x = n - dot(n, ng) * ng
+    lx = norm(x)
+    x = np.where(lx > 1e-12, x / np.maximum(lx, 1e-30), n)
+    ix = dot(wo, x)
+    a = ix * ix + iz * iz
+    b = 2.0 * (a + iz * t)
+    c = (t + iz) ** 2
+    disc = np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))
+    nz2 = np.where(ix < 0, 0.25 * (b + disc), 0.25 * (b - disc)) / np.maximum(a, 1e-30)
+    nx = np.sqrt(np.maximum(1.0 - nz2, 0.0))
+    nz = np.sqrt(np.maximum(nz2, 0.0))
+    out = np.where(changed, nx * x + nz * ng, n)
+    return out.astype(np.float32), changed
+

@@ -56,9 +56,14 @@ class MaterialRegistry:
         self.rows.append(row)
         return len(self.rows) - 1
 
+    def uses_normal_maps(self, indices) -> bool:
+        def mapped(row: dict) -> bool:
+            return row.get("normal_tex", -1) >= 0 or any(mapped(self.rows[c]) for c, *_r in row.get("mix", ()))
+        return any(mapped(self.rows[i]) for i in indices)
+
     def uses_textures(self, indices) -> bool:
         def textured(row: dict) -> bool:
-            if row.get("base_tex", -1) >= 0 or row.get("emit_tex", -1) >= 0 or row.get("alpha_tex", -1) >= 0:
+            if max(row.get(k, -1) for k in ("base_tex", "emit_tex", "alpha_tex", "normal_tex")) >= 0:
                 return True
             return any(tex >= 0 or textured(self.rows[comp]) for comp, _w, tex, _s in row.get("mix", ()))
         return any(textured(self.rows[i]) for i in indices)
@@ -139,6 +144,7 @@ class MaterialRegistry:
                     self._warn(material, f"Principled '{name}' is not supported and was ignored")
             if "Alpha" in inp:
                 self._alpha(material, inp["Alpha"], row)
+            self._normal(material, node, row)
             return row
         if t == "BSDF_TRANSPARENT":
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
@@ -150,6 +156,7 @@ class MaterialRegistry:
             row["base_color"] = self._color_input(material, node.inputs["Color"], "base_tex", row, (0.8, 0.8, 0.8))
             if self._float_input(material, node.inputs["Roughness"]) > 0:
                 self._warn(material, "Diffuse BSDF roughness (Oren-Nayar) is approximated as Lambertian")
+            self._normal(material, node, row)
             return row
         if t == "EMISSION":
             row = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
@@ -165,6 +172,7 @@ class MaterialRegistry:
             if "Anisotropy" in node.inputs and (node.inputs["Anisotropy"].is_linked
                                                 or abs(float(node.inputs["Anisotropy"].default_value)) > 1e-4):
                 self._warn(material, "Glossy BSDF anisotropy is not supported; rendered isotropic")
+            self._normal(material, node, row)
             return row
         if t in {"MIX_SHADER", "ADD_SHADER"}:
             return self._mix(material, node, depth)
@@ -173,6 +181,25 @@ class MaterialRegistry:
                 "roughness": float(material.roughness), "f0": 0.04}
 
     # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/mix.py) ---------
+    def _normal(self, material, node, row: dict) -> None:
+        """A BSDF's Normal input driven by a tangent-space Normal Map node on an Image Texture -> normal_tex and
+        normal_strength; anything else on it (Bump, other spaces) is reported and ignored."""
+        socket = node.inputs.get("Normal")
+        if socket is None or not socket.is_linked:
+            return
+        src = socket.links[0].from_node
+        if src.type == "NORMAL_MAP" and src.space == "TANGENT":
+            col = src.inputs["Color"]
+            img = col.links[0].from_node if col.is_linked else None
+            if img is not None and img.type == "TEX_IMAGE" and img.image is not None:
+                if src.uv_map:
+                    self._warn(material, f"'{src.name}' names UV map '{src.uv_map}'; the render UV map is used")
+                row["normal_tex"] = self._texture(material, img.image, closest=img.interpolation == "Closest")
+                row["normal_strength"] = self._float_input(material, src.inputs["Strength"])
+                return
+        self._warn(material, f"'{src.name}' ({src.type}) on the Normal input is not supported; the mesh normal is "
+                   "used (supported: a tangent-space Normal Map of an Image Texture)")
+
     def _alpha(self, material, socket, row: dict) -> None:
         """Principled Alpha: constant, or an Image Texture's Alpha (or Color, as luminance) -> row alpha fields."""
         tex = self._factor_texture(material, socket)

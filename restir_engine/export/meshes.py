@@ -15,9 +15,10 @@ GEOMETRY_TYPES = {"MESH", "CURVE", "CURVES", "SURFACE", "FONT", "META"}
 MAX_COORD = 1e7  # beyond this float32 precision makes ray offsets meaningless
 
 
-def _read_mesh(mesh, want_uv: bool) -> dict | None:
+def _read_mesh(mesh, want_uv: bool, want_tangents: bool = False, warnings: list | None = None) -> dict | None:
     """Local-space triangle arrays of a mesh datablock: verts (t,3,3), normals (t,3,3),
-    uvs (t,3,2) or None, slot (t,) int32 material slot index."""
+    uvs (t,3,2) or None, tangents (t,3,4) (MikkTSpace tangent of the UV map and bitangent sign) or None,
+    slot (t,) int32 material slot index."""
     mesh.calc_loop_triangles()
     tris = mesh.loop_triangles
     nt = len(tris)
@@ -46,7 +47,20 @@ def _read_mesh(mesh, want_uv: bool) -> dict | None:
         uv = np.empty(len(mesh.loops) * 2, np.float32)
         layer.data.foreach_get("uv", uv)
         uvs = uv.reshape(-1, 2)[loops].reshape(nt, 3, 2)
-    return {"verts": co.reshape(-1, 3)[vidx].reshape(nt, 3, 3), "normals": nrm, "uvs": uvs, "slot": slot}
+    tangents = None
+    if want_tangents and uvs is not None:
+        try:
+            mesh.calc_tangents(uvmap=layer.name)
+            tl = np.empty(len(mesh.loops) * 3, np.float32)
+            mesh.loops.foreach_get("tangent", tl)
+            sign = np.empty(len(mesh.loops), np.float32)
+            mesh.loops.foreach_get("bitangent_sign", sign)
+            tangents = np.concatenate([tl.reshape(-1, 3), sign[:, None]], axis=1)[loops].reshape(nt, 3, 4)
+        except RuntimeError as e:  # n-gons: Blender computes tangents for triangles and quads only
+            if warnings is not None:
+                warnings.append(f"Mesh '{mesh.name}': no tangents for its normal map ({e}); rendered without it")
+    return {"verts": co.reshape(-1, 3)[vidx].reshape(nt, 3, 3), "normals": nrm, "uvs": uvs, "slot": slot,
+            "tangents": tangents}
 
 
 def instance_key(inst) -> tuple:
@@ -93,7 +107,7 @@ def export_geometry(depsgraph, registry, warnings: list):
                 continue
             try:
                 want_uv = registry.uses_textures(slot_cache[mats_key])
-                cache[key] = _read_mesh(mesh, want_uv)
+                cache[key] = _read_mesh(mesh, want_uv, registry.uses_normal_maps(slot_cache[mats_key]), warnings)
             finally:
                 obj.to_mesh_clear()
         arrays = cache[key]
@@ -112,6 +126,9 @@ def export_geometry(depsgraph, registry, warnings: list):
     instance = np.empty(total, np.int32)
     need_uv = any(b[0]["uvs"] is not None for b in blocks)
     uvs = np.zeros((total, 3, 2), np.float32) if need_uv else None
+    need_tangents = any(b[0]["tangents"] is not None for b in blocks)
+    # a mesh without tangents gets zero ones: its normal map then leaves the normal as it is (m_z N)
+    tangents = np.zeros((total, 3, 4), np.float32) if need_tangents else None
     at = 0
     for k, (arrays, m, slot_map, _name, _key) in enumerate(blocks):  # per instance, vectorized over triangles
         n = len(arrays["verts"])
@@ -128,6 +145,12 @@ def export_geometry(depsgraph, registry, warnings: list):
         instance[at:at + n] = k
         if uvs is not None and arrays["uvs"] is not None:
             uvs[at:at + n] = arrays["uvs"]
+        if tangents is not None and arrays["tangents"] is not None:
+            tw = arrays["tangents"][..., :3].reshape(-1, 3) @ lin.T   # surface vectors move with the linear part
+            tw /= np.maximum(np.linalg.norm(tw, axis=1), 1e-30)[:, None]
+            tangents[at:at + n, :, :3] = tw.reshape(n, 3, 3)
+            # a mirroring transform flips the bitangent (the normal is transformed, the frame's handedness not)
+            tangents[at:at + n, :, 3] = arrays["tangents"][..., 3] * np.sign(np.linalg.det(lin) or 1.0)
         at += n
     # drop unusable triangles: non-finite or huge coordinates, zero area
     finite = np.isfinite(verts).all(axis=(1, 2)) & (np.abs(verts).max(axis=(1, 2)) < MAX_COORD)
@@ -144,12 +167,13 @@ def export_geometry(depsgraph, registry, warnings: list):
     if not keep.all():
         verts, normals, material, instance = verts[keep], normals[keep], material[keep], instance[keep]
         uvs = uvs[keep] if uvs is not None else None
+        tangents = tangents[keep] if tangents is not None else None
     bad_n = ~np.isfinite(normals).all(axis=2)
     if bad_n.any():
         normals[bad_n] = 0.0  # the shader falls back to the geometric normal
     stats = {"triangles": len(verts), "instances": len(blocks), "dropped": int((~keep).sum()),
              "instance_keys": [b[4] for b in blocks], "instance_matrices": np.array([b[1] for b in blocks])}
-    return TriangleSet(verts, normals, material, uvs, instance), stats
+    return TriangleSet(verts, normals, material, uvs, instance, tangents), stats
 
 
 def _spans(blocks):

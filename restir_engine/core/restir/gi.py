@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..accel import shadow_rays
-from ..bsdf import eval_view
+from ..bsdf import diffuse_f, eval_view
 from ..light_tiles import PackedPoints
 from ..sampling import cols, dot, finite, norm, to_local, vmax
 from ..target import LUM as _LUM
@@ -250,7 +250,8 @@ def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray, verified: bool = F
     f, _pdf = eval_view(sub.view, sub.wo_l, wi_l)
     g = glossy[live]
     if g.any():
-        f[:, g] = sub.view.kd[:, g] * (wi_l[2, g] > 0)
+        gr = np.flatnonzero(g)
+        f[:, gr] = diffuse_f(sub.view, cols(wi_l, gr), gr)
     ok = (cos2 > 0) & (dot(wi, sub.ng) > 0)
     contrib = f * lo
     contrib *= np.abs(wi_l[2]) * cos2 / np.maximum(dist * dist, np.float32(1e-30)) * res.W[live] * ok
