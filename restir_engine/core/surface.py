@@ -10,9 +10,8 @@ import numpy as np
 from .bsdf import SurfaceParams, ViewTerms
 from .microfacet_tables import rows_at
 from .mix import hash_uniform, pick_components
-from .textures import sample
 from .sampling import barycentric, cols, dot, norm, orthonormal_basis
-from .textures import apply_texture
+from .textures import apply_texture, sample
 
 
 class Surface:

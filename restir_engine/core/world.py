@@ -93,7 +93,6 @@ class World:
         """Directions (3, n) (unit, world space), their solid-angle pdf (n,) and radiance (3, n) from uniforms
         u1, u2 (n,); ``frame`` = (normal, tangent, bitangent) (3, n) each: the receivers' shading frames (used by a
         constant world)."""
-        n = len(u1)
         if self.image is None:
             local = cosine_hemisphere(u1.astype(np.float32), u2.astype(np.float32))
             d = to_world(local, *frame)
