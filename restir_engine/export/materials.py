@@ -142,6 +142,8 @@ class MaterialRegistry:
             for name in ("Transmission Weight", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
                 if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
                     self._warn(material, f"Principled '{name}' is not supported and was ignored")
+            if "Diffuse Roughness" in inp:
+                row["diffuse_roughness"] = float(np.clip(self._float_input(material, inp["Diffuse Roughness"]), 0, 1))
             if "Alpha" in inp:
                 self._alpha(material, inp["Alpha"], row)
             self._normal(material, node, row)
@@ -154,8 +156,7 @@ class MaterialRegistry:
         if t == "BSDF_DIFFUSE":
             row = {"f0": 0.0, "metallic": 0.0}
             row["base_color"] = self._color_input(material, node.inputs["Color"], "base_tex", row, (0.8, 0.8, 0.8))
-            if self._float_input(material, node.inputs["Roughness"]) > 0:
-                self._warn(material, "Diffuse BSDF roughness (Oren-Nayar) is approximated as Lambertian")
+            row["diffuse_roughness"] = float(np.clip(self._float_input(material, node.inputs["Roughness"]), 0, 1))
             self._normal(material, node, row)
             return row
         if t == "EMISSION":
