@@ -8,10 +8,10 @@ naming the material and the reason.
 """
 from __future__ import annotations
 
-import bpy
 import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
+from ..compat import uses_nodes
 from ..core.textures import NearestImage
 
 MAGENTA = (1.0, 0.0, 1.0)
@@ -20,12 +20,6 @@ MAGENTA = (1.0, 0.0, 1.0)
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
 
-
-def uses_nodes(idblock) -> bool:
-    """Whether a material/world is defined by its node tree (always, from Blender 5.0 on)."""
-    if idblock.node_tree is None:
-        return False
-    return True if bpy.app.version >= (5, 0, 0) else bool(idblock.use_nodes)
 
 
 class MaterialRegistry:
