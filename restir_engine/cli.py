@@ -58,17 +58,8 @@ def parse(argv):
 def _set_format(scene, fmt: str):
     settings = scene.render.image_settings
     fmt = fmt.upper()
-    if fmt == "OPEN_EXR_MULTILAYER":
-        if hasattr(settings, "media_type"):
-            settings.media_type = "MULTI_LAYER_IMAGE"
-        else:
-            settings.file_format = "OPEN_EXR_MULTILAYER"
-        return
-    if fmt == "EXR":
-        fmt = "OPEN_EXR"
-    if hasattr(settings, "media_type"):
-        settings.media_type = "IMAGE"
-    settings.file_format = fmt
+    from .compat import set_output_format  # imports bpy: only once a render is asked for
+    set_output_format(settings, "OPEN_EXR" if fmt == "EXR" else fmt)
 
 
 def main(argv=None) -> int:

@@ -1,19 +1,32 @@
 #!/usr/bin/env bash
-# Build installable Blender extension zips (one per platform) into dist/.
-# Stages restir_engine/ with the root blender_manifest.toml (the source of truth) and the embreex
-# wheels from PyPI, then runs Blender's own extension builder (blender_ext.py from the bpy wheel).
+# Build installable Blender extension zips (one per platform) into dist/, for Blender 4.2 to 5.2 LTS: the embreex
+# wheels for Python 3.11 (Blender 4.2-5.0) and 3.13 (Blender 5.1+) of every platform are bundled.
+# Stages restir_engine/ with the root blender_manifest.toml (the source of truth) and the wheels, then runs
+# Blender's own extension builder (blender_ext.py from the bpy wheel of the newest venv found).
+# Wheels are taken from the cache folder $WHEEL_CACHE (default .cache/wheels); missing ones are downloaded with pip,
+# and without a network the build stops, naming what is missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/setup_venv.sh
+if scripts/find_python.sh 3.13 >/dev/null; then ver=3.13; else ver=3.11; fi
+venv=$(scripts/setup_venv.sh "$ver")
+cache=${WHEEL_CACHE:-.cache/wheels}
+mkdir -p "$cache"
 stage=dist/stage/restir_engine
 rm -rf dist/stage && mkdir -p "$stage/wheels"
 cp -r restir_engine/. "$stage/"
 find "$stage" -name __pycache__ -prune -exec rm -rf {} +
 cp blender_manifest.toml "$stage/"
-for plat in manylinux_2_28_x86_64 win_amd64 macosx_13_0_arm64 macosx_13_0_x86_64; do
-  .venv/bin/python -m pip download --quiet --disable-pip-version-check --no-deps --only-binary=:all: \
-    --python-version 3.11 --platform "$plat" embreex==4.4.0.post1 -d "$stage/wheels"
+# every wheel the manifest lists: from the cache, else downloaded into it (platform and Python from its name)
+for whl in $(grep -o 'embreex-[^"]*\.whl' blender_manifest.toml); do
+  if [ ! -f "$cache/$whl" ]; then
+    IFS=- read -r _name version tag _abi plat <<< "${whl%.whl}"
+    py="${tag:2:1}.${tag:3}"
+    "$venv/bin/python" -m pip download --quiet --disable-pip-version-check --no-deps --only-binary=:all: \
+      --python-version "$py" --platform "${plat##*.}" "embreex==$version" -d "$cache" >&2 || true
+    [ -f "$cache/$whl" ] || { echo "build_extension.sh: $whl is neither in $cache nor downloadable" >&2; exit 1; }
+  fi
+  cp "$cache/$whl" "$stage/wheels/"
 done
-ext=$(find .venv/lib/python3.11/site-packages/bpy -name blender_ext.py | head -1)
-.venv/bin/python "$ext" build --source-dir "$stage" --output-dir dist --split-platforms
+ext=$(find "$venv"/lib/python*/site-packages/bpy -name blender_ext.py | head -1)
+"$venv/bin/python" "$ext" build --source-dir "$stage" --output-dir dist --split-platforms
 ls -1 dist/*.zip

@@ -1,14 +1,27 @@
 #!/usr/bin/env bash
-# Create or reuse .venv with the pinned versions of requirements.txt (re-installs when it changes).
+# Create or reuse a pinned virtualenv (re-installed when its requirements change) and print its folder:
+#   scripts/setup_venv.sh 3.11   -> .venv     from requirements.txt        (bpy 5.0.1, numpy 1.26.4)
+#   scripts/setup_venv.sh 3.13   -> .venv313  from requirements-py313.txt  (bpy 5.2.3 LTS, numpy 2.x)
+# The Python comes from scripts/find_python.sh ($PYTHON overrides it). Default: 3.11.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-PY=${PYTHON:-python3.11}
-command -v "$PY" >/dev/null 2>&1 || PY=python3
-stamp=.venv/.requirements.sha256
-want=$(sha256sum requirements.txt | cut -d' ' -f1)
-if [ ! -x .venv/bin/python ] || [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
-  "$PY" -c 'import sys; sys.exit(0 if sys.version_info[:2] == (3, 11) else "Python 3.11 is required (bpy 5.0.1)")'
-  [ -x .venv/bin/python ] || "$PY" -m venv .venv
-  .venv/bin/python -m pip install --quiet --disable-pip-version-check -r requirements.txt
+ver=${1:-3.11}
+case "$ver" in
+  3.11) venv=.venv; req=requirements.txt ;;
+  3.13) venv=.venv313; req=requirements-py313.txt ;;
+  *) echo "setup_venv.sh: unknown Python version '$ver' (3.11 or 3.13)" >&2; exit 2 ;;
+esac
+stamp=$venv/.requirements.sha256
+want=$(sha256sum "$req" | cut -d' ' -f1)
+if [ ! -x "$venv/bin/python" ] || [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
+  py=${PYTHON:-$(scripts/find_python.sh "$ver" || true)}
+  if [ -z "$py" ]; then
+    echo "setup_venv.sh: Python $ver not found (PATH or pyenv's versions folder)" >&2
+    exit 1
+  fi
+  "$py" -c "import sys; sys.exit(0 if sys.version_info[:2] == tuple(map(int, '$ver'.split('.'))) else 'Python $ver is required')" >&2
+  [ -x "$venv/bin/python" ] || "$py" -m venv "$venv" >&2
+  "$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r "$req" >&2
   echo "$want" > "$stamp"
 fi
+echo "$venv"

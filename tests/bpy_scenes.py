@@ -128,9 +128,18 @@ def _spec_material(name, spec):
     return m
 
 
+# Rough diffuse (Oren–Nayar): Diffuse BSDFs of roughness 0.3 / 0.6 / 1, Principled Diffuse Roughness 0.5 / 1,
+# and a Lambert Diffuse BSDF beside them.
+ROUGH_DIFFUSE_GRID = [[("D", (0.8, 0.5, 0.3), 0.3, {}), ("D", (0.8, 0.5, 0.3), 0.6, {}), ("D", (0.8, 0.5, 0.3), 1.0, {}),
+                       ("P", (0.3, 0.6, 0.8), 0.5, {"Diffuse Roughness": 0.5}),
+                       ("P", (0.3, 0.6, 0.8), 0.5, {"Diffuse Roughness": 1.0}), ("D", (0.8, 0.5, 0.3), 0.0, {})]]
+
+
 def _grid_material(name, kind, color, roughness, extra):
     if kind == "D":
-        return diffuse(name, color)
+        m = diffuse(name, color)
+        m.node_tree.nodes["Diffuse BSDF"].inputs["Roughness"].default_value = roughness
+        return m
     if kind == "G":
         m = bpy.data.materials.new(name)
         enable_nodes(m)

@@ -29,6 +29,22 @@ def test_manifest_wheels_match_the_pinned_embreex():
         pinned = next(line.split("==")[1].strip() for line in f if line.startswith("embreex=="))
     assert manifest["wheels"] and all(f"embreex-{pinned}-" in w for w in manifest["wheels"])
     assert "numpy" not in " ".join(manifest["wheels"])  # Blender ships numpy
+    # Python 3.11 (Blender 4.2-5.0) and 3.13 (5.1-5.2 LTS) wheels for every platform, and both venvs pin the same
+    for tag in ("cp311", "cp313"):
+        for plat in ("manylinux", "win_amd64", "macosx_13_0_arm64", "macosx_13_0_x86_64"):
+            assert any(f"-{tag}-{tag}-" in w and plat in w for w in manifest["wheels"]), (tag, plat)
+    with open(os.path.join(ROOT, "requirements-py313.txt")) as f:
+        assert f"embreex=={pinned}\n" in f.read()
+    assert manifest["blender_version_max"] >= "5.3.0"  # 5.2 LTS installs
+
+
+def test_license_file_matches_the_manifest():
+    with open(os.path.join(ROOT, "blender_manifest.toml"), "rb") as f:
+        manifest = tomllib.load(f)
+    assert manifest["license"] == ["SPDX:GPL-3.0-or-later"]
+    with open(os.path.join(ROOT, "LICENSE")) as f:
+        head = f.read(300)
+    assert "GNU GENERAL PUBLIC LICENSE" in head and "Version 3" in head
 
 
 def test_core_never_imports_bpy():

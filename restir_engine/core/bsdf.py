@@ -59,8 +59,8 @@ def multiscatter_fresnel(fss: np.ndarray, e_avg: np.ndarray) -> np.ndarray:
 PARAM_ROWS = {"diffuse": slice(0, 3), "a_m": slice(3, 6), "b_m": slice(6, 9), "d_m": slice(9, 12),
               "fm": slice(12, 15), "a_d": slice(15, 18), "c_d": slice(18, 21), "fd": slice(21, 24),
               "msd": slice(24, 27), "diel_f0": slice(27, 30), "alpha": 30, "eta2m1": 31, "f0r": 32, "p_spec": 33,
-              "spec_on": 34, "metal": 35, "diel": 36}
-PARAM_WIDTH = 37
+              "spec_on": 34, "metal": 35, "diel": 36, "on_a": 37, "on_b": 38, "on_ems": slice(39, 42)}
+PARAM_WIDTH = 42
 #: The rows that scale with a lobe's weight (Mix/Add components: core/mix.py)
 WEIGHT_ROWS = (slice(0, 12), slice(15, 21))
 
@@ -76,7 +76,9 @@ class SurfaceParams:
       msd (3)        ms - fd: the dielectric layer's albedo is (1 - (1 - E) msd) · mix(f0t, 1, S)
       diel_f0 (3)    f0t = f0 · Specular Tint (0 without a dielectric lobe)
       alpha, eta2m1 = η² - 1, f0r = f0 (untinted), p_spec (probability of sampling a specular lobe), spec_on (1
-      where a specular lobe exists), metal, diel (1 where that lobe exists)."""
+      where a specular lobe exists), metal, diel (1 where that lobe exists)
+      on_a, on_b, on_ems (3)  the diffuse lobe's energy-preserving Oren–Nayar (Cycles 4.3+; Lambert: 1/π, 0, 0):
+                     f_d = diffuse · layer · (a + b t + Ems (1 - E(cos θo)) (1 - E(cos θi))), see :func:`oren_nayar_E`."""
 
     __slots__ = ("block",)
 
@@ -108,10 +110,12 @@ class SurfaceParams:
             self.block[rows] *= factor
 
     @staticmethod
-    def from_material(base, metallic, roughness, f0_d, spec_tint=None, metal_f90=None, multiscatter=None):
+    def from_material(base, metallic, roughness, f0_d, spec_tint=None, metal_f90=None, multiscatter=None,
+                      diffuse_roughness=None):
         """From base colours (m, 3) (scene-linear RGB, as the material table stores them), metallic, roughness,
         the dielectric f0 (m,) (IOR and Specular IOR Level applied; 0 = no dielectric lobe), and optionally the
-        Specular Tint (m, 3) (white), metal_f90 (m,) (1) and multiscatter (m,) (1)."""
+        Specular Tint (m, 3) (white), metal_f90 (m,) (1), multiscatter (m,) (1) and the diffuse roughness (m,) (0:
+        Lambert)."""
         m = len(metallic)
         base = np.maximum(np.asarray(base, np.float32), 0).T
         met = np.clip(np.asarray(metallic, np.float32), 0, 1)
@@ -161,6 +165,16 @@ class SurfaceParams:
         b[PARAM_ROWS["spec_on"]] = metal | (diel_w > 0)
         b[PARAM_ROWS["metal"]] = metal
         b[PARAM_ROWS["diel"]] = diel_w > 0
+        sigma = np.zeros(m, np.float32) if diffuse_roughness is None else np.clip(diffuse_roughness, 0, 1)
+        sigma = np.where(sigma < 1e-5, 0.0, sigma)
+        on_a = 1.0 / (np.pi + sigma * (np.pi / 2 - 2.0 / 3.0))
+        on_b = sigma * on_a
+        e_avg_on = on_a * np.pi + ((2 * np.pi - 5.6) / 3.0) * on_b
+        albedo = np.clip(base, 0, 1)
+        b[PARAM_ROWS["on_a"]] = on_a
+        b[PARAM_ROWS["on_b"]] = on_b
+        b[PARAM_ROWS["on_ems"]] = (albedo * albedo * (e_avg_on / np.maximum(1 - e_avg_on, 1e-12)) / np.pi
+                                   / (1 - albedo * (1 - e_avg_on))) * (on_b > 0)
         return out
 
     @staticmethod
@@ -168,9 +182,11 @@ class SurfaceParams:
         """Parameters of materials ``idx`` (all when None) of a scene.MaterialTable, with ``base`` (k, 3) instead
         of their base colours when given (textures)."""
         sel = slice(None) if idx is None else idx
+        dr = getattr(mats, "diffuse_roughness", None)
         return SurfaceParams.from_material(mats.base_color[sel] if base is None else base, mats.metallic[sel],
                                            mats.roughness[sel], mats.f0[sel], mats.specular_tint[sel],
-                                           mats.metal_f90[sel], mats.multiscatter[sel])
+                                           mats.metal_f90[sel], mats.multiscatter[sel],
+                                           None if dr is None else dr[sel])
 
 
 def view_albedo(p: SurfaceParams, wo: np.ndarray) -> np.ndarray:
@@ -210,6 +226,9 @@ class ViewTerms:
     f0r: np.ndarray | None = None  # (n,) untinted dielectric f0 (with spec_c)
     bump_n: np.ndarray | None = None   # (3, n) normal-mapped surfaces: the unmapped normal in the local frame
     bump_a2: np.ndarray | None = None  # (n,) and its bump-shadowing roughness (:func:`bump_factor`)
+    on_a: np.ndarray | None = None     # (n,) Oren–Nayar where some surface has a diffuse roughness (else None):
+    on_b: np.ndarray | None = None     # a, b and the multiple-scattering colour Ems (1 - E(cos θo)) (3, n)
+    on_ms: np.ndarray | None = None
     spec_n: np.ndarray | None = None   # (3, n) the specular lobes' normal in the local frame (surface.py), or None
     co_s: np.ndarray | None = None     # (n,) cos θo about spec_n
 
@@ -231,7 +250,7 @@ class ViewTerms:
         has_diel = bool(p.diel.any())
         if not (has_metal or has_diel):
             return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha * alpha, lam_o, co, p.spec_on,
-                             p.p_spec, False)
+                             p.p_spec, False)._oren_nayar(p, co)
         e = view_albedo(p, wo) if albedo is None else albedo
         one_e = 1.0 - e
         miss = one_e / e
@@ -262,7 +281,31 @@ class ViewTerms:
             np.clip(w, 0.0, 1.0, out=w)                 # 1 where there is no dielectric layer (f0t = 0, S = 0)
             kd *= w
         return ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha * alpha, lam_o, co, p.spec_on,
-                         p.p_spec, True, p.f0r if has_diel else None)
+                         p.p_spec, True, p.f0r if has_diel else None)._oren_nayar(p, co)
+
+    def _oren_nayar(self, p: SurfaceParams, co: np.ndarray) -> "ViewTerms":
+        """Attach the Oren–Nayar terms where some surface has a diffuse roughness: f_d = kd π (a + b t + ms (1 - E_i))
+        (kd stays the Lambert lobe, which the ReSTIR targets and the GI diffuse split use as its approximation)."""
+        on_b = p.on_b
+        if not on_b.any():
+            return self
+        self.on_a, self.on_b = p.on_a * np.float32(np.pi), on_b * np.float32(np.pi)
+        self.on_ms = p.on_ems * (1.0 - oren_nayar_E(p.on_a, on_b, np.maximum(co, 0))) * np.float32(np.pi)
+        return self
+
+
+def oren_nayar_G(c: np.ndarray) -> np.ndarray:
+    """The Oren–Nayar albedo integral's angular part at cos θ = c (Cycles' closed form, Taylor near 0)."""
+    c = np.clip(c, 0.0, 1.0)
+    s = np.sqrt(np.maximum(1.0 - c * c, 0.0))
+    theta = np.arccos(c)
+    g = s * (theta - 2.0 / 3.0 - s * c) + (2.0 / 3.0) * (s / np.maximum(c, 1e-6)) * (1.0 - s * s * s)
+    return np.where(c < 1e-6, (np.pi / 2 - 2.0 / 3.0) - c, g).astype(np.float32)
+
+
+def oren_nayar_E(a, b, c):
+    """Directional albedo a π + b G(c) of the single-scattering Oren–Nayar lobe (a white surface)."""
+    return a * np.float32(np.pi) + b * oren_nayar_G(c)
 
 
 def view_terms(surf) -> ViewTerms:
@@ -303,6 +346,13 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     ci = wi[2]
     valid = (co > 0) & (ci > 0)
     kd = v.kd
+    if v.on_b is not None:  # Oren–Nayar relative to Lambert (on_a, on_b, on_ms carry the factor π)
+        nl = np.maximum(ci, 0)
+        nv = np.maximum(co, 0)
+        t = dot(wo, wi) - nl * nv
+        t = np.where(t > 0, t / (np.maximum(nl, nv) + np.float32(1e-30)), t)
+        e_l = oren_nayar_E(v.on_a, v.on_b, nl) * np.float32(1.0 / np.pi)
+        kd = kd * (v.on_a + v.on_b * t) + kd * v.on_ms * (1.0 - e_l)
     if v.bump_n is not None:
         ok, g = bump_factor(v, wi)
         valid = valid & (ok > 0)

@@ -63,6 +63,8 @@ class MaterialTable:
     mix_weight  (k,) constant weight of the component (product of the Mix factors on its path; Add: 1)
     mix_tex     (k,) int32  texture index whose value t (first channel) further weighs it, -1 = none
     mix_sign    (k,) +1: weight x t, -1: weight x (1 - t)
+    diffuse_roughness (m,) Oren–Nayar σ of the diffuse lobe (Principled Diffuse Roughness, Diffuse BSDF Roughness;
+                        0 = Lambert)
     normal_tex  (m,) int32  tangent-space normal map texture (a Normal Map node on the BSDF's Normal), -1 = none
     normal_strength (m,) its Strength
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
@@ -83,6 +85,7 @@ class MaterialTable:
     base_tex: np.ndarray
     emit_tex: np.ndarray
     two_sided_emission: np.ndarray
+    diffuse_roughness: np.ndarray = None
     normal_tex: np.ndarray = None
     normal_strength: np.ndarray = None
     alpha: np.ndarray = None
@@ -113,6 +116,7 @@ class MaterialTable:
             alpha=col("alpha", 1.0), alpha_tex=col("alpha_tex", -1, np.int32), alpha_sign=col("alpha_sign", 1.0),
             mix_normalize=col("mix_normalize", False, bool),
             normal_tex=col("normal_tex", -1, np.int32), normal_strength=col("normal_strength", 1.0),
+            diffuse_roughness=col("diffuse_roughness", 0.0),
             **_mix_arrays(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
 

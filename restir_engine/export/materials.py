@@ -8,10 +8,10 @@ naming the material and the reason.
 """
 from __future__ import annotations
 
-import bpy
 import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
+from ..compat import uses_nodes
 from ..core.textures import NearestImage
 
 MAGENTA = (1.0, 0.0, 1.0)
@@ -20,12 +20,6 @@ MAGENTA = (1.0, 0.0, 1.0)
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
 
-
-def uses_nodes(idblock) -> bool:
-    """Whether a material/world is defined by its node tree (always, from Blender 5.0 on)."""
-    if idblock.node_tree is None:
-        return False
-    return True if bpy.app.version >= (5, 0, 0) else bool(idblock.use_nodes)
 
 
 class MaterialRegistry:
@@ -142,6 +136,8 @@ class MaterialRegistry:
             for name in ("Transmission Weight", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
                 if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
                     self._warn(material, f"Principled '{name}' is not supported and was ignored")
+            if "Diffuse Roughness" in inp:
+                row["diffuse_roughness"] = float(np.clip(self._float_input(material, inp["Diffuse Roughness"]), 0, 1))
             if "Alpha" in inp:
                 self._alpha(material, inp["Alpha"], row)
             self._normal(material, node, row)
@@ -154,8 +150,7 @@ class MaterialRegistry:
         if t == "BSDF_DIFFUSE":
             row = {"f0": 0.0, "metallic": 0.0}
             row["base_color"] = self._color_input(material, node.inputs["Color"], "base_tex", row, (0.8, 0.8, 0.8))
-            if self._float_input(material, node.inputs["Roughness"]) > 0:
-                self._warn(material, "Diffuse BSDF roughness (Oren-Nayar) is approximated as Lambertian")
+            row["diffuse_roughness"] = float(np.clip(self._float_input(material, node.inputs["Roughness"]), 0, 1))
             self._normal(material, node, row)
             return row
         if t == "EMISSION":

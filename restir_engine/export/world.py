@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from .materials import MaterialRegistry, uses_nodes
+from ..compat import uses_nodes
+from .materials import MaterialRegistry
 
 
 def export_world(scene, warnings: list):

@@ -8,6 +8,8 @@ import time
 import bpy
 import numpy as np
 
+from restir_engine.compat import set_output_format
+
 
 def configure_cycles(scene, samples: int, bounces: int, seed: int = 0):
     """Cycles as ground truth: CPU, no clamping, light threshold 0, box filter of one pixel (the same
@@ -63,10 +65,7 @@ def read_exr(path: str) -> dict:
 def use_multilayer_exr(scene) -> None:
     """Write renders of ``scene`` as 32-bit multilayer EXR (every pass; Blender 4.x and 5.x settings)."""
     settings = scene.render.image_settings
-    if hasattr(settings, "media_type"):
-        settings.media_type = "MULTI_LAYER_IMAGE"
-    else:
-        settings.file_format = "OPEN_EXR_MULTILAYER"
+    set_output_format(settings, "OPEN_EXR_MULTILAYER")
     settings.color_depth = "32"
 
 
