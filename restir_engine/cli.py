@@ -1,8 +1,8 @@
 """Render a .blend with the ReSTIR engine through the ``bpy`` module, like
 ``blender -b FILE.blend -E RESTIR [-o PATH] [-F FORMAT] [-s START] [-e END] (-a | -f N)``.
 
-Usage: python -m restir_engine FILE.blend [-o PATH] [-F FORMAT] [-s N] [-e N] (-a | -f N)
-       [--samples N] [--seed N] [--max-bounces N] [--percentage P]
+Usage: python -m restir_engine FILE.blend [-E ENGINE] [--python-expr EXPR] [-o PATH] [-F FORMAT] [-s N] [-e N]
+       (-a | -f N) [--samples N] [--seed N] [--max-bounces N] [--percentage P]
 Output path, format and frame range come from the file unless overridden. A bad argument gets one line
 ``error: ...`` and exit status 2; an unreadable file, an unknown engine or a failed render exit status 1.
 """
@@ -48,7 +48,9 @@ def parse(argv):
     p.add_argument("--seed", type=_at_least(0))
     p.add_argument("--max-bounces", type=_at_least(0))
     p.add_argument("--percentage", type=_at_least(1), help="resolution percentage")
-    p.add_argument("--engine", default="RESTIR", help="render engine id (CYCLES for a reference render)")
+    p.add_argument("-E", "--engine", default="RESTIR", help="render engine id (CYCLES for a reference render)")
+    p.add_argument("--python-expr", action="append", default=[],
+                   help="Python run after the file is loaded, before rendering (as blender's --python-expr)")
     args = p.parse_args(argv)
     if args.frame_start is not None and args.frame_end is not None and args.frame_end < args.frame_start:
         p.error(f"frame end {args.frame_end} is before frame start {args.frame_start}")
@@ -78,6 +80,12 @@ def main(argv=None) -> int:
         reason = str(exc).strip().splitlines()[-1].split("failed: ")[-1]
         print(f"error: cannot read {args.blend}: {reason}", file=sys.stderr)
         return 1
+    for expr in args.python_expr:
+        try:
+            exec(compile(expr, "<--python-expr>", "exec"), {"bpy": bpy, "__name__": "__main__"})
+        except Exception as exc:  # noqa: BLE001 - the user's expression; report it in one line
+            print(f"error: --python-expr failed: {type(exc).__name__}: {exc}", file=sys.stderr)
+            return 1
     scene = bpy.context.scene
     try:
         scene.render.engine = args.engine
