@@ -66,6 +66,13 @@ def test_chunked_flamenco_job_equals_sequential_render(addon, tmp_path):
         assert np.array_equal(seq, job), f"frame {f} differs from the sequential render"
         moved += f > 1 and not np.array_equal(seq, read_exr(str(tmp_path / "seq" / "f_0001.exr"))["Combined"])
     assert moved == FRAMES - 1  # the frames are not all alike: the comparison can see a change
+    # and it sees missing history: the second chunk without preroll differs from the sequential frames
+    (late,) = [t for t in compile_job({"blendfile": blend, "frames": f"1-{FRAMES}", "chunk_size": 4, "preroll": 0,
+                                       "render_output_path": str(tmp_path / "cold" / "f_####"),
+                                       "format": "OPEN_EXR_MULTILAYER"}) if t["name"] == "render-5-6"]
+    run_cli(blend, late["commands"][0]["params"]["args"])
+    assert not np.array_equal(read_exr(str(tmp_path / "seq" / "f_0005.exr"))["Combined"],
+                              read_exr(str(tmp_path / "cold" / "f_0005.exr"))["Combined"])
 
 
 def test_job_preroll_setting_is_capped_and_starts_at_zero():
