@@ -9,9 +9,11 @@ from __future__ import annotations
 def register():
     import bpy
 
-    from . import engine, presets, properties, ui
+    from . import denoise, engine, presets, properties, ui
     properties.register()
     presets.register()
+    for cls in denoise.CLASSES:
+        bpy.utils.register_class(cls)
     bpy.utils.register_class(engine.RestirRenderEngine)
     ui.register()
 
@@ -19,8 +21,10 @@ def register():
 def unregister():
     import bpy
 
-    from . import engine, presets, properties, ui
+    from . import denoise, engine, presets, properties, ui
     ui.unregister()
     bpy.utils.unregister_class(engine.RestirRenderEngine)
+    for cls in reversed(denoise.CLASSES):
+        bpy.utils.unregister_class(cls)
     presets.unregister()
     properties.unregister()

@@ -37,3 +37,31 @@ def set_output_format(settings, fmt: str) -> None:
     if has_media:
         settings.media_type = "IMAGE"
     settings.file_format = fmt
+
+
+def compositor_tree(scene, create: bool = True):
+    """The scene's compositor node tree (a node group assigned to the scene from Blender 5.0 on, the scene's own
+    tree with ``use_nodes`` before), created when missing and ``create``; None otherwise."""
+    if hasattr(scene, "compositing_node_group"):
+        tree = scene.compositing_node_group
+        if tree is None and create:
+            tree = bpy.data.node_groups.new(f"{scene.name} Compositing", "CompositorNodeTree")
+            scene.compositing_node_group = tree
+        return tree
+    if create:
+        scene.use_nodes = True
+    return scene.node_tree
+
+
+def compositor_output(tree):
+    """The node whose input is the composited image: the Composite node (Blender 4.x) or the tree's Group Output
+    with an "Image" socket (Blender 5.x), created when missing. Returns (node, its image input socket)."""
+    if hasattr(bpy.types, "CompositorNodeComposite"):
+        node = next((n for n in tree.nodes if n.bl_idname == "CompositorNodeComposite"), None) or \
+            tree.nodes.new("CompositorNodeComposite")
+        return node, node.inputs[0]
+    if not any(i.in_out == "OUTPUT" and i.name == "Image" for i in tree.interface.items_tree
+               if getattr(i, "item_type", "SOCKET") == "SOCKET"):
+        tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+    node = next((n for n in tree.nodes if n.bl_idname == "NodeGroupOutput"), None) or tree.nodes.new("NodeGroupOutput")
+    return node, node.inputs["Image"]

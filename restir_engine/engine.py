@@ -51,7 +51,8 @@ def with_data_passes(settings: RenderSettings, view_layer) -> RenderSettings:
     """``settings`` computing Depth/Normal/Vector only when the view layer writes one of them."""
     wanted = bool(view_layer.use_pass_z or view_layer.use_pass_normal or view_layer.use_pass_vector)
     reservoirs = bool(view_layer.restir.use_pass_reservoir_m or view_layer.restir.use_pass_reservoir_ucw)
-    return replace(settings, data_passes=wanted, reservoir_passes=reservoirs)
+    return replace(settings, data_passes=wanted, reservoir_passes=reservoirs,
+                   denoise_data=bool(view_layer.restir.use_pass_denoising_data))
 
 
 def scene_problems(core_scene, light_count: int) -> list[str]:

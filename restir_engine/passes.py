@@ -30,6 +30,8 @@ PASSES = (
      "GI Reservoir M"),
     ("GI Reservoir UCW", "X", "VALUE", lambda sc, vl: vl.restir.use_pass_gi_reservoir_ucw and has_gi_reservoirs(sc),
      "GI Reservoir UCW"),
+    ("Denoising Albedo", "RGB", "COLOR", lambda sc, vl: vl.restir.use_pass_denoising_data, "Denoising Albedo"),
+    ("Denoising Normal", "XYZ", "VECTOR", lambda sc, vl: vl.restir.use_pass_denoising_data, "Denoising Normal"),
 )
 
 

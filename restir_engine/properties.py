@@ -18,6 +18,11 @@ def _update_passes(self, context):
         view_layer.update_render_passes()
 
 
+def _denoise_option(settings, context):
+    from .denoise import update_option
+    update_option(settings, context)
+
+
 class RestirSceneSettings(bpy.types.PropertyGroup):
     integrator: EnumProperty(
         name="Integrator",
@@ -107,6 +112,10 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
     boiling_threshold: FloatProperty(
         name="Threshold", description="A reservoir is emptied when its contribution exceeds this many times its "
         "block's mean (lower filters more)", default=BOILING_THRESHOLD, min=1.5, soft_max=100.0)
+    use_denoising: BoolProperty(name="Denoise", description="Denoise F12 and animation frames in the compositor: "
+                                "Blender's Denoise node (Open Image Denoise) on Combined with the Denoising Albedo "
+                                "and Normal passes (turning this on sets the nodes and passes up)", default=False,
+                                update=_denoise_option)
     samples: IntProperty(name="Samples", description="Iterations averaged per frame", default=16, min=1,
                          soft_max=4096)
     seed: IntProperty(name="Seed", description="Noise pattern; different seeds give independent noise", default=0,
@@ -161,6 +170,9 @@ class RestirViewLayerSettings(bpy.types.PropertyGroup):
     use_pass_gi_reservoir_ucw: BoolProperty(name="GI Reservoir UCW", description="Unbiased contribution weight W "
                                             "(m²) of the shaded ReSTIR GI reservoir (Indirect Method ReSTIR GI)",
                                             default=False, update=_update_passes)
+    use_pass_denoising_data: BoolProperty(name="Denoising Data", description="Denoising Albedo and Denoising Normal "
+                                          "(first hit's albedo and camera-space normal, averaged over the samples), "
+                                          "for the compositor's Denoise node", default=False, update=_update_passes)
 
 
 CLASSES = (RestirSceneSettings, RestirViewLayerSettings)

@@ -34,7 +34,7 @@ from . import pathtracer
 from .accel import in_worker, pool, thread_count
 from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
-from .bsdf import luminance_rows
+from .bsdf import denoising_albedo, luminance_rows
 from .context_cache import context_for, fingerprint
 from .direct_choice import choose_direct_method
 from .light_blocks import BlockLightTiles
@@ -86,6 +86,7 @@ class RenderSettings:
     light_sampler: str = "SPATIAL"  # light tiles: "SPATIAL" (per-block importance, light_blocks.py) or "POWER"
     film_transparent: bool = False
     data_passes: bool = True  # Depth, Normal and Vector (one more ray per pixel and frame); off when not written
+    denoise_data: bool = False  # Denoising Albedo / Normal: first-hit albedo and camera-space normal, per sample
     tile_pixels: int = CHUNK_PIXELS  # pixels per chunk of work (smaller: finer progress and cancellation)
     coverage_samples: int = 0  # camera rays per pixel for the emission seen directly: 1, 4, 9, 16 ...; 0 = automatic
     indirect_method: str = "PATH"  # with integrator RESTIR: "OFF" (no bounces), "PATH" or "RESTIR_GI" (restir/gi.py)
@@ -270,6 +271,8 @@ class FrameRenderer:
                     "res_m": _BUFFERS.zeros((h, w)), "res_w": _BUFFERS.zeros((h, w))}
         if self.gi is not None:
             self.acc["gi_m"], self.acc["gi_w"] = _BUFFERS.zeros((h, w)), _BUFFERS.zeros((h, w))
+        if self.settings.denoise_data:
+            self.acc["albedo"], self.acc["dnormal"] = _BUFFERS.zeros((h, w, 3)), _BUFFERS.zeros((h, w, 3))
         self.samples_done = 0
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
         self.gi_skipped = 0  # sample passes that kept path-traced indirect light (GI_MIN_SHARE)
@@ -640,7 +643,12 @@ class FrameRenderer:
             if c.gi_res is not None:
                 flat["gi_m"][pix] += c.gi_res.M
                 flat["gi_w"][pix] += c.gi_res.W
+            if "albedo" in flat and len(hit):
+                surf = c.hits.surf
+                flat["albedo"][pix] += np.ascontiguousarray(denoising_albedo(surf).T)
+                flat["dnormal"][pix] += np.ascontiguousarray((world_to_cam @ surf.ns).T)
 
+        world_to_cam = np.ascontiguousarray(self.ctx.scene.camera.cam_to_world[:3, :3].T, dtype=np.float32)
         self._map(add, chunks, stop)
 
     def combined(self) -> np.ndarray:
@@ -671,6 +679,9 @@ class FrameRenderer:
         if self.gi is not None:
             jobs["GI Reservoir M"] = lambda: mean("gi_m")
             jobs["GI Reservoir UCW"] = lambda: mean("gi_w")
+        if "albedo" in self.acc:
+            jobs["Denoising Albedo"] = lambda: mean("albedo")
+            jobs["Denoising Normal"] = lambda: mean("dnormal")
         run = map if in_worker() else pool().map  # one pass per pool task (inline inside a worker)
         out = dict(zip(jobs, run(lambda job: job(), jobs.values())))
         if self.settings.data_passes:

@@ -164,6 +164,20 @@ def _last_choices(scene):
     return LAST_CHOICES.get(scene.name)
 
 
+class RESTIR_PT_sampling_denoising(RestirPanel, bpy.types.Panel):
+    bl_label = "Denoising"
+    bl_parent_id = "RESTIR_PT_sampling"
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.restir, "use_denoising", text="")
+
+    def draw(self, context):
+        layout = self.split_layout()
+        layout.label(text="Compositor: Denoise node on Combined with")
+        layout.label(text="Denoising Albedo and Normal")
+        layout.operator("restir.set_up_denoising")
+
+
 class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):
     bl_label = "Light Paths"
 
@@ -199,9 +213,12 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.active = sc.integrator == "RESTIR" and sc.indirect_method == "RESTIR_GI" and sc.max_bounces > 0
         col.prop(vl.restir, "use_pass_gi_reservoir_m")
         col.prop(vl.restir, "use_pass_gi_reservoir_ucw")
+        col = layout.column(heading="Denoising", align=True)
+        col.prop(vl.restir, "use_pass_denoising_data")
 
 
-PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_indirect, RESTIR_PT_light_paths, RESTIR_PT_passes)
+PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_indirect, RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths,
+          RESTIR_PT_passes)
 
 
 def _standard_panels():
