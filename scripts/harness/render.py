@@ -14,7 +14,12 @@ from restir_engine.compat import set_output_format
 def configure_cycles(scene, samples: int, bounces: int, seed: int = 0):
     """Cycles as ground truth: CPU, no clamping, light threshold 0, box filter of one pixel (the same
     pixel filter as ours), no denoising, no adaptive sampling, no glossy blur, true sphere lights."""
-    scene.render.engine = "CYCLES"
+    try:
+        scene.render.engine = "CYCLES"
+    except TypeError:  # Cycles' add-on unregistered (seen once on bpy 5.2.3 in a long test session): enable it
+        import addon_utils
+        addon_utils.enable("cycles", default_set=True)
+        scene.render.engine = "CYCLES"
     c = scene.cycles
     c.device = "CPU"
     c.samples = samples
