@@ -38,12 +38,18 @@ def set_up(scene) -> None:
 
 
 def remove(scene) -> None:
-    """Take the denoise nodes out of the compositor (the passes stay as they are)."""
+    """Take the Denoise node out of the compositor: the Render Layers image goes straight to the output again (an
+    output left unconnected would make Blender write black frames). The passes stay as they are."""
     tree = compositor_tree(scene, create=False)
     if tree is None:
         return
-    for n in [n for n in tree.nodes if n.name.startswith(NODE_PREFIX)]:
-        tree.nodes.remove(n)
+    den = tree.nodes.get(NODE_PREFIX)
+    if den is not None:
+        tree.nodes.remove(den)
+    layers = tree.nodes.get(f"{NODE_PREFIX} Layers")
+    if layers is not None:
+        _out, socket = compositor_output(tree)
+        tree.links.new(layers.outputs["Image"], socket)
 
 
 def update_option(settings, context) -> None:

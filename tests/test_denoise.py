@@ -71,6 +71,6 @@ def test_denoise_option_sets_up_the_compositor_and_cuts_the_error(addon, tmp_pat
     e_raw, e_den = rel_mse(raw, ref), rel_mse(den, ref)
     print(f"DENOISE raw {e_raw:.5f} denoised {e_den:.5f} ratio {e_raw / e_den:.2f}")
     assert e_raw > 5 * e_den, f"raw relMSE {e_raw:.4f}, denoised {e_den:.4f}: ratio {e_raw / e_den:.1f} (target 5)"
-    scene.restir.use_denoising = False  # the option also takes the nodes out again
+    scene.restir.use_denoising = False  # the option also takes the Denoise node out again: the raw image returns
     again = render_exr(scene, str(tmp_path / "again.exr"))
-    assert rel_mse(again, ref) > 2 * e_den
+    np.testing.assert_allclose(again, raw, rtol=1e-5, atol=1e-6)
