@@ -137,16 +137,20 @@ def image_cells(size, n=4):
     return cells
 
 
+def path_vs_cycles_cells(build, bounces, size=(96, 64)):
+    """Per-seed means of the 4 x 4 image cells of ``build(size)`` rendered by our path tracer (64 samples) and by
+    Cycles (128): ((REPS, 16), (REPS, 16))."""
+    cells = image_cells(size)
+    ours = render_reps(lambda: build(size), "RESTIR", bounces, 64, integrator="PATH")
+    ref = render_reps(lambda: build(size), "CYCLES", bounces, 128)
+    return cell_means(ours, cells), cell_means(ref, cells)
+
+
 def test_alpha_cutouts_match_cycles(addon):
     """Principled Alpha 0.4 and a Mix(Transparent, Diffuse) whose factor is a checker image (Closest
     interpolation), seen by the camera in front of a wall and casting shadows: camera, shadow and (with the wall
     behind) every ray passes the transparent points as Cycles' transparency does, per 4 x 4 image cell."""
-    size = (96, 64)
-    cells = image_cells(size)
-    ours = render_reps(lambda: alpha_scene(size), "RESTIR", 0, 64, integrator="PATH")
-    ref = render_reps(lambda: alpha_scene(size), "CYCLES", 0, 128)
-    assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
-                       power=range(16))
+    assert_cells_match(*path_vs_cycles_cells(alpha_scene, 0), [f"cell {k}" for k in range(16)], power=range(16))
 
 
 @pytest.mark.parametrize("kind,bounces", [("IMAGE", 0), ("CONSTANT", 0), ("IMAGE", 3)])
@@ -157,12 +161,8 @@ def test_world_light_matches_cycles(addon, kind, bounces):
     where ours reads ~1.2 % low (z ≈ 3 in 24 seeds; Cycles bends a smooth normal at silhouettes where we bend the
     view vector, docs/CONVENTIONS.md), inside the bound but too close to it for that power."""
     from bpy_scenes import world_scene
-    size = (96, 64)
-    cells = image_cells(size)
-    ours = render_reps(lambda: world_scene(kind, size, rotation_z=0.8), "RESTIR", bounces, 64, integrator="PATH")
-    ref = render_reps(lambda: world_scene(kind, size, rotation_z=0.8), "CYCLES", bounces, 128)
-    assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
-                       power=[4, 5, 6] + list(range(8, 16)))
+    cells = path_vs_cycles_cells(lambda size: world_scene(kind, size, rotation_z=0.8), bounces)
+    assert_cells_match(*cells, [f"cell {k}" for k in range(16)], power=[4, 5, 6] + list(range(8, 16)))
 
 
 def test_normal_maps_match_cycles(addon):
@@ -173,11 +173,7 @@ def test_normal_maps_match_cycles(addon):
     read 2-9 % bright; on a normal-mapped sphere, which this test leaves out, one cell still reads 0.65 % high,
     docs/RESULTS.md.)"""
     from bpy_scenes import normal_map_scene
-    size = (96, 64)
-    cells = image_cells(size)
-    ours = render_reps(lambda: normal_map_scene(size), "RESTIR", 0, 64, integrator="PATH")
-    ref = render_reps(lambda: normal_map_scene(size), "CYCLES", 0, 128)
-    assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
+    assert_cells_match(*path_vs_cycles_cells(normal_map_scene, 0), [f"cell {k}" for k in range(16)],
                        power=range(16))
 
 

@@ -355,6 +355,30 @@ def fresnel_exact(c, eta2m1):
     return a
 
 
+def half_vector_terms(wdw: np.ndarray, co, ci, alpha2):
+    """cos θh, ωo·h and the GGX D(h) of unit directions with ωo·ωi = ``wdw`` (overwritten: it becomes ωo·h),
+    cos θo ``co`` and cos θi ``ci`` about the lobe's normal, without forming h: |ωo + ωi|² = 2 + 2 ωo·ωi,
+    cos θh = (cos θo + cos θi)/|ωo + ωi|, ωo·h = (1 + ωo·ωi)/|ωo + ωi|. Arrays broadcast (the target's
+    candidates x surfaces blocks); float32 in place where it can."""
+    hinv = 2.0 + 2.0 * wdw
+    np.maximum(hinv, np.float32(1e-24), out=hinv)
+    np.sqrt(hinv, out=hinv)
+    np.divide(np.float32(1.0), hinv, out=hinv)
+    cos_h = (co + ci) * hinv
+    np.clip(cos_h, 0.0, 1.0, out=cos_h)
+    odh = wdw
+    odh += 1.0
+    odh *= hinv
+    np.clip(odh, 1e-6, 1.0, out=odh)
+    den = cos_h * cos_h
+    den *= alpha2 - 1.0
+    den += 1.0
+    d = den * den
+    d *= np.float32(np.pi)
+    np.divide(alpha2, d, out=d)
+    return cos_h, odh, d
+
+
 def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     """f (3, n) and pdf (n,) (solid angle) of unit directions wi (3, n) at surfaces with view terms ``v``. The half
     vector h = (wo + wi)/|wo + wi| enters only through cos θ_h = (cos θ_o + cos θ_i)/|wo + wi| and
@@ -382,23 +406,7 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         co = v.co_s
         ci = dot(wi, v.spec_n)
         valid_s = valid & (ci > 0)
-    wdw = dot(wo, wi)
-    hinv = 2.0 + 2.0 * wdw
-    np.maximum(hinv, np.float32(1e-24), out=hinv)
-    np.sqrt(hinv, out=hinv)
-    np.divide(np.float32(1.0), hinv, out=hinv)
-    cos_h = (co + ci) * hinv
-    np.clip(cos_h, 0, 1, out=cos_h)
-    odh = wdw
-    odh += 1.0
-    odh *= hinv
-    np.clip(odh, 1e-6, 1.0, out=odh)
-    den = cos_h * cos_h
-    den *= v.alpha2 - 1.0
-    den += 1.0
-    d = den * den
-    d *= np.float32(np.pi)
-    np.divide(v.alpha2, d, out=d)                    # GGX D(h)
+    cos_h, odh, d = half_vector_terms(dot(wo, wi), co, ci, v.alpha2)
     s = 1.0 + v.lam_o + smith_lambda(v.alpha, ci)
     den4 = 4.0 * co * ci
     np.maximum(den4, np.float32(1e-12), out=den4)

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import fresnel_exact, view_terms
+from .bsdf import fresnel_exact, half_vector_terms, view_terms
 from .light_tiles import PackedPoints, light_points
 from .accel import in_worker, pool
 from .lights import spot_factor
@@ -148,22 +148,7 @@ class ShadingTerms:
             wdw += dy * self.wo[1]
             wdw += dz * self.wo[2]
             wdw *= inv                               # ωo·ωi
-            hinv = 2.0 + 2.0 * wdw
-            np.maximum(hinv, np.float32(1e-24), out=hinv)
-            np.sqrt(hinv, out=hinv)
-            np.divide(np.float32(1.0), hinv, out=hinv)
-            cos_h = (self.co + ci) * hinv
-            np.clip(cos_h, 0.0, 1.0, out=cos_h)
-            odh = wdw
-            odh += 1.0
-            odh *= hinv
-            np.clip(odh, 1e-6, 1.0, out=odh)
-            den = cos_h * cos_h
-            den *= self.alpha2 - 1.0
-            den += 1.0
-            dist_d = den * den
-            dist_d *= np.float32(np.pi)
-            np.divide(self.alpha2, dist_d, out=dist_d)  # GGX D(h)
+            cos_h, odh, dist_d = half_vector_terms(wdw, self.co, ci, self.alpha2)
             c2 = ci * ci
             np.clip(c2, 1e-12, 1.0, out=c2)
             tan2 = 1.0 - c2
