@@ -28,7 +28,7 @@ from harness.render import render_blend_passes  # noqa: E402
 from harness.scenes import ensure_blend  # noqa: E402
 
 BOUNCES = 4
-LADDERS = {"cycles": ("CYCLES", {}, (1, 2, 4, 8, 16, 32)),
+LADDERS = {"cycles": ("CYCLES", {}, (1, 2, 4, 8, 16, 32, 64)),
            "ours (defaults)": ("RESTIR", {}, (1, 2, 4, 8, 16, 32)),
            "ours, ReSTIR DI forced": ("RESTIR", {"integrator": "RESTIR", "direct_method": "RESTIR"}, (1, 2, 4, 8))}
 
@@ -67,10 +67,13 @@ def main():
     for key, pts in out["ladders"].items():
         if key == "cycles":
             continue
+        # only where Cycles was measured at that time: interpolate_loglog clamps, and a clamped Cycles error
+        # (its last point) would flatter us beyond the end of its ladder
+        t_max = max(c["seconds"] for c in cyc)
         ratios = [interpolate_loglog([c["seconds"] for c in cyc], [c["rel_mse"] for c in cyc], p["seconds"])
-                  / p["rel_mse"] for p in pts]
+                  / p["rel_mse"] if p["seconds"] <= t_max else None for p in pts]
         out.setdefault("cycles_over_ours", {})[key] = ratios
-        print(f"{key}: Cycles relMSE / ours at equal time " + " ".join(f"{r:.2f}" for r in ratios), flush=True)
+        print(f"{key}: Cycles relMSE / ours at equal time " + " ".join("-" if r is None else f"{r:.2f}" for r in ratios), flush=True)
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "default_cube.json"), "w") as f:
         json.dump(out, f, indent=1)
