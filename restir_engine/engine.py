@@ -65,6 +65,13 @@ def scene_problems(core_scene, light_count: int) -> list[str]:
     return problems
 
 
+def _viewport_pass(context) -> str:
+    """The pass the 3D view shows (View3DShading.restir.render_pass)."""
+    shading = getattr(getattr(context, "space_data", None), "shading", None)
+    settings = getattr(shading, "restir", None)
+    return settings.render_pass if settings is not None else "COMBINED"
+
+
 class RestirRenderEngine(bpy.types.RenderEngine):
     bl_idname = "RESTIR"
     bl_label = "ReSTIR"
@@ -75,6 +82,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._viewport = None
+        self._exporter = None
+        self._viewport_settings_last = None
         self._texture = None
 
     def __del__(self):
@@ -189,59 +198,91 @@ class RestirRenderEngine(bpy.types.RenderEngine):
 
     # -- viewport (Rendered shading) ----------------------------------------------------------
     def view_update(self, context, depsgraph):
-        """Blender's thread: export the scene; the worker thread renders it."""
-        from .viewport import ViewportSession, view_camera
+        """Blender's thread: export what the edit changed (export.incremental); the worker renders it."""
+        from .export.incremental import SceneExporter, update_level
+        from .viewport import ViewportSession
         scene = depsgraph.scene
         if self._viewport is None:
             self._viewport = ViewportSession(self.tag_redraw)
-        w, h = self._view_size(context)
-        space = context.space_data
-        cam = view_camera(context.region_data, w, h, space.clip_start, space.clip_end)
+            self._exporter = SceneExporter()
+        exporter = self._exporter
+        level = update_level(depsgraph.updates) if exporter.last is not None else "FULL"
+        cam, key = self._view(context)
+        settings = self._viewport_settings(scene, context)
+        session = self._viewport
+        session.budget = float(scene.restir.viewport_budget_ms) / 1000.0
+        session.max_samples = int(scene.restir.viewport_samples)
+        if level == "NONE" and settings == self._viewport_settings_last:
+            session.set_view(cam, key)
+            return
         try:
-            core_scene = export_scene(depsgraph, camera=cam)
+            core_scene = exporter.export(depsgraph, cam, level)
         except ExportError as exc:
             self.report({"ERROR"}, str(exc))
             return
-        settings = settings_from_scene(scene)
-        settings.samples = 1
-        settings.data_passes = False  # the viewport shows Combined only
-        settings.tile_pixels = 16384  # small chunks: a stop request is seen within one chunk of one stage
-        self._viewport.set_scene(core_scene, settings)
-        self._viewport.set_view(cam, self._view_key(context, w, h))
-
-    def _view_size(self, context):
-        pixel = max(1, int(self.get_preview_pixel_size(context.scene))) * 2  # half resolution for speed
-        return max(1, context.region.width // pixel), max(1, context.region.height // pixel)
+        self._viewport_settings_last = settings
+        session.set_scene(core_scene, settings)
+        session.set_view(cam, key)
 
     @staticmethod
-    def _view_key(context, w, h):
+    def _viewport_settings(scene, context) -> RenderSettings:
+        """The render settings, one sample per pass, data passes only on demand (the Depth/Normal/Motion viewport
+        passes compute them lazily); a reservoir pass on screen makes Auto resample, as in a final render."""
+        from .viewport import RESERVOIR_PASSES
+        settings = settings_from_scene(scene)
+        settings.samples = 1
+        settings.data_passes = False
+        settings.reservoir_passes = _viewport_pass(context) in RESERVOIR_PASSES
+        settings.tile_pixels = 16384  # small chunks: a stop request is seen within one chunk of one stage
+        return settings
+
+    def _view(self, context):
+        """(core camera of the 3D view at its full viewport resolution, key of the view)."""
+        from .viewport import view_camera
+        pixel = max(1, int(self.get_preview_pixel_size(context.scene)))
+        w, h = max(1, context.region.width // pixel), max(1, context.region.height // pixel)
+        space = context.space_data
         rd = context.region_data
-        return (tuple(map(tuple, rd.view_matrix)), tuple(map(tuple, rd.window_matrix)), w, h)
+        key = (tuple(map(tuple, rd.view_matrix)), tuple(map(tuple, rd.window_matrix)), w, h)
+        return view_camera(rd, w, h, space.clip_start, space.clip_end), key
 
     def view_draw(self, context, depsgraph):
-        """UI thread: restart on view changes, draw the running mean. Must stay cheap."""
+        """UI thread: hand the view to the worker, draw its newest image. Never waits for a pass."""
         import gpu
         from gpu_extras.presets import draw_texture_2d
 
-        from .viewport import view_camera
-        if self._viewport is None:
+        from .viewport import DATA_PASSES, RESERVOIR_PASSES
+        session = self._viewport
+        if session is None:
             return
-        w, h = self._view_size(context)
-        space = context.space_data
-        self._viewport.set_view(view_camera(context.region_data, w, h, space.clip_start, space.clip_end),
-                                self._view_key(context, w, h))
-        image, samples = self._viewport.latest()
+        cam, key = self._view(context)
+        session.set_view(cam, key)
+        name = _viewport_pass(context)
+        last = self._viewport_settings_last
+        if last is not None and last.reservoir_passes != (name in RESERVOIR_PASSES) and self._exporter.last is not None:
+            # Auto picks its direct-light method with the reservoir passes in mind: re-plan with the same scene
+            settings = replace(last, reservoir_passes=name in RESERVOIR_PASSES)
+            self._viewport_settings_last = settings
+            session.set_scene(self._exporter.export(depsgraph, cam, "SETTINGS"), settings)
+        session.set_pass(name)
+        image, _samples = session.latest()
+        if session.last_error:
+            self.update_stats("ReSTIR", f"Viewport failed: {session.last_error}")
         if image is None:
             return
         ih, iw = image.shape[:2]
         buf = gpu.types.Buffer("FLOAT", iw * ih * 4, np.ascontiguousarray(image).ravel())
         self._texture = gpu.types.GPUTexture((iw, ih), format="RGBA16F", data=buf)
         gpu.state.blend_set("ALPHA_PREMULT")
-        self.bind_display_space_shader(depsgraph.scene)
+        data = session.image_pass in DATA_PASSES  # false colours and data: shown as they are, not tone-mapped
+        if not data:
+            self.bind_display_space_shader(depsgraph.scene)
         draw_texture_2d(self._texture, (0, 0), context.region.width, context.region.height)
-        self.unbind_display_space_shader()
+        if not data:
+            self.unbind_display_space_shader()
         gpu.state.blend_set("NONE")
-        self.update_stats("ReSTIR", f"Viewport | {samples} samples")
+        if not session.last_error:
+            self.update_stats("ReSTIR", session.stats.text())
 
     def _write(self, images: dict, window, scene, view_layer):
         _x0, _y0, w, h = window

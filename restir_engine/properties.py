@@ -9,6 +9,7 @@ from .core.light_tiles import TileSettings
 from .core.restir.di import CandidateSettings
 from .core.restir.gi import GISettings
 from .core.restir.reuse import SpatialSettings, TemporalSettings
+from .viewport import DEFAULT_BUDGET, MAX_VIEWPORT_SAMPLES, VIEWPORT_PASSES
 
 
 def _update_passes(self, context):
@@ -118,6 +119,14 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                                 update=_denoise_option)
     samples: IntProperty(name="Samples", description="Iterations averaged per frame", default=16, min=1,
                          soft_max=4096)
+    viewport_samples: IntProperty(name="Viewport Samples", description="Samples the Rendered viewport accumulates "
+                                  "for a still view before it stops", default=MAX_VIEWPORT_SAMPLES, min=1,
+                                  soft_max=4096)
+    viewport_budget_ms: IntProperty(name="Navigation Budget (ms)", description="Time the first image after a view "
+                                    "change may take: while the view moves, the viewport renders at 1/2, 1/4 "
+                                    "or 1/8 resolution to stay under it, then refines at full resolution "
+                                    "(0 = always full resolution)", default=int(DEFAULT_BUDGET * 1000), min=0,
+                                    soft_max=2000)
     seed: IntProperty(name="Seed", description="Noise pattern; different seeds give independent noise", default=0,
                       min=0)
     max_bounces: IntProperty(name="Max Bounces", description="Indirect bounces (0 = direct light only)",
@@ -175,7 +184,14 @@ class RestirViewLayerSettings(bpy.types.PropertyGroup):
                                           "for the compositor's Denoise node", default=False, update=_update_passes)
 
 
-CLASSES = (RestirSceneSettings, RestirViewLayerSettings)
+class RestirViewShadingSettings(bpy.types.PropertyGroup):
+    """Per 3D view: what its Rendered shading shows (``View3DShading.restir``)."""
+
+    render_pass: EnumProperty(name="Render Pass", description="Pass shown by the Rendered viewport",
+                              items=[(key, label, desc) for key, label, desc in VIEWPORT_PASSES], default="COMBINED")
+
+
+CLASSES = (RestirSceneSettings, RestirViewLayerSettings, RestirViewShadingSettings)
 
 
 def register():
@@ -183,9 +199,11 @@ def register():
         bpy.utils.register_class(cls)
     bpy.types.Scene.restir = PointerProperty(type=RestirSceneSettings)
     bpy.types.ViewLayer.restir = PointerProperty(type=RestirViewLayerSettings)
+    bpy.types.View3DShading.restir = PointerProperty(type=RestirViewShadingSettings)
 
 
 def unregister():
+    del bpy.types.View3DShading.restir
     del bpy.types.ViewLayer.restir
     del bpy.types.Scene.restir
     for cls in reversed(CLASSES):

@@ -1,20 +1,61 @@
-"""Rendered viewport shading: progressive sample passes on a background thread, drawn as a texture.
+"""Rendered viewport shading: a worker thread renders sample passes of the 3D view; the UI thread only draws.
 
-The core is pure NumPy, so a worker thread renders while Blender's UI thread only copies the
-running mean into a GPU texture in ``view_draw``. Geometry is exported in ``view_update`` (Blender's
-thread, as the API requires); camera moves only restart accumulation.
+The session is driven from Blender's thread by three calls that never wait for the worker:
+``set_scene`` (a new or edited scene, from ``view_update``), ``set_view`` (the view's camera, from
+``view_draw``) and ``set_pass`` (the pass to show). The worker:
+
+- renders the pass after a view change (a navigation pass) at a reduced resolution, 1/divider of the view's,
+  the divider chosen from the measured cost per pixel so that the pass fits the time budget; a navigation pass
+  is not interrupted by further view changes (else fast navigation would never show an image), it picks up
+  the newest view when it ends;
+- when no new view arrived during that pass, doubles the resolution pass by pass up to full resolution and
+  accumulates samples there (refinement passes, interrupted at once by a view change, a scene edit or a stop);
+- carries temporal history across views: each view's first pass reprojects the reservoirs (ReSTIR DI and GI) of
+  the last view that finished one, through the previous view's camera (any resolution), with the disocclusion
+  tests of the final render; a new view is a new "frame" for the random streams.
+
+Images handed to the UI are (h, w, 4) float32 in scene-linear (Combined and the light passes) or display
+values (the false-colour and data passes, see :func:`pass_image`).
 """
 from __future__ import annotations
 
+import dataclasses
 import threading
+import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .core.renderer import FrameRenderer, RenderSettings
-from .core.scene import Camera
+from .core.scene import Camera, Motion
 
 MAX_VIEWPORT_SAMPLES = 1024
 HALF_FLOAT_MAX = 65504.0  # RGBA16F textures turn larger values into inf (black viewport)
+DIVIDERS = (1, 2, 4, 8)   # resolution dividers of a navigation pass
+DEFAULT_BUDGET = 0.15     # seconds a navigation pass may take (the first image after a move)
+COST_SMOOTHING = 0.5      # weight of the newest pass in the running cost-per-pixel estimate
+
+# viewport pass: (label, description); the RESTIR_* false colours are documented in docs/USAGE.md
+VIEWPORT_PASSES = (
+    ("COMBINED", "Combined", "The image"),
+    ("DIRECT", "Direct", "Direct light"),
+    ("INDIRECT", "Indirect", "Indirect light"),
+    ("EMISSION", "Emission", "Emission seen directly"),
+    ("RES_M", "Reservoir M", "ReSTIR DI confidence M, false colour (log scale, 1 to 64)"),
+    ("RES_UCW", "Reservoir UCW", "ReSTIR DI unbiased contribution weight, false colour (log scale, auto range)"),
+    ("GI_M", "GI Reservoir M", "ReSTIR GI confidence M, false colour (log scale, 1 to 64)"),
+    ("GI_UCW", "GI Reservoir UCW", "ReSTIR GI unbiased contribution weight, false colour (log scale, auto range)"),
+    ("DEPTH", "Depth", "Distance along the view axis, grey (near dark, far bright)"),
+    ("NORMAL", "Normal", "World-space shading normal, 0.5 + 0.5 n"),
+    ("VECTOR", "Motion", "Screen motion since the previous view, 0.5 + v / 32 px in red/green"),
+)
+RESERVOIR_PASSES = {"RES_M", "RES_UCW"}  # passes that make the Auto direct method resample
+DATA_PASSES = {"RES_M", "RES_UCW", "GI_M", "GI_UCW", "DEPTH", "NORMAL", "VECTOR"}  # shown without view transform
+M_FULL_SCALE = 64.0  # Reservoir M at the top of its colour ramp
+
+# a perceptual ramp from dark blue through teal and green to yellow (control points, linearly interpolated)
+_RAMP = np.array([[0.267, 0.005, 0.329], [0.229, 0.322, 0.546], [0.128, 0.567, 0.551], [0.369, 0.789, 0.383],
+                  [0.993, 0.906, 0.144]], np.float32)
 
 
 def view_camera(region_data, width: int, height: int, clip_start: float, clip_end: float) -> Camera:
@@ -26,51 +67,345 @@ def view_camera(region_data, width: int, height: int, clip_start: float, clip_en
                   clip_start=clip_start, clip_end=clip_end)
 
 
+def scaled_camera(camera: Camera, divider: int) -> Camera:
+    """The same view at 1/divider of its resolution (the projection is in NDC, so only the raster changes)."""
+    w, h = max(1, camera.width // divider), max(1, camera.height // divider)
+    return dataclasses.replace(camera, width=w, height=h, window=(0, 0, w, h))
+
+
+def choose_divider(seconds_per_pixel: float | None, pixels: int, budget: float) -> int:
+    """The smallest divider whose pass is predicted to fit ``budget`` seconds (cost ∝ pixels); the largest when
+    none does. Without a measurement yet: the largest (the first image comes fast, then the estimate exists).
+    A budget of 0: always full resolution."""
+    if budget <= 0:
+        return 1
+    if seconds_per_pixel is None:
+        return DIVIDERS[-1]
+    for d in DIVIDERS:
+        if seconds_per_pixel * pixels / (d * d) <= budget:
+            return d
+    return DIVIDERS[-1]
+
+
+def false_colour(t: np.ndarray) -> np.ndarray:
+    """(h, w) values in [0, 1] -> (h, w, 3) colours of the ramp."""
+    x = np.clip(np.nan_to_num(t), 0.0, 1.0) * (len(_RAMP) - 1)
+    i = np.minimum(x.astype(np.int64), len(_RAMP) - 2)
+    f = (x - i)[..., None].astype(np.float32)
+    return _RAMP[i] * (1 - f) + _RAMP[i + 1] * f
+
+
+def m_colour(m: np.ndarray) -> np.ndarray:
+    """Reservoir confidence M -> colour: log2(1 + M) / log2(1 + 64), so 0 is the ramp's start (and black where
+    nothing was hit), 1 a quarter-way, 64 or more its end."""
+    out = false_colour(np.log2(1.0 + np.maximum(m, 0)) / np.log2(1.0 + M_FULL_SCALE))
+    out[m <= 0] = 0.0
+    return out
+
+
+def ucw_colour(w: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
+    """Unbiased contribution weight -> colour on a log10 scale from its 1st to its 99th percentile over the
+    pixels where it is positive (black elsewhere); returns the colours and that range."""
+    pos = w > 0
+    if not pos.any():
+        return np.zeros(w.shape + (3,), np.float32), (0.0, 0.0)
+    lw = np.log10(w[pos])
+    lo, hi = (float(v) for v in np.percentile(lw, [1, 99]))
+    out = np.zeros(w.shape + (3,), np.float32)
+    out[pos] = false_colour((lw - lo) / max(hi - lo, 1e-6))
+    return out, (10.0 ** lo, 10.0 ** hi)
+
+
+def pass_image(renderer: FrameRenderer, name: str) -> tuple[np.ndarray, dict]:
+    """The viewport pass ``name`` (a VIEWPORT_PASSES key) of the renderer's running mean as (h, w, 4) float32
+    and facts about its mapping (for the header); a pass the renderer does not have (Reservoir M when the
+    direct light is not resampled) is black, with the reason."""
+    acc = renderer.acc
+    h, w = acc["alpha"].shape
+    inv = np.float32(1.0 / max(1, renderer.samples_done))
+    out = np.zeros((h, w, 4), np.float32)
+    out[..., 3] = 1.0
+    info: dict = {}
+    if name == "COMBINED":
+        return renderer.combined(), info
+    light = {"DIRECT": "direct", "INDIRECT": "indirect", "EMISSION": "emit"}
+    if name in light:
+        out[..., :3] = acc[light[name]] * inv
+        return out, info
+    if name in ("RES_M", "RES_UCW", "GI_M", "GI_UCW"):
+        key = {"RES_M": "res_m", "RES_UCW": "res_w", "GI_M": "gi_m", "GI_UCW": "gi_w"}[name]
+        if key not in acc or (name.startswith("RES") and renderer.candidates is None):
+            info["missing"] = "no reservoirs: " + ("ReSTIR GI is off" if name.startswith("GI")
+                                                   else f"the direct light uses {renderer.method}")
+            return out, info
+        mean = acc[key] * inv
+        if name.endswith("_M"):
+            out[..., :3] = m_colour(mean)
+            info["mean"] = float(mean[mean > 0].mean()) if (mean > 0).any() else 0.0
+        else:
+            out[..., :3], info["range"] = ucw_colour(mean)
+        return out, info
+    depth, normal, vector = renderer.data_passes()
+    if name == "DEPTH":
+        d = depth[..., 0]
+        hit = d < 1e9
+        far = float(d[hit].max()) if hit.any() else 1.0
+        out[..., :3] = np.where(hit, d / max(far, 1e-6), 0.0)[..., None]
+        info["range"] = (0.0, far)
+    elif name == "NORMAL":
+        out[..., :3] = np.where(np.any(normal != 0, axis=-1, keepdims=True), 0.5 + 0.5 * normal, 0.0)
+    elif name == "VECTOR":
+        out[..., :2] = 0.5 + vector[..., :2] / 32.0
+        out[..., 2] = 0.5
+    else:
+        raise ValueError(f"unknown viewport pass {name!r}")
+    return out, info
+
+
+@dataclass
+class ViewportStats:
+    """What the header shows: samples of the current view, the last pass's seconds, the divider, mean M."""
+
+    samples: int = 0
+    pass_seconds: float = 0.0
+    divider: int = 1
+    width: int = 0
+    height: int = 0
+    mean_m: float | None = None     # mean ReSTIR DI confidence over the pixels with a surface (None: no DI reservoirs)
+    gi_mean_m: float | None = None  # the same for ReSTIR GI
+    navigation_passes: int = 0    # passes rendered right after a view change
+    interrupted_passes: int = 0   # refinement passes stopped by a view change, an edit or a stop
+    scenes: int = 0               # scenes (exports) the session rendered
+    extra: dict = field(default_factory=dict)
+
+    def text(self) -> str:
+        s = f"Viewport | {self.samples} samples | {self.width}x{self.height}"
+        if self.divider > 1:
+            s += f" (1/{self.divider})"
+        s += f" | {1000 * self.pass_seconds:.0f} ms/pass"
+        if self.mean_m is not None:
+            s += f" | mean M {self.mean_m:.1f}"
+        if self.gi_mean_m is not None:
+            s += f" | GI mean M {self.gi_mean_m:.1f}"
+        return s
+
+
 class ViewportSession:
-    """Owns the FrameRenderer and the worker thread of one viewport engine instance."""
+    """One viewport engine instance's worker: owns the FrameRenderer and renders what the UI asked for last."""
 
-    def __init__(self, redraw):
+    def __init__(self, redraw, budget: float = DEFAULT_BUDGET, max_samples: int = MAX_VIEWPORT_SAMPLES,
+                 clock=time.perf_counter):
         self.redraw = redraw
+        self.budget = float(budget)
+        self.max_samples = int(max_samples)
+        self.clock = clock
         self.renderer: FrameRenderer | None = None
-        self.lock = threading.Lock()
-        self.stop = threading.Event()
-        self.thread: threading.Thread | None = None
-        self.key = None
-        self.image = None  # latest Combined (h, w, 4), float32, clamped for half floats
-        self.samples = 0
+        self.stats = ViewportStats()
+        self.pass_name = "COMBINED"
+        self._cv = threading.Condition()
+        self._scene = None           # (Scene, RenderSettings) waiting for the worker
+        self._view = None            # (Camera at full resolution, key), the newest asked for
+        self._key = None             # the key of the view being rendered
+        self._divider = 1
+        self._frame = 0              # views rendered so far: keys the random streams of each view
+        self._cost = None            # running estimate of seconds per pixel of one pass
+        self._interrupt = False      # the running refinement pass must stop
+        self._navigating = False     # the running pass is a navigation pass (view changes do not stop it)
+        self._closed = False
+        self._republish = False
+        self._image = None
+        self._image_pass = None
+        self._thread: threading.Thread | None = None
+        self.last_error: str | None = None
 
-    def set_scene(self, scene, settings: RenderSettings):
-        self.halt()
-        self.renderer = FrameRenderer(scene, settings)
-        self.key = None
+    # -- called from Blender's thread (never waits for a pass) -----------------------------------
+    def set_scene(self, scene, settings: RenderSettings) -> None:
+        """Render ``scene`` from now on (the view is kept; history is carried over where the lights map)."""
+        with self._cv:
+            self._scene = (scene, settings)
+            self._interrupt = True
+            self._closed = False
+            self._cv.notify_all()
+        self._ensure_thread()
 
-    def set_view(self, camera: Camera, key):
-        """Restart accumulation when the view (matrices, size) changed."""
-        if self.renderer is None or key == self.key:
-            return
-        self.halt()
-        self.key = key
-        self.renderer.set_camera(camera)
-        self.stop.clear()
-        self.thread = threading.Thread(target=self._work, name="restir-viewport", daemon=True)
-        self.thread.start()
-
-    def _work(self):
-        r = self.renderer
-        while not self.stop.is_set() and r.samples_done < MAX_VIEWPORT_SAMPLES:
-            if not r.sample_pass(should_stop=self.stop.is_set):
+    def set_view(self, camera: Camera, key) -> None:
+        """The view's camera at full resolution; a changed ``key`` (matrices, size) starts a new view."""
+        with self._cv:
+            if self._view is not None and self._view[1] == key:
                 return
-            img = np.minimum(r.combined(), HALF_FLOAT_MAX)
-            with self.lock:
-                self.image, self.samples = img, r.samples_done
-            self.redraw()
+            self._view = (camera, key)
+            if not self._navigating:  # a refinement pass (any resolution) stops for the new view
+                self._interrupt = True
+            self._cv.notify_all()
+        self._ensure_thread()
 
-    def halt(self):
-        self.stop.set()
-        if self.thread is not None:
-            self.thread.join()
-        self.thread = None
+    def set_pass(self, name: str) -> None:
+        """Show another pass (recomputed from the running sums; nothing is re-rendered)."""
+        if name not in {p[0] for p in VIEWPORT_PASSES}:
+            raise ValueError(f"unknown viewport pass {name!r}")
+        with self._cv:
+            if name != self.pass_name:
+                self.pass_name = name
+                self._republish = True
+                self._cv.notify_all()
+
+    @property
+    def image_pass(self) -> str | None:
+        """The pass the newest image shows."""
+        return self._image_pass
 
     def latest(self):
-        with self.lock:
-            return self.image, self.samples
+        """(image or None, samples of the current view)."""
+        with self._cv:
+            return self._image, self.stats.samples
+
+    def halt(self, timeout: float = 5.0) -> None:
+        """Stop the worker (leaving Rendered mode, freeing the engine); returns when it has ended."""
+        with self._cv:
+            self._closed = True
+            self._interrupt = True
+            self._cv.notify_all()
+        t = self._thread
+        if t is not None and t is not threading.current_thread():
+            t.join(timeout)
+        self._thread = None
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def _ensure_thread(self) -> None:
+        if self._thread is None or not self._thread.is_alive():
+            # not named "restir...": those are the pool's threads, which run nested work inline
+            self._thread = threading.Thread(target=self._run, name="viewport-worker", daemon=True)
+            self._thread.start()
+
+    # -- the worker -------------------------------------------------------------------------------
+    def _has_work(self) -> bool:
+        if self._scene is not None or self._republish:
+            return True
+        if self.renderer is None or self._view is None:
+            return False
+        if self._view[1] != self._key or self._divider > 1:
+            return True
+        return self.renderer.samples_done < self.max_samples
+
+    def _run(self) -> None:
+        try:
+            self._loop()
+        except Exception as exc:  # noqa: BLE001 - reported in the header instead of killing Blender's draw
+            import traceback
+            traceback.print_exc()
+            self.last_error = f"{type(exc).__name__}: {exc}"
+            self.redraw()
+
+    def _loop(self) -> None:
+        while True:
+            with self._cv:
+                while not self._closed and not self._has_work():
+                    self._cv.wait()
+                if self._closed:
+                    return
+                job, self._scene = self._scene, None
+                view = self._view
+                republish, self._republish = self._republish, False
+                self._interrupt = False
+            if job is not None:
+                self._adopt_scene(*job)
+            if self.renderer is None or view is None:
+                continue
+            camera, key = view
+            navigation = key != self._key
+            if navigation:
+                self._divider = choose_divider(self._cost, camera.width * camera.height, self.budget)
+                self._move(camera, key)
+            elif self._divider > 1:  # the view stayed: refine, doubling the resolution up to full (each step
+                self._divider //= 2   # reprojects the last one's reservoirs, as a camera move does)
+                self._move(camera, key)
+            elif republish and self.renderer.samples_done > 0:
+                self._publish()
+                continue
+            if self.renderer.samples_done >= self.max_samples:
+                continue
+            self._pass(navigation)
+
+    def _adopt_scene(self, scene, settings: RenderSettings) -> None:
+        old = self.renderer
+        hist = old.latest_history() if old is not None else None
+        cam = scene.camera if self._view is None else scaled_camera(self._view[0], self._divider)
+        scene.camera = cam
+        self.renderer = FrameRenderer(scene, dataclasses.replace(settings, frame=self._frame))
+        if hist is not None and settings.temporal_reuse:
+            self.renderer.adopt_history(hist)
+        if old is not None:
+            old.release()
+        self._key = None  # the next pass is a navigation pass: an edit's first image comes as fast as a move's
+        self.stats.scenes += 1
+
+    def _move(self, camera: Camera, key) -> None:
+        """Point the renderer at the view (at the current divider); the scene's motion holds the previous view
+        (for the Motion pass: objects do not move between views)."""
+        r = self.renderer
+        prev = r.ctx.scene.camera
+        cam = scaled_camera(camera, self._divider)
+        self._frame += 1
+        r.move_camera(cam, self._frame)
+        mats = r.ctx.scene.export_stats.get("instance_matrices") if hasattr(r.ctx.scene, "export_stats") else None
+        if mats is None:
+            mats = np.zeros((0, 4, 4))
+        r.ctx.scene.motion = Motion(current=mats, prev=mats, next=mats,
+                                    camera_prev=dataclasses.replace(prev, width=cam.width, height=cam.height,
+                                                                    window=cam.window))
+        self._key = key
+
+    def _pass(self, navigation: bool) -> None:
+        r = self.renderer
+        t0 = self.clock()
+
+        def should_stop():
+            return self._closed or (self._interrupt and not navigation) or self._scene is not None
+
+        with self._cv:
+            self._navigating = navigation
+            if not navigation and self._view is not None and self._view[1] != self._key:
+                return  # the view moved while this pass was being set up: render the new view first
+        try:
+            done = r.sample_pass(should_stop=should_stop)
+        finally:
+            self._navigating = False
+        seconds = self.clock() - t0
+        if not done:
+            self.stats.interrupted_passes += 1
+            return
+        _x0, _y0, w, h = r.ctx.scene.camera.window
+        per_pixel = seconds / max(1, w * h)
+        self._cost = per_pixel if self._cost is None else \
+            COST_SMOOTHING * per_pixel + (1 - COST_SMOOTHING) * self._cost
+        self._publish(seconds, int(navigation))
+
+    def _publish(self, seconds: float | None = None, navigation: int = 0) -> None:
+        """Hand the pass shown to the UI, with the stats (one replacement: a reader never sees half of them)."""
+        r = self.renderer
+        image, info = pass_image(r, self.pass_name)
+        if self.pass_name == "COMBINED":
+            image = np.minimum(image, HALF_FLOAT_MAX)
+        _x0, _y0, w, h = r.ctx.scene.camera.window
+        with self._cv:
+            self._image = image
+            self._image_pass = self.pass_name
+            self.stats = dataclasses.replace(self.stats, samples=r.samples_done, divider=self._divider,
+                                             width=w, height=h, extra=info,
+                                             navigation_passes=self.stats.navigation_passes + navigation,
+                                             pass_seconds=self.stats.pass_seconds if seconds is None else seconds,
+                                             mean_m=_mean_confidence(r, "res_m") if r.candidates is not None else None,
+                                             gi_mean_m=_mean_confidence(r, "gi_m"))
+        self.redraw()
+
+
+def _mean_confidence(renderer: FrameRenderer, key: str) -> float | None:
+    """Mean reservoir confidence M per sample over the pixels that have one (None: no such reservoirs)."""
+    m = renderer.acc.get(key)
+    if m is None or not renderer.samples_done:
+        return None
+    hit = m > 0
+    return float(m[hit].mean() / renderer.samples_done) if hit.any() else 0.0

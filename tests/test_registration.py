@@ -152,3 +152,28 @@ def test_panels_draw_with_the_last_render_choices(addon):
     texts = [t for _n, _a, t in drawn if t]
     assert "Last render: Light Sampling" in texts and "1 point lamp" in texts
     assert any(t.startswith("Pixel coverage: 4 rays") for t in texts)
+
+
+def test_viewport_render_pass_selector(addon):
+    """The 3D view's shading settings carry the viewport pass (every documented pass is selectable) and the
+    Shading popover's panel draws it for Rendered shading with this engine only."""
+    from restir_engine.ui import panels
+    from restir_engine.viewport import VIEWPORT_PASSES
+    space = next(a.spaces[0] for s in bpy.data.screens for a in s.areas if a.type == "VIEW_3D")
+    shading = space.shading
+    for key, _label, _desc in VIEWPORT_PASSES:
+        shading.restir.render_pass = key
+        assert shading.restir.render_pass == key
+    seen = []
+
+    class Ctx:
+        engine = "RESTIR"
+        space_data = space
+    shading.type = "RENDERED"
+    assert panels.RESTIR_PT_viewport_render_pass.poll(Ctx)
+    holder = type("Holder", (), {"layout": _Layout(seen)})()
+    panels.RESTIR_PT_viewport_render_pass.draw(holder, Ctx)
+    assert seen == ["render_pass"]
+    Ctx.engine = "CYCLES"
+    assert not panels.RESTIR_PT_viewport_render_pass.poll(Ctx)
+    shading.type = "SOLID"

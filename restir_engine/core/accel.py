@@ -115,6 +115,14 @@ class Accel:
             self._scene = rtcore_scene.EmbreeScene()
             self._mesh = TriangleMesh(self._scene, np.ascontiguousarray(triangles, dtype=np.float32))
 
+    def with_cutout(self, cutout=None, ng_rows: np.ndarray | None = None) -> "Accel":
+        """The same Embree scene (not rebuilt) with other cut-out materials: for a scene whose triangles are
+        unchanged and whose materials were edited."""
+        out = Accel.__new__(Accel)
+        out.__dict__.update(self.__dict__)
+        out.cutout, out._ng_rows = cutout, ng_rows
+        return out
+
     # -- chunked execution -------------------------------------------------------------
     def _chunks(self, n: int):
         return [(s, min(n, s + CHUNK_RAYS)) for s in range(0, n, CHUNK_RAYS)]

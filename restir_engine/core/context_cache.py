@@ -16,7 +16,7 @@ import threading
 import numpy as np
 
 _LOCK = threading.Lock()
-_LAST: tuple | None = None  # (fingerprint, TraceContext)
+_LAST: tuple | None = None  # (fingerprint, TraceContext, triangles' fingerprint, lamp triangles' fingerprint)
 
 
 def fingerprint(*parts) -> bytes:
@@ -56,7 +56,9 @@ def scene_key(scene) -> bytes:
 
 def context_for(scene, max_bounces: int, film_transparent: bool, build):
     """(TraceContext, reused) for ``scene``: the last one with ``scene`` swapped in when the scene's content
-    is unchanged, else ``build(scene, max_bounces, film_transparent)`` (which then becomes the last one)."""
+    is unchanged, else ``build(scene, max_bounces, film_transparent, accels=...)`` (which then becomes the last
+    one); ``accels`` hands over the last context's Embree scenes whose triangles are unchanged (an edit of
+    materials, lamp power or the world rebuilds the tables, not the acceleration structures)."""
     global _LAST
     key = scene_key(scene)
     with _LOCK:
@@ -65,9 +67,16 @@ def context_for(scene, max_bounces: int, film_transparent: bool, build):
         ctx = dataclasses.replace(last[1], scene=scene, max_bounces=int(max(0, max_bounces)),
                                   film_transparent=film_transparent)
         return ctx, True
-    ctx = build(scene, max_bounces, film_transparent)
+    geom_key, lamp_key = fingerprint(scene.geometry.verts), fingerprint(scene.lamps.tris.verts)
+    accels = {}
+    if last is not None:
+        if last[2] == geom_key:
+            accels["geom"] = last[1].geom_accel
+        if last[3] == lamp_key:
+            accels["lamp"] = last[1].lamp_accel
+    ctx = build(scene, max_bounces, film_transparent, accels=accels)
     with _LOCK:
-        _LAST = (key, ctx)
+        _LAST = (key, ctx, geom_key, lamp_key)
     return ctx, False
 
 

@@ -447,7 +447,11 @@ def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     return depth, normal, np.where(np.isfinite(vector), vector, 0.0).astype(np.float32)
 
 
-def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False) -> TraceContext:
+def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False, accels: dict | None = None
+                  ) -> TraceContext:
+    """Everything the chunks need for ``scene``. ``accels`` ({"geom": Accel, "lamp": Accel}, optional): Embree
+    scenes built over exactly these triangles before (an edit of materials or lamps only), reused unbuilt."""
+    accels = accels or {}
     geom = scene.geometry
     lamps = scene.lamps
     verts = np.concatenate([geom.verts.reshape(-1, 3), lamps.tris.verts.reshape(-1, 3)])
@@ -460,8 +464,10 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
     geom_ng_rows = np.ascontiguousarray(geom_ng.T)
     cut = Cutout.of(geom, scene.materials)
-    return TraceContext(scene=scene, geom_accel=Accel(geom.verts, cut, geom_ng_rows if cut else None),
-                        lamp_accel=Accel(lamps.tris.verts),
+    geom_accel = accels["geom"].with_cutout(cut, geom_ng_rows if cut else None) if "geom" in accels else \
+        Accel(geom.verts, cut, geom_ng_rows if cut else None)
+    return TraceContext(scene=scene, geom_accel=geom_accel,
+                        lamp_accel=accels["lamp"] if "lamp" in accels else Accel(lamps.tris.verts),
                         lights=LightTable(scene, max(radius, 1e-3)), geom_ng=geom_ng, lamp_ng=lamp_ng,
                         material_params=params, max_bounces=int(max(0, max_bounces)),
                         film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),

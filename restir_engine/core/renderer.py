@@ -51,6 +51,7 @@ from .target import WIDTH, ShadingTerms
 
 INTEGRATORS = ("PATH", "RESTIR")
 CHUNK_PIXELS = 32768  # pixels per chunk of work (measured: scripts/benchmark_stages.py --tile-sweep)
+STOP_POLL_SECONDS = 0.02  # how often a running stage asks should_stop (the viewport's latency to a new view)
 
 
 class Cancelled(Exception):
@@ -256,10 +257,32 @@ class FrameRenderer:
         self.build_seconds = time.perf_counter() - t0
         self.set_camera(scene.camera)
         if history is not None and history.fits(scene.camera):
-            self.prev_history = history.remapped(self.ctx.lights)  # from the previous frame (None: lights cannot map)
-            if self.prev_history is not None and self.prev_history.gi_res is not None and \
-                    (self.gi is None or self.prev_history.gi_key != self.gi_light_key):
-                self.prev_history = dataclasses.replace(self.prev_history, gi_res=None, gi_terms=None)
+            self.adopt_history(history)
+
+    def adopt_history(self, history) -> None:
+        """Reuse ``history`` (restir.history.TemporalHistory, from another frame or view of this scene or of an
+        edited one) in the next first sample pass: its reservoirs are remapped to this light table (dropped
+        when they cannot be) and its GI reservoirs dropped when anything that emits changed. Reprojection
+        projects with the history's own camera, so its resolution may differ from this one's."""
+        hist = history.remapped(self.ctx.lights)  # None: the lights cannot be mapped
+        if hist is not None and hist.gi_res is not None and (self.gi is None or hist.gi_key != self.gi_light_key):
+            hist = dataclasses.replace(hist, gi_res=None, gi_terms=None)
+        self.prev_history = hist
+
+    def latest_history(self):
+        """The newest temporal history: the current view's first pass's, else the one that pass would reuse."""
+        return self.history if self.history is not None else self.prev_history
+
+    def move_camera(self, camera, frame: int) -> None:
+        """Viewport navigation: render the same scene from ``camera`` (any resolution) as frame ``frame`` (keys
+        the random streams, so a new view never repeats the last one's noise) and restart accumulation; the
+        newest history is reprojected into the new view's first pass (temporal reuse, as between the frames
+        of an animation with a moving camera)."""
+        hist = self.latest_history()
+        self.settings = dataclasses.replace(self.settings, frame=int(frame))
+        self.set_camera(camera)
+        if hist is not None and self.settings.temporal_reuse:
+            self.prev_history = hist
 
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
@@ -326,7 +349,7 @@ class FrameRenderer:
         out = [None] * len(items)
         pending = set(futures)
         while pending:
-            done, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
+            done, pending = wait(pending, timeout=STOP_POLL_SECONDS, return_when=FIRST_COMPLETED)
             for f in done:
                 out[futures[f]] = f.result()
             if stop.should_stop and stop.should_stop():

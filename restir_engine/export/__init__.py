@@ -15,7 +15,7 @@ from .materials import MaterialRegistry
 from .meshes import export_geometry, instance_matrices
 from .world import export_world
 
-__all__ = ["ExportError", "export_scene", "neighbour_frames"]
+__all__ = ["ExportError", "export_scene", "export_shading", "neighbour_frames"]
 
 
 def neighbour_frames(engine, depsgraph, scene_out: Scene, camera_override=None, need_next=True):
@@ -43,22 +43,30 @@ def neighbour_frames(engine, depsgraph, scene_out: Scene, camera_override=None, 
     scene_out.motion = Motion(current=current, prev=prev, next=nxt, camera_prev=cam_prev, camera_next=cam_next)
 
 
-def export_scene(depsgraph, camera_override=None, camera=None) -> Scene:
+def export_scene(depsgraph, camera_override=None, camera=None, mesh_cache: dict | None = None) -> Scene:
     """Export everything visible in ``depsgraph``; raises :class:`ExportError` on unusable input.
 
     camera: a ready core Camera (the viewport's view) instead of the scene's camera object.
+    mesh_cache: meshes read by earlier exports (export.meshes.export_geometry), for the viewport.
+    ``export_stats["material_index"]`` maps each material's name to its table index (incremental.py).
     """
     t0 = time.perf_counter()
-    scene = depsgraph.scene
     warnings: list[str] = []
     if camera is None:
         camera = export_camera(depsgraph, camera_override, warnings)
     registry = MaterialRegistry(warnings)
-    geometry, stats = export_geometry(depsgraph, registry, warnings)
-    lamps = export_lamps(depsgraph, registry, warnings)
-    world, world_image, world_rotation = export_world(scene, warnings)
-    materials = registry.table()
-    out = Scene(geometry=geometry, materials=materials, lamps=lamps, camera=camera,
-                world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings)
-    out.export_stats = dict(stats, seconds=time.perf_counter() - t0)
+    geometry, stats = export_geometry(depsgraph, registry, warnings, mesh_cache)
+    geometry_warnings = list(warnings)
+    out = export_shading(depsgraph, registry, geometry, camera, warnings)
+    out.export_stats = dict(stats, seconds=time.perf_counter() - t0, material_index=dict(registry.index),
+                            geometry_warnings=geometry_warnings)
     return out
+
+
+def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warnings: list) -> Scene:
+    """The lamps, the world and the material table (after the geometry registered its materials in
+    ``registry``) around ``geometry``."""
+    lamps = export_lamps(depsgraph, registry, warnings)
+    world, world_image, world_rotation = export_world(depsgraph.scene, warnings)
+    return Scene(geometry=geometry, materials=registry.table(), lamps=lamps, camera=camera,
+                 world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings)

@@ -79,37 +79,64 @@ def instance_matrices(depsgraph) -> dict:
     return out
 
 
-def export_geometry(depsgraph, registry, warnings: list):
-    """Returns (TriangleSet, stats dict); the TriangleSet's ``instance`` holds each triangle's index into
-    ``stats["instance_keys"]`` / ``stats["instance_matrices"]``."""
-    blocks: list[tuple] = []  # (local arrays, matrix, material index map)
-    cache: dict = {}
-    slot_cache: dict = {}
+def geometry_instances(depsgraph):
+    """(instance, object) of every instance whose geometry is exported."""
     for inst in depsgraph.object_instances:
         obj = inst.object
         if obj.type not in GEOMETRY_TYPES or not inst.show_self:
             continue
         if not getattr(obj, "visible_camera", True) and not getattr(obj, "visible_diffuse", True):
             continue
+        yield inst, obj
+
+
+def slot_signature(depsgraph) -> tuple:
+    """The material names in every exported instance's slots, in export order (equal signatures: the
+    triangles' material indices are unchanged)."""
+    return tuple(tuple(s.material.name_full if s.material else "" for s in obj.material_slots)
+                 for _inst, obj in geometry_instances(depsgraph))
+
+
+def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None = None):
+    """Returns (TriangleSet, stats dict); the TriangleSet's ``instance`` holds each triangle's index into
+    ``stats["instance_keys"]`` / ``stats["instance_matrices"]``. ``mesh_cache`` (optional, kept by the caller
+    between exports whose meshes did not change: the viewport after a transform edit) holds the local arrays
+    read from each evaluated mesh; ``stats["meshes_read"]`` counts the meshes read from Blender."""
+    blocks: list[tuple] = []  # (local arrays, matrix, material index map)
+    cache: dict = {}
+    reads = 0
+    slots_seen: list = []
+    slot_cache: dict = {}
+    for inst, obj in geometry_instances(depsgraph):
         data = obj.data
         key = data.as_pointer() if (obj.type == "MESH" and data is not None) else obj.as_pointer()
         mats_key = (key, tuple(s.material.name_full if s.material else "" for s in obj.material_slots))
         if mats_key not in slot_cache:
             slot_cache[mats_key] = np.array([registry.material_index(s.material) for s in obj.material_slots] or [0],
                                             np.int32)
+        slots_seen.append(mats_key[1])
         if key not in cache:
-            try:
-                mesh = obj.to_mesh()
-            except RuntimeError:
-                mesh = None
-            if mesh is None:
-                cache[key] = None
-                continue
-            try:
-                want_uv = registry.uses_textures(slot_cache[mats_key])
-                cache[key] = _read_mesh(mesh, want_uv, registry.uses_normal_maps(slot_cache[mats_key]), warnings)
-            finally:
-                obj.to_mesh_clear()
+            want_uv = registry.uses_textures(slot_cache[mats_key])
+            want_tangents = registry.uses_normal_maps(slot_cache[mats_key])
+            # the name guards against a freed mesh's address reused by another one
+            kept = (key, data.name_full if data is not None else obj.name_full, want_uv, want_tangents)
+            if mesh_cache is not None and kept in mesh_cache:
+                cache[key] = mesh_cache[kept]
+            else:
+                try:
+                    mesh = obj.to_mesh()
+                except RuntimeError:
+                    mesh = None
+                if mesh is None:
+                    cache[key] = None
+                    continue
+                try:
+                    cache[key] = _read_mesh(mesh, want_uv, want_tangents, warnings)
+                    reads += 1
+                finally:
+                    obj.to_mesh_clear()
+                if mesh_cache is not None:
+                    mesh_cache[kept] = cache[key]
         arrays = cache[key]
         if arrays is None:
             continue
@@ -118,7 +145,8 @@ def export_geometry(depsgraph, registry, warnings: list):
 
     if not blocks:
         return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0, "instance_keys": [],
-                                     "instance_matrices": np.zeros((0, 4, 4))}
+                                     "instance_matrices": np.zeros((0, 4, 4)), "meshes_read": reads,
+                                     "slot_signature": tuple(slots_seen)}
     total = sum(len(b[0]["verts"]) for b in blocks)
     verts = np.empty((total, 3, 3), np.float32)
     normals = np.empty((total, 3, 3), np.float32)
@@ -172,7 +200,8 @@ def export_geometry(depsgraph, registry, warnings: list):
     if bad_n.any():
         normals[bad_n] = 0.0  # the shader falls back to the geometric normal
     stats = {"triangles": len(verts), "instances": len(blocks), "dropped": int((~keep).sum()),
-             "instance_keys": [b[4] for b in blocks], "instance_matrices": np.array([b[1] for b in blocks])}
+             "instance_keys": [b[4] for b in blocks], "instance_matrices": np.array([b[1] for b in blocks]),
+             "meshes_read": reads, "slot_signature": tuple(slots_seen)}
     return TriangleSet(verts, normals, material, uvs, instance, tangents), stats
 
 

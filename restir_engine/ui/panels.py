@@ -68,7 +68,9 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
             row.operator("restir.apply_preset", text=label).preset = key
         layout.prop(s, "integrator")
         col = layout.column(align=True)
-        col.prop(s, "samples")
+        col.prop(s, "samples", text="Render Samples")
+        col.prop(s, "viewport_samples")
+        col.prop(s, "viewport_budget_ms")
         col.prop(s, "seed")
         layout.prop(s, "coverage_samples")
         last = _last_choices(context.scene)
@@ -217,8 +219,26 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl.restir, "use_pass_denoising_data")
 
 
+class RESTIR_PT_viewport_render_pass(bpy.types.Panel):
+    """The Rendered viewport's pass, in the 3D view's Shading popover (as Cycles' Render Pass)."""
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "HEADER"
+    bl_parent_id = "VIEW3D_PT_shading"
+    bl_label = "Render Pass"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        view = context.space_data
+        return context.engine in cls.COMPAT_ENGINES and view is not None and view.shading.type == "RENDERED"
+
+    def draw(self, context):
+        self.layout.prop(context.space_data.shading.restir, "render_pass", text="")
+
+
 PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_indirect, RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths,
-          RESTIR_PT_passes)
+          RESTIR_PT_passes)  # Render Properties
+VIEW_PANELS = (RESTIR_PT_viewport_render_pass,)  # the 3D view's header popovers
 
 
 def _standard_panels():
@@ -229,7 +249,7 @@ def _standard_panels():
 
 
 def register():
-    for cls in PANELS:
+    for cls in PANELS + VIEW_PANELS:
         bpy.utils.register_class(cls)
     for panel in _standard_panels():
         panel.COMPAT_ENGINES.add(ENGINE)
@@ -238,5 +258,5 @@ def register():
 def unregister():
     for panel in _standard_panels():
         panel.COMPAT_ENGINES.discard(ENGINE)
-    for cls in reversed(PANELS):
+    for cls in reversed(PANELS + VIEW_PANELS):
         bpy.utils.unregister_class(cls)

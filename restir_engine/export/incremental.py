@@ -1,0 +1,127 @@
+"""Viewport edits without a full export: what changed (``depsgraph.updates``) decides what is exported again.
+
+Levels, from cheapest:
+
+- ``NONE``: nothing the image depends on (the scene camera: the viewport renders the view's own camera);
+- ``SETTINGS``: only the scene's properties (render settings); the exported scene is reused as it is;
+- ``SHADING``: materials, lamps, the world: the material table, lamps and world are exported again around the
+  previous triangles (no mesh is read, no triangle is transformed; the Embree scene is reused);
+- ``TRANSFORM``: objects moved (or their material slots changed): the triangles are transformed again from the
+  meshes read before (the mesh cache), nothing is read from Blender's meshes;
+- ``FULL``: geometry edited, objects added/removed/hidden, anything unknown: everything, meshes read again.
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import bpy
+
+from . import export_scene, export_shading
+from .materials import MaterialRegistry
+from .meshes import slot_signature
+
+LEVELS = ("NONE", "SETTINGS", "SHADING", "TRANSFORM", "FULL")
+_SHADING_TYPES = (bpy.types.Material, bpy.types.World, bpy.types.NodeTree, bpy.types.Image, bpy.types.Light,
+                  bpy.types.Texture)
+_GEOMETRY_DATA = (bpy.types.Mesh, bpy.types.Curve, bpy.types.MetaBall) + \
+    tuple(getattr(bpy.types, n) for n in ("Curves", "PointCloud", "Volume", "TextCurve") if hasattr(bpy.types, n))
+
+
+def update_level(updates) -> str:
+    """The export level that a depsgraph's ``updates`` need (one of LEVELS)."""
+    level = 0
+    for u in updates:
+        idv = u.id
+        if isinstance(idv, _SHADING_TYPES):
+            need = 2
+        elif isinstance(idv, bpy.types.Object):
+            if idv.type == "LIGHT":
+                need = 2
+            elif idv.type == "CAMERA":
+                need = 0
+            elif u.is_updated_geometry:
+                need = 4
+            elif u.is_updated_transform:
+                need = 3
+            else:  # shading flag: a material edit, or another material in a slot (checked by the exporter)
+                need = 2
+        elif isinstance(idv, _GEOMETRY_DATA):
+            need = 4 if u.is_updated_geometry else 2
+        elif isinstance(idv, bpy.types.Scene):
+            need = 1
+        else:  # collections (visibility, objects added or removed), anything else
+            need = 4
+        level = max(level, need)
+    return LEVELS[level]
+
+
+class SceneExporter:
+    """Keeps the last exported scene and the meshes it read, and exports only what an update needs.
+    ``counts`` tallies the exports by level actually run (a level may fall back to a fuller one)."""
+
+    def __init__(self):
+        self.last = None
+        self.mesh_cache: dict = {}
+        self.counts = {level: 0 for level in LEVELS}
+        self.last_level = None
+        self.last_seconds = 0.0
+
+    def export(self, depsgraph, camera, level: str = "FULL"):
+        """The core Scene for ``depsgraph`` seen by ``camera`` (a core Camera), doing the ``level`` of work
+        (update_level) when the previous export allows it."""
+        t0 = time.perf_counter()
+        out, done = None, level
+        if self.last is None:
+            done = "FULL"
+        elif level in ("NONE", "SETTINGS"):  # a copy: the worker may be rendering the last one
+            out = dataclasses.replace(self.last, camera=camera)
+            out.export_stats = self.last.export_stats
+        elif level == "SHADING":
+            out = self._shading(depsgraph, camera)
+            if out is None:
+                done = "TRANSFORM"
+        if out is None:
+            if done == "FULL":
+                self.mesh_cache.clear()
+            out = export_scene(depsgraph, camera=camera, mesh_cache=self.mesh_cache)
+            out.export_stats["material_needs"] = _needs(out)
+        self.counts[done] += 1
+        self.last, self.last_level = out, done
+        self.last_seconds = time.perf_counter() - t0
+        return out
+
+    def _shading(self, depsgraph, camera):
+        """Materials, lamps and world around the previous triangles; None when the triangles' material indices
+        or the data read from the meshes (UVs, tangents) would change."""
+        last = self.last
+        stats = last.export_stats
+        if slot_signature(depsgraph) != stats["slot_signature"]:
+            return None
+        warnings = list(stats.get("geometry_warnings", []))
+        registry = MaterialRegistry(warnings)
+        for name in stats["material_index"]:  # the previous order gives the previous indices
+            mat = bpy.data.materials.get(name)
+            if mat is None:
+                return None
+            registry.material_index(mat.evaluated_get(depsgraph))
+        if registry.index != stats["material_index"]:  # a mix gained or lost a component: rows moved
+            return None
+        out = export_shading(depsgraph, registry, last.geometry, camera, warnings)
+        out.motion = None
+        out.export_stats = dict(stats, material_index=dict(registry.index))
+        if _needs(out) != stats["material_needs"]:
+            return None
+        out.export_stats["material_needs"] = stats["material_needs"]
+        return out
+
+
+def _needs(scene) -> tuple:
+    """Per material row and mix component: whether it reads a texture or a normal map (what the mesh reads
+    depended on: UVs, tangents)."""
+    m = scene.materials
+    rows = []
+    for arr in (m.base_tex, m.emit_tex, getattr(m, "alpha_tex", None), getattr(m, "normal_tex", None),
+                getattr(m, "mix_first", None), getattr(m, "mix_tex", None)):
+        rows.append(None if arr is None else tuple(int(v) >= 0 for v in arr))
+    return tuple(rows)
