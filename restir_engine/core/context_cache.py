@@ -16,7 +16,7 @@ import threading
 import numpy as np
 
 _LOCK = threading.Lock()
-_LAST: tuple | None = None  # (fingerprint, TraceContext, triangles' fingerprint, lamp triangles' fingerprint)
+_LAST: tuple | None = None  # (fingerprint, TraceContext, geometry's fingerprint, lamp triangles' fingerprint)
 
 
 def fingerprint(*parts) -> bytes:
@@ -48,10 +48,11 @@ def fingerprint(*parts) -> bytes:
     return h.digest()
 
 
-def scene_key(scene) -> bytes:
+def scene_key(scene, geometry_key: bytes | None = None) -> bytes:
     """What the acceleration structures and the light table depend on (not the camera or the motion)."""
-    return fingerprint(scene.geometry, scene.materials, scene.lamps, scene.world_radiance,
-                       getattr(scene, "world_image", None), getattr(scene, "world_rotation", None))
+    return fingerprint(geometry_key if geometry_key is not None else fingerprint(scene.geometry), scene.materials,
+                       scene.lamps, scene.world_radiance, getattr(scene, "world_image", None),
+                       getattr(scene, "world_rotation", None))
 
 
 def context_for(scene, max_bounces: int, film_transparent: bool, build):
@@ -60,18 +61,22 @@ def context_for(scene, max_bounces: int, film_transparent: bool, build):
     one); ``accels`` hands over the last context's Embree scenes whose triangles are unchanged (an edit of
     materials, lamp power or the world rebuilds the tables, not the acceleration structures)."""
     global _LAST
-    key = scene_key(scene)
     with _LOCK:
         last = _LAST
+    # the same TriangleSet object as the last context's is the same triangles (an exported scene's arrays are
+    # never modified; the viewport's edits of materials or lamps hand the previous geometry on): no hashing
+    same_geometry = last is not None and last[1].scene.geometry is scene.geometry
+    geom_key = last[2] if same_geometry else fingerprint(scene.geometry)
+    key = scene_key(scene, geom_key)
     if last is not None and last[0] == key:
         ctx = dataclasses.replace(last[1], scene=scene, max_bounces=int(max(0, max_bounces)),
                                   film_transparent=film_transparent)
         return ctx, True
-    geom_key, lamp_key = fingerprint(scene.geometry.verts), fingerprint(scene.lamps.tris.verts)
+    lamp_key = fingerprint(scene.lamps.tris.verts)
     accels = {}
     if last is not None:
         if last[2] == geom_key:
-            accels["geom"] = last[1].geom_accel
+            accels["geom"], accels["derived"] = last[1].geom_accel, last[1].geom_derived
         if last[3] == lamp_key:
             accels["lamp"] = last[1].lamp_accel
     ctx = build(scene, max_bounces, film_transparent, accels=accels)

@@ -58,6 +58,7 @@ class TraceContext:
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
     lamp_ng_rows: np.ndarray = None     # (3, n_lamp) lamp_ng as rows
+    geom_derived: "GeometryDerived" = None  # the geometry-only arrays above, kept for a rebuild over the same triangles
 
 
 def power_heuristic(a, b):
@@ -447,22 +448,47 @@ def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     return depth, normal, np.where(np.isfinite(vector), vector, 0.0).astype(np.float32)
 
 
+@dataclass
+class GeometryDerived:
+    """Per-triangle arrays derived from the geometry alone (kept while the triangles are unchanged)."""
+
+    bounds: tuple          # (min (3,), max (3,)) of the finite vertices, or None when there are none
+    ng: np.ndarray         # (n, 3) unit geometric normals
+    ng_rows: np.ndarray    # (3, n)
+    flat: np.ndarray       # (n,) bool: the three corner normals are equal
+    normal_rows: np.ndarray  # (9, n) corner shading normals as rows
+
+    @staticmethod
+    def of(geom) -> "GeometryDerived":
+        verts = geom.verts.reshape(-1, 3)
+        finite = verts[np.isfinite(verts).all(axis=1)]
+        bounds = (finite.min(0), finite.max(0)) if len(finite) else None
+        ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
+        nrm = geom.normals
+        flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
+        return GeometryDerived(bounds, ng, np.ascontiguousarray(ng.T), flat,
+                               np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32))
+
+
 def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False, accels: dict | None = None
                   ) -> TraceContext:
-    """Everything the chunks need for ``scene``. ``accels`` ({"geom": Accel, "lamp": Accel}, optional): Embree
-    scenes built over exactly these triangles before (an edit of materials or lamps only), reused unbuilt."""
+    """Everything the chunks need for ``scene``. ``accels`` (optional) hands over what an earlier context built
+    over exactly these triangles (an edit of materials, lamps or the world): "geom" / "lamp" Embree scenes
+    (Accel), "derived" (GeometryDerived); they are reused instead of rebuilt."""
     accels = accels or {}
     geom = scene.geometry
     lamps = scene.lamps
-    verts = np.concatenate([geom.verts.reshape(-1, 3), lamps.tris.verts.reshape(-1, 3)])
-    finite = verts[np.isfinite(verts).all(axis=1)]
-    radius = float(np.linalg.norm(finite.max(0) - finite.min(0)) / 2) if len(finite) else 1.0
-    geom_ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
+    derived = accels.get("derived") or GeometryDerived.of(geom)
+    lamp_verts = lamps.tris.verts.reshape(-1, 3)
+    lamp_verts = lamp_verts[np.isfinite(lamp_verts).all(axis=1)]
+    boxes = [b for b in (derived.bounds, (lamp_verts.min(0), lamp_verts.max(0)) if len(lamp_verts) else None)
+             if b is not None]
+    radius = float(np.linalg.norm(np.max([b[1] for b in boxes], axis=0) - np.min([b[0] for b in boxes], axis=0))
+                   / 2) if boxes else 1.0
+    geom_ng = derived.ng
     lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
     params = SurfaceParams.of_table(scene.materials)
-    nrm = geom.normals
-    flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
-    geom_ng_rows = np.ascontiguousarray(geom_ng.T)
+    geom_ng_rows = derived.ng_rows
     cut = Cutout.of(geom, scene.materials)
     geom_accel = accels["geom"].with_cutout(cut, geom_ng_rows if cut else None) if "geom" in accels else \
         Accel(geom.verts, cut, geom_ng_rows if cut else None)
@@ -477,6 +503,5 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         and bool((scene.materials.normal_tex >= 0).any()),
                         world=World(scene.world_radiance, getattr(scene, "world_image", None),
                                     getattr(scene, "world_rotation", None)),
-                        geom_flat=flat, geom_ng_rows=geom_ng_rows,
-                        geom_normal_rows=np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32),
-                        lamp_ng_rows=np.ascontiguousarray(lamp_ng.T))
+                        geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
+                        lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)
