@@ -54,6 +54,7 @@ class TraceContext:
     has_mix: bool = False  # some material is a Mix/Add shader (core/mix.py)
     world: World = None    # the background as a light (core/world.py)
     normal_maps: bool = False  # some material has a tangent-space normal map (surface.normal_map)
+    bump_maps: bool = False    # some material has a Bump node (surface.bump_map)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -501,6 +502,7 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         has_mix=scene.materials.mix_first is not None and bool((scene.materials.mix_first >= 0).any()),
                         normal_maps=scene.materials.normal_tex is not None
                         and bool((scene.materials.normal_tex >= 0).any()),
+                        bump_maps=scene.materials.bump_tex is not None and bool((scene.materials.bump_tex >= 0).any()),
                         world=World(scene.world_radiance, getattr(scene, "world_image", None),
                                     getattr(scene, "world_rotation", None)),
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,

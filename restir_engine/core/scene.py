@@ -67,6 +67,9 @@ class MaterialTable:
                         0 = Lambert)
     normal_tex  (m,) int32  tangent-space normal map texture (a Normal Map node on the BSDF's Normal), -1 = none
     normal_strength (m,) its Strength
+    bump_tex    (m,) int32  height map of a Bump node on the BSDF's Normal (its luminance, on top of a Normal Map
+                        when the Bump's own Normal input has one), -1 = none
+    bump_strength, bump_distance (m,) the Bump's Strength and Distance (negative: Invert), in scene units
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
@@ -88,6 +91,9 @@ class MaterialTable:
     diffuse_roughness: np.ndarray = None
     normal_tex: np.ndarray = None
     normal_strength: np.ndarray = None
+    bump_tex: np.ndarray = None
+    bump_strength: np.ndarray = None
+    bump_distance: np.ndarray = None
     alpha: np.ndarray = None
     alpha_tex: np.ndarray = None
     alpha_sign: np.ndarray = None
@@ -116,6 +122,8 @@ class MaterialTable:
             alpha=col("alpha", 1.0), alpha_tex=col("alpha_tex", -1, np.int32), alpha_sign=col("alpha_sign", 1.0),
             mix_normalize=col("mix_normalize", False, bool),
             normal_tex=col("normal_tex", -1, np.int32), normal_strength=col("normal_strength", 1.0),
+            bump_tex=col("bump_tex", -1, np.int32), bump_strength=col("bump_strength", 1.0),
+            bump_distance=col("bump_distance", 1.0),
             diffuse_roughness=col("diffuse_roughness", 0.0),
             **_mix_arrays(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

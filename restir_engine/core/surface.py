@@ -11,7 +11,7 @@ from .bsdf import SurfaceParams, ViewTerms
 from .microfacet_tables import rows_at
 from .mix import hash_uniform, pick_components
 from .sampling import barycentric, cols, dot, norm, orthonormal_basis
-from .textures import apply_texture, sample
+from .textures import apply_texture, gradient, sample
 
 
 class Surface:
@@ -55,14 +55,18 @@ class Surface:
         bad = ~np.isfinite(ln) | (ln < 0.5)
         if bad.any():
             ns[:, bad] = ng[:, bad]
-        mapped = None
-        if ctx.normal_maps and geom.tangents is not None:
-            mapped = np.flatnonzero(mats.normal_tex[mat] >= 0)
-            if mapped.size:
-                smooth_n = ns[:, mapped].copy()
-                ns[:, mapped] = normal_map(mats, geom, mat, prim, u, v, ns, mapped)
-            else:
-                mapped = None
+        mapped = None  # hits whose normal a Normal Map and/or a Bump node changed
+        none = np.empty(0, np.intp)
+        nmap = np.flatnonzero(mats.normal_tex[mat] >= 0) if ctx.normal_maps and geom.tangents is not None else none
+        bump = np.flatnonzero(mats.bump_tex[mat] >= 0) if ctx.bump_maps and geom.uvs is not None else none
+        if len(nmap) or len(bump):
+            mapped = np.union1d(nmap, bump)
+            smooth_n = ns[:, mapped].copy()
+            if len(nmap):
+                ns[:, nmap] = normal_map(mats, geom, mat, prim, u, v, ns, nmap)
+            if len(bump):  # about the normal facing the ray, as Cycles (then turned back like every normal)
+                facing = np.where(dot(cols(ng, bump), cols(d, bump)) > 0, np.float32(-1.0), np.float32(1.0))
+                ns[:, bump] = bump_map(mats, geom, mat, prim, u, v, ns[:, bump] * facing, bump) * facing
         # shading normal on the geometric normal's side, both facing the incoming ray
         s_ng = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
         s_ns = np.where(dot(ns, ng) < 0, -s_ng, s_ng)
@@ -175,6 +179,45 @@ def normal_map(mats, geom, mat, prim, u, v, ns, rows) -> np.ndarray:
     ln = norm(out)
     ok = np.isfinite(ln) & (ln > 1e-12)
     return np.where(ok, out / np.where(ok, ln, 1.0), n).astype(np.float32)
+
+
+def bump_map(mats, geom, mat, prim, u, v, n, rows) -> np.ndarray:
+    """Shading normals (3, k) of hits ``rows`` under Cycles' Bump node: with the height's differentials along two
+    surface directions, N' = normalize(|det| N - d sign(det) (dH_1 R_1 + dH_2 R_2)), R_1 = t_2 x N, R_2 = N x t_1,
+    det = t_1 · R_1, then mixed with N by the strength (d: Distance, negative when inverted). Cycles takes the
+    screen-space differentials of the position; the triangle's UV differentials dP/du, dP/dv serve here (the
+    formula gives the same surface gradient for any two directions where the height is linear across them),
+    with the exact UV derivatives of the interpolated height (Cycles' default Filter Width, 0.1 pixel, is close to
+    that limit). ``n``: (3, k) unit normals facing the ray."""
+    p = prim[rows]
+    m = mat[rows]
+    c = np.take(geom.uvs, p, axis=0)                                   # (k, 3 corners, 2)
+    uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[rows][:, None], v[rows][:, None])
+    tri = np.take(geom.verts, p, axis=0)                               # (k, 3 corners, 3)
+    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    d1, d2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
+    det_uv = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    ok = np.abs(det_uv) > 1e-12
+    inv = np.where(ok, 1.0 / np.where(ok, det_uv, 1.0), 0.0)[:, None]
+    dpdu = ((e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * inv).T              # (3, k)
+    dpdv = ((e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * inv).T
+    dh = np.zeros((2, len(rows)), np.float32)                          # dH/du, dH/dv
+    for t in np.unique(mats.bump_tex[m]):  # loop over textures, not hits
+        sel = np.flatnonzero(mats.bump_tex[m] == t)
+        dh[:, sel] = gradient(mats.textures[t], uv[sel]).T
+    r1 = np.cross(dpdv.T, n.T).T
+    r2 = np.cross(n.T, dpdu.T).T
+    det = dot(dpdu, r1)
+    dist = mats.bump_distance[m]
+    strength = mats.bump_strength[m]
+    out = np.abs(det) * n - (dist * np.sign(det)) * (dh[0] * r1 + dh[1] * r2)
+    ln = norm(out)
+    good = ok & np.isfinite(ln) & (ln > 1e-20)
+    out = np.where(good, out / np.where(good, ln, 1.0), n)
+    out = strength * out + (1.0 - strength) * n
+    ln = norm(out)
+    good = np.isfinite(ln) & (ln > 1e-12)
+    return np.where(good, out / np.where(good, ln, 1.0), n).astype(np.float32)
 
 
 def valid_reflection_normal(ng: np.ndarray, wo: np.ndarray, n: np.ndarray):

@@ -46,6 +46,31 @@ def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return (top * (1 - fy) + bot * fy).astype(np.float32)
 
 
+def gradient(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """(n, 2) derivatives d/du, d/dv of the first channel of ``image`` as :func:`sample` interpolates it at ``uv``
+    (bilinear: the exact derivative inside the texel cell; nearest: zero, the image being constant there)."""
+    if isinstance(image, NearestImage):
+        return np.zeros((len(uv), 2), np.float32)
+    h, w = image.shape[:2]
+    x = uv[:, 0] * w - 0.5
+    y = uv[:, 1] * h - 0.5
+    x = np.where(np.isfinite(x), x, 0.0)
+    y = np.where(np.isfinite(y), y, 0.0)
+    x0 = np.floor(x)
+    y0 = np.floor(y)
+    fx = (x - x0).astype(np.float32)
+    fy = (y - y0).astype(np.float32)
+    x0 = x0.astype(np.int64) % w
+    y0 = y0.astype(np.int64) % h
+    x1 = (x0 + 1) % w
+    y1 = (y0 + 1) % h
+    c = image[..., 0]
+    a, b, cc, d = c[y0, x0], c[y0, x1], c[y1, x0], c[y1, x1]
+    du = ((b - a) * (1 - fy) + (d - cc) * fy) * w
+    dv = ((cc - a) * (1 - fx) + (d - b) * fx) * h
+    return np.stack([du, dv], axis=1).astype(np.float32)
+
+
 def apply_texture(values: np.ndarray, tex_index: np.ndarray, uv: np.ndarray | None, textures: list) -> np.ndarray:
     """Multiply ``values`` (n, 3) by the texture each row names (-1 = none)."""
     if uv is None or not textures:

@@ -122,6 +122,6 @@ def _needs(scene) -> tuple:
     m = scene.materials
     rows = []
     for arr in (m.base_tex, m.emit_tex, getattr(m, "alpha_tex", None), getattr(m, "normal_tex", None),
-                getattr(m, "mix_first", None), getattr(m, "mix_tex", None)):
+                getattr(m, "bump_tex", None), getattr(m, "mix_first", None), getattr(m, "mix_tex", None)):
         rows.append(None if arr is None else tuple(int(v) >= 0 for v in arr))
     return tuple(rows)

@@ -53,11 +53,12 @@ class MaterialRegistry:
     def uses_normal_maps(self, indices) -> bool:
         def mapped(row: dict) -> bool:
             return row.get("normal_tex", -1) >= 0 or any(mapped(self.rows[c]) for c, *_r in row.get("mix", ()))
+        # (a Bump alone needs no tangents: its surface gradient comes from the triangle's positions and UVs)
         return any(mapped(self.rows[i]) for i in indices)
 
     def uses_textures(self, indices) -> bool:
         def textured(row: dict) -> bool:
-            if max(row.get(k, -1) for k in ("base_tex", "emit_tex", "alpha_tex", "normal_tex")) >= 0:
+            if max(row.get(k, -1) for k in ("base_tex", "emit_tex", "alpha_tex", "normal_tex", "bump_tex")) >= 0:
                 return True
             return any(tex >= 0 or textured(self.rows[comp]) for comp, _w, tex, _s in row.get("mix", ()))
         return any(textured(self.rows[i]) for i in indices)
@@ -177,12 +178,19 @@ class MaterialRegistry:
 
     # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/mix.py) ---------
     def _normal(self, material, node, row: dict) -> None:
-        """A BSDF's Normal input driven by a tangent-space Normal Map node on an Image Texture -> normal_tex and
-        normal_strength; anything else on it (Bump, other spaces) is reported and ignored."""
+        """A BSDF's Normal input: a tangent-space Normal Map node on an Image Texture -> normal_tex and
+        normal_strength; a Bump node whose Height is an Image Texture -> bump_tex, bump_strength, bump_distance
+        (its own Normal input may hold such a Normal Map); anything else is reported and ignored."""
         socket = node.inputs.get("Normal")
         if socket is None or not socket.is_linked:
             return
         src = socket.links[0].from_node
+        if src.type == "BUMP":  # its height (if supported), then what its own Normal input holds
+            self._bump(material, src, row)
+            inner = src.inputs.get("Normal")
+            if inner is None or not inner.is_linked:
+                return
+            src = inner.links[0].from_node
         if src.type == "NORMAL_MAP" and src.space == "TANGENT":
             col = src.inputs["Color"]
             img = col.links[0].from_node if col.is_linked else None
@@ -193,7 +201,26 @@ class MaterialRegistry:
                 row["normal_strength"] = self._float_input(material, src.inputs["Strength"])
                 return
         self._warn(material, f"'{src.name}' ({src.type}) on the Normal input is not supported; the mesh normal is "
-                   "used (supported: a tangent-space Normal Map of an Image Texture)")
+                   "used (supported: a tangent-space Normal Map of an Image Texture, a Bump of an Image Texture)")
+
+    def _bump(self, material, node, row: dict) -> bool:
+        """A Bump node with an Image Texture on Height (Color as luminance, or Alpha) -> row fields; False (with a
+        warning) when its height is anything else."""
+        height = node.inputs["Height"]
+        link = height.links[0] if height.is_linked else None
+        img = link.from_node if link is not None else None
+        if img is None or img.type != "TEX_IMAGE" or img.image is None:
+            what = "nothing" if img is None else f"'{img.name}' ({img.type})"
+            self._warn(material, f"Bump '{node.name}': its Height is {what}; the bump is ignored (supported: an "
+                       "Image Texture)")
+            return False
+        sign = -1.0 if getattr(node, "invert", False) else 1.0
+        alpha = link.from_socket.name == "Alpha"
+        row["bump_tex"] = self._texture(material, img.image, alpha=alpha, luminance=not alpha,
+                                        closest=img.interpolation == "Closest")
+        row["bump_strength"] = max(0.0, self._float_input(material, node.inputs["Strength"]))
+        row["bump_distance"] = sign * self._float_input(material, node.inputs["Distance"])
+        return True
 
     def _alpha(self, material, socket, row: dict) -> None:
         """Principled Alpha: constant, or an Image Texture's Alpha (or Color, as luminance) -> row alpha fields."""
