@@ -105,15 +105,15 @@ def test_principled_parameters_and_emission(scene):
 
 def test_unsupported_node_is_approximated_and_reported(scene):
     bpy.ops.mesh.primitive_plane_add()
-    m = bpy.data.materials.new("Glass")
+    m = bpy.data.materials.new("Leaf")
     if bpy.app.version < (5, 0, 0):
         m.use_nodes = True
     nodes = m.node_tree.nodes
-    g = nodes.new("ShaderNodeBsdfGlass")
+    g = nodes.new("ShaderNodeBsdfTranslucent")
     m.node_tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
     bpy.context.active_object.data.materials.append(m)
     s = export()
-    assert any("Glass" in w and "not supported" in w for w in s.warnings)
+    assert any("Leaf" in w and "BSDF_TRANSLUCENT" in w and "not supported" in w for w in s.warnings)
 
 
 def textured_plane(img, socket: str, name="Tex"):

@@ -28,6 +28,7 @@ from . import microfacet_tables
 from .cutout import Cutout
 from .world import World
 from .bsdf import SurfaceParams, diffuse_f, eval_view, sample_bsdf
+from .glass import DELTA_PDF, sample_glass
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
 from .sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
 from .scene import Scene
@@ -55,6 +56,7 @@ class TraceContext:
     world: World = None    # the background as a light (core/world.py)
     normal_maps: bool = False  # some material has a tangent-space normal map (surface.normal_map)
     bump_maps: bool = False    # some material has a Bump node (surface.bump_map)
+    has_glass: bool = False    # some material has a smooth glass closure (core/glass.py)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -256,17 +258,32 @@ class BsdfRay:
     o: np.ndarray
     d: np.ndarray
     hits: object = None
+    delta: np.ndarray | None = None  # (k,) bool: a delta sample (smooth glass): f is its weight, pdf DELTA_PDF
 
 
 def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
-    """One BSDF sample per surface of s from uniforms u (3, n), kept where it leaves above the surface."""
+    """One BSDF sample per surface of s from uniforms u (3, n), kept where it leaves above the surface (or, from
+    smooth glass, on the side its delta sample goes to)."""
     wi_l, f, pdf = sample_bsdf(s.params, s.wo_l, u[0], u[1], u[2], view=s.view)
     wi = to_world(wi_l, s.ns, s.t, s.bt)
     wi /= np.maximum(norm(wi), np.float32(1e-12))
-    rows = np.flatnonzero((pdf > 0) & (dot(wi, s.ng) > 0))
+    ok = (pdf > 0) & (dot(wi, s.ng) > 0)
+    delta = None
+    if s.glass is not None:
+        g = np.flatnonzero(s.glass)
+        wg, weight, valid = sample_glass(cols(s.wo, g), cols(s.ns, g), cols(s.ng, g), s.glass_front[g],
+                                         s.glass_ior[g], cols(s.glass_reflect, g), cols(s.glass_refract, g), u[0, g])
+        wi[:, g] = wg
+        wi_l[:, g] = 0.0
+        wi_l[2, g] = 1.0  # unused for delta rows (their throughput is the weight)
+        f[:, g] = weight
+        pdf[g] = DELTA_PDF
+        ok[g] = valid
+        delta = s.glass
+    rows = np.flatnonzero(ok)
     d = cols(wi, rows)
     return BsdfRay(rows, cols(wi_l, rows), cols(f, rows), pdf[rows], offset_origin(cols(s.p, rows), cols(s.ng, rows), d),
-                   d)
+                   d, delta=None if delta is None else delta[rows])
 
 
 def needs_continuation(ctx: TraceContext, direct_resampled: bool) -> bool:
@@ -330,6 +347,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         rows, wi_l, f, pdf, o, d, hits = ray.rows, ray.wi_l, ray.f, ray.pdf, ray.o, ray.d, ray.hits
         thr = cols(throughput, rows) * f
         scale = wi_l[2] / np.maximum(pdf, np.float32(1e-30))
+        if ray.delta is not None:
+            scale = np.where(ray.delta, np.float32(1.0), scale).astype(np.float32)
         thr *= scale
         if bounce == 1 and first is not None:  # x2's diffuse lobe alone (throughput 1 before it)
             dthr = diffuse_f(s.view, wi_l, rows) * scale
@@ -355,11 +374,14 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             hits = ctx.geom_accel.intersect(o, d)
         else:
             hits = hits.take(keep)
-        # emission found by the BSDF ray: lamps in front of the hit, then the hit itself, else the world
-        collect = not (bounce == 0 and direct_resampled)
-        if collect and len(lamps.tris):
+        # emission found by the BSDF ray: lamps in front of the hit, then the hit itself, else the world; when
+        # the first surfaces' direct light is resampled, only what their delta (glass) rays find, which
+        # resampling cannot reach
+        collect = None if not (bounce == 0 and direct_resampled) else \
+            (np.zeros(len(keep), bool) if ray.delta is None else ray.delta[keep])
+        if (collect is None or collect.any()) and len(lamps.tris):
             lh = lamp_hits(ctx, o, d, hits.t)
-            sel = np.flatnonzero(lh.prim >= 0)
+            sel = np.flatnonzero((lh.prim >= 0) if collect is None else (lh.prim >= 0) & collect)
             if sel.size:
                 le, pl = _lamp_emission(ctx, lh, o, d, sel)
                 le *= power_heuristic(prev_pdf[sel], pl)
@@ -380,9 +402,9 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         if hsel.size == 0:
             break
         hp = hits.prim[hsel]
-        if collect:
+        if collect is None or collect.any():
             light = ctx.lights.geom_to_light[hp]
-            em = np.flatnonzero(light >= 0)
+            em = np.flatnonzero((light >= 0) if collect is None else (light >= 0) & collect[hsel])
             if em.size:
                 hs = hsel[em]
                 le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
@@ -503,6 +525,8 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         normal_maps=scene.materials.normal_tex is not None
                         and bool((scene.materials.normal_tex >= 0).any()),
                         bump_maps=scene.materials.bump_tex is not None and bool((scene.materials.bump_tex >= 0).any()),
+                        has_glass=scene.materials.transmission is not None
+                        and bool((scene.materials.transmission > 0).any()),
                         world=World(scene.world_radiance, getattr(scene, "world_image", None),
                                     getattr(scene, "world_rotation", None)),
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,

@@ -70,6 +70,10 @@ class MaterialTable:
     bump_tex    (m,) int32  height map of a Bump node on the BSDF's Normal (its luminance, on top of a Normal Map
                         when the Bump's own Normal input has one), -1 = none
     bump_strength, bump_distance (m,) the Bump's Strength and Distance (negative: Invert), in scene units
+    transmission (m,)   probability that a hit uses the smooth glass closure (Glass BSDF: 1; Principled: (1 - Metallic)
+                        x Transmission Weight; the row's other parameters are then the rest of the BSDF)
+    glass_ior   (m,)    its index of refraction (inside over outside, the geometric normal pointing outside)
+    glass_reflect, glass_refract (m, 3) the tints of its reflection and its refraction
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
@@ -94,6 +98,10 @@ class MaterialTable:
     bump_tex: np.ndarray = None
     bump_strength: np.ndarray = None
     bump_distance: np.ndarray = None
+    transmission: np.ndarray = None
+    glass_ior: np.ndarray = None
+    glass_reflect: np.ndarray = None
+    glass_refract: np.ndarray = None
     alpha: np.ndarray = None
     alpha_tex: np.ndarray = None
     alpha_sign: np.ndarray = None
@@ -124,6 +132,8 @@ class MaterialTable:
             normal_tex=col("normal_tex", -1, np.int32), normal_strength=col("normal_strength", 1.0),
             bump_tex=col("bump_tex", -1, np.int32), bump_strength=col("bump_strength", 1.0),
             bump_distance=col("bump_distance", 1.0),
+            transmission=col("transmission", 0.0), glass_ior=col("glass_ior", 1.5),
+            glass_reflect=col("glass_reflect", (1.0, 1.0, 1.0)), glass_refract=col("glass_refract", (1.0, 1.0, 1.0)),
             diffuse_roughness=col("diffuse_roughness", 0.0),
             **_mix_arrays(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

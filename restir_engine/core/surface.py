@@ -9,6 +9,7 @@ import numpy as np
 
 from .bsdf import SurfaceParams, ViewTerms
 from .microfacet_tables import rows_at
+from .glass import GLASS_SALT
 from .mix import hash_uniform, pick_components
 from .sampling import barycentric, cols, dot, norm, orthonormal_basis
 from .textures import apply_texture, gradient, sample
@@ -85,6 +86,30 @@ class Surface:
                 self.params.assign(textured, SurfaceParams.of_table(mats, tm, base))
         if scale is not None:
             self.params.scale(scale)
+        # smooth glass (core/glass.py): picked per point with the material's transmission share; black for every
+        # evaluation, sampled as a delta closure by pathtracer.sample_rays
+        self.glass = None
+        if ctx.has_glass:
+            cand = np.flatnonzero(mats.transmission[mat] > 0)
+            if cand.size:
+                pick = hash_uniform(prim[cand] ^ GLASS_SALT, u[cand], v[cand]) < mats.transmission[mat[cand]]
+                rows = cand[pick]
+                if rows.size:
+                    n = len(prim)
+                    self.glass = np.zeros(n, bool)  # per surface: uses the glass closure
+                    self.glass[rows] = True
+                    self.glass_front = s_ng > 0  # the ray came from outside (against the outward normal)
+                    gm = mat[rows]
+                    w = np.ones(rows.size, np.float32) if scale is None else scale[rows]
+                    self.glass_ior = np.ones(n, np.float32)
+                    self.glass_ior[rows] = mats.glass_ior[gm]
+                    self.glass_reflect = np.zeros((3, n), np.float32)
+                    self.glass_reflect[:, rows] = mats.glass_reflect[gm].T * w
+                    self.glass_refract = np.zeros((3, n), np.float32)
+                    self.glass_refract[:, rows] = mats.glass_refract[gm].T * w
+                    k = rows.size
+                    self.params.assign(rows, SurfaceParams.from_material(np.zeros((k, 3), np.float32),
+                                                                         np.zeros(k), np.ones(k), np.zeros(k)))
         self.t, self.bt = orthonormal_basis(self.ns)
         self.bump_n = self.bump_a2 = None
         if mapped is not None:  # the unmapped (smooth) normal in the local frame, for Cycles' bump shadowing
@@ -145,6 +170,13 @@ class Surface:
         out = Surface.__new__(Surface)
         for name in ("prim", "b1", "b2", "mat", "bsdf_mat", "albedo", "layer"):
             setattr(out, name, getattr(self, name)[idx])
+        out.glass = None
+        if self.glass is not None:
+            for name in ("glass", "glass_front", "glass_ior"):
+                setattr(out, name, getattr(self, name)[idx])
+            for name in ("glass_reflect", "glass_refract"):
+                a = getattr(self, name)
+                setattr(out, name, a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1))
         for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l", "bump_n", "spec_n"):
             a = getattr(self, name)
             setattr(out, name, None if a is None else a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1))

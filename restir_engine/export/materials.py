@@ -22,6 +22,9 @@ def srgb_to_linear(c: np.ndarray) -> np.ndarray:
 
 
 
+SMOOTH_GLASS_ROUGHNESS = 0.05  # glass rougher than this is rendered smooth, with a warning
+
+
 class MaterialRegistry:
     """Assigns table indices to Blender materials (index 0 is Blender's default grey) and
     collects textures; reports approximations through ``warnings``."""
@@ -134,15 +137,23 @@ class MaterialRegistry:
             row["emission"] = tuple(np.array(ec, np.float32) * strength)
             if row.get("emit_tex", -1) >= 0 and strength == 0:
                 row["emit_tex"] = -1
-            for name in ("Transmission Weight", "Coat Weight", "Sheen Weight", "Subsurface Weight"):
+            for name in ("Coat Weight", "Sheen Weight", "Subsurface Weight"):
                 if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
                     self._warn(material, f"Principled '{name}' is not supported and was ignored")
+            if "Transmission Weight" in inp:
+                self._principled_transmission(material, inp, row, ior)
             if "Diffuse Roughness" in inp:
                 row["diffuse_roughness"] = float(np.clip(self._float_input(material, inp["Diffuse Roughness"]), 0, 1))
             if "Alpha" in inp:
                 self._alpha(material, inp["Alpha"], row)
             self._normal(material, node, row)
             return row
+        if t == "BSDF_GLASS":
+            c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
+            ior = self._float_input(material, node.inputs["IOR"])
+            self._smooth_glass_warning(material, self._float_input(material, node.inputs["Roughness"]))
+            return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transmission": 1.0, "glass_ior": max(ior, 1e-3),
+                    "glass_reflect": tuple(c), "glass_refract": tuple(c)}
         if t == "BSDF_TRANSPARENT":
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
             if min(c) < 0.999:
@@ -175,6 +186,35 @@ class MaterialRegistry:
         self._warn(material, f"shader '{node.name}' ({t}) is not supported; approximated by the viewport colour")
         return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                 "roughness": float(material.roughness), "f0": 0.04}
+
+    def _principled_transmission(self, material, inp, row: dict, ior: float) -> None:
+        """Principled Transmission Weight t: a smooth glass closure with probability (1 - Metallic) t (untinted
+        reflection; refraction tinted by the square root of Base Color, as Cycles: a pass through a solid object
+        crosses two interfaces); the rest of the row becomes the remaining BSDF, whose metallic share is
+        Metallic / (1 - (1 - Metallic) t) so that the two add up to Cycles' mix."""
+        sock = inp["Transmission Weight"]
+        if sock.is_linked:
+            self._warn(material, "Principled 'Transmission Weight' from a texture is not supported; its default "
+                       "value is used")
+        t = float(np.clip(sock.default_value, 0, 1))
+        if t <= 0:
+            return
+        m = float(np.clip(row.get("metallic", 0.0), 0, 1))
+        share = (1 - m) * t
+        row["transmission"] = share
+        row["metallic"] = m / (1 - share) if share < 1 else 0.0
+        row["glass_ior"] = max(ior, 1e-3)
+        row["glass_reflect"] = (1.0, 1.0, 1.0)
+        row["glass_refract"] = tuple(float(np.sqrt(np.clip(c, 0.0, 1.0))) for c in row["base_color"])
+        if min(row.get("specular_tint", (1.0, 1.0, 1.0))) < 0.999:
+            self._warn(material, "Specular Tint does not tint the reflection of Principled transmission here")
+        if row.get("base_tex", -1) >= 0:
+            self._warn(material, "a textured Base Color tints refraction by its constant colour, not the image")
+        self._smooth_glass_warning(material, float(row.get("roughness", 0.5)))
+
+    def _smooth_glass_warning(self, material, roughness: float) -> None:
+        if roughness > SMOOTH_GLASS_ROUGHNESS:
+            self._warn(material, f"rough glass/transmission (roughness {roughness:.2f}) is rendered as smooth glass")
 
     # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/mix.py) ---------
     def _normal(self, material, node, row: dict) -> None:
@@ -361,4 +401,5 @@ def _has_bsdf(row: dict) -> bool:
     if row.get("transparent"):
         return False
     return (row.get("base_tex", -1) >= 0 or any(c > 0 for c in row.get("base_color", (0.8, 0.8, 0.8)))
-            or row.get("f0", 0.04) > 0 or row.get("metallic", 0.0) > 0 or bool(row.get("mix")))
+            or row.get("f0", 0.04) > 0 or row.get("metallic", 0.0) > 0 or bool(row.get("mix"))
+            or row.get("transmission", 0.0) > 0)

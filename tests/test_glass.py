@@ -1,0 +1,72 @@
+"""Smooth glass sampling (core/glass.py) against closed forms: Fresnel, Snell's law, total internal reflection."""
+import numpy as np
+
+from restir_engine.core.glass import sample_glass
+
+
+def _incident(theta_deg, k):
+    t = np.radians(theta_deg)
+    wo = np.tile(np.array([[np.sin(t)], [0.0], [np.cos(t)]], np.float32), (1, k))
+    n = np.tile(np.array([[0.0], [0.0], [1.0]], np.float32), (1, k))
+    return wo, n
+
+
+def test_normal_incidence_reflects_f0_and_refracts_straight_through():
+    k = 200000
+    wo, n = _incident(0.0, k)
+    u = np.random.default_rng(1).random(k, dtype=np.float32)
+    white = np.ones((3, k), np.float32)
+    wi, w, valid = sample_glass(wo, n, n, np.ones(k, bool), np.full(k, 1.5, np.float32), white, 0.5 * white, u)
+    reflected = wi[2] > 0
+    f0 = ((1.5 - 1) / (1.5 + 1)) ** 2
+    se = np.sqrt(f0 * (1 - f0) / k)
+    assert abs(reflected.mean() - f0) < 5 * se and valid.all()
+    assert np.allclose(wi[:, ~reflected], [[0], [0], [-1]], atol=1e-6)
+    assert np.allclose(w[:, reflected], 1.0) and np.allclose(w[:, ~reflected], 0.5)
+
+
+def test_snell_fresnel_and_total_internal_reflection():
+    k = 4000
+    for theta, front in ((40.0, True), (30.0, False), (45.0, False)):
+        wo, n = _incident(theta, k)
+        u = np.linspace(0, 1, k, endpoint=False, dtype=np.float32)
+        white = np.ones((3, k), np.float32)
+        wi, _w, valid = sample_glass(wo, n, n, np.full(k, front), np.full(k, 1.5, np.float32), white, white, u)
+        eta = 1.5 if front else 1 / 1.5
+        ci = np.cos(np.radians(theta))
+        s2 = (1 - ci * ci) / eta ** 2
+        refracted = wi[2] < 0
+        if s2 >= 1:  # beyond the critical angle (41.8° from inside): everything reflects
+            assert not refracted.any() and valid.all()
+            continue
+        ct = np.sqrt(1 - s2)
+        rs = (ci - eta * ct) / (ci + eta * ct)
+        rp = (eta * ci - ct) / (eta * ci + ct)
+        fresnel = 0.5 * (rs * rs + rp * rp)
+        assert abs((~refracted).mean() - fresnel) <= 1.0 / k + 1e-6  # u is a uniform grid: exact up to one step
+        t = wi[:, refracted]
+        assert np.allclose(np.sqrt(t[0] ** 2 + t[1] ** 2), np.sqrt(s2), atol=1e-5)  # Snell: sin θt = sin θi / η
+        assert np.allclose(-t[2], ct, atol=1e-5) and (t[0] < 0).all()  # continues forward, bent toward -n
+
+
+def test_glass_and_principled_transmission_are_exported(addon):
+    import pytest
+
+    from bpy_scenes import glass_material
+    from restir_engine.export.materials import MaterialRegistry
+    warnings = []
+    reg = MaterialRegistry(warnings)
+    glass = reg.rows[reg.material_index(glass_material("G", "GLASS", 1.33, (0.9, 0.8, 0.7)))]
+    assert glass["transmission"] == 1.0 and glass["glass_ior"] == pytest.approx(1.33)
+    assert glass["glass_reflect"] == glass["glass_refract"] == pytest.approx((0.9, 0.8, 0.7))
+    mat = glass_material("P", "PRINCIPLED", 1.5, (0.25, 1.0, 0.64), transmission=0.5)
+    mat.node_tree.nodes["Principled BSDF"].inputs["Metallic"].default_value = 0.2
+    row = reg.rows[reg.material_index(mat)]
+    assert row["transmission"] == pytest.approx(0.4)               # (1 - 0.2) x 0.5
+    assert row["metallic"] == pytest.approx(0.2 / 0.6)             # the rest: 0.2 metal + 0.4 dielectric
+    assert row["glass_refract"] == pytest.approx((0.5, 1.0, 0.8))  # sqrt(Base Color)
+    assert not warnings
+    rough = glass_material("R", "GLASS")
+    rough.node_tree.nodes["Glass BSDF"].inputs["Roughness"].default_value = 0.3
+    reg.material_index(rough)
+    assert any("rough glass" in w for w in warnings)
