@@ -270,14 +270,15 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.update_stats("ReSTIR", f"Viewport failed: {session.last_error}")
         if image is None:
             return
-        ih, iw = image.shape[:2]
-        buf = gpu.types.Buffer("FLOAT", iw * ih * 4, np.ascontiguousarray(image).ravel())
-        self._texture = gpu.types.GPUTexture((iw, ih), format="RGBA16F", data=buf)
+        if self._texture is None or self._texture[0] is not image:  # upload only a new image, not every redraw
+            ih, iw = image.shape[:2]
+            buf = gpu.types.Buffer("FLOAT", iw * ih * 4, np.ascontiguousarray(image).ravel())
+            self._texture = (image, gpu.types.GPUTexture((iw, ih), format="RGBA16F", data=buf))
         gpu.state.blend_set("ALPHA_PREMULT")
         data = session.image_pass in DATA_PASSES  # false colours and data: shown as they are, not tone-mapped
         if not data:
             self.bind_display_space_shader(depsgraph.scene)
-        draw_texture_2d(self._texture, (0, 0), context.region.width, context.region.height)
+        draw_texture_2d(self._texture[1], (0, 0), context.region.width, context.region.height)
         if not data:
             self.unbind_display_space_shader()
         gpu.state.blend_set("NONE")

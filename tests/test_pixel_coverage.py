@@ -99,3 +99,22 @@ def test_passes_spread_over_the_pixel():
     measured = e[:, edge].var(axis=0, ddof=1).mean()
     print(f"16-pass edge variance: {measured:.5f} against {independent:.5f} with independent jitter")
     assert measured < 0.5 * independent
+
+
+def test_coverage_rays_go_where_an_emitter_can_be_seen():
+    """Automatic coverage: the extra rays are cast only in the pixels an emitter's projection may touch (every
+    pixel the rectangle covers is among them, pixels far from it are not), and not at all when the emitters are
+    out of view; the image stays an unbiased estimate (tests above)."""
+    from restir_engine.core import pathtracer
+    from restir_engine.core.renderer import FrameRenderer
+    scene = emitter_on_floor()
+    r = FrameRenderer(scene, RenderSettings(samples=1, max_bounces=0))
+    assert r.coverage > 1 and r.coverage_mask is not None
+    mask = r.coverage_mask.reshape(WIDTH, WIDTH)
+    assert mask[exact_emission() > 0].all()
+    assert 0 < mask.mean() < 0.8 and not mask[0, 0] and not mask[-1, -1]
+    away = emitter_on_floor()
+    away.geometry.verts[2:, :, 0] += 50.0  # the rectangle far outside the view
+    ctx = pathtracer.build_context(away, 0)
+    assert coverage_samples(0, ctx.lights, ctx.scene.lamps, away.camera) == (1, "no emitter in view")
+    assert coverage_samples(0, ctx.lights, ctx.scene.lamps)[0] > 1  # without a camera: as before

@@ -87,3 +87,74 @@ def project(cam: Camera, points: np.ndarray):
     raster[:, 1] = (h[1] / w + 1) * np.float32(0.5 * cam.height)
     depth = -(zrow[0] * x + zrow[1] * y + zrow[2] * z + zrow[3])
     return raster, depth.astype(np.float32, copy=False)
+
+
+def spheres_in_view(cam: Camera, centers: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """(k,) bool: whether each sphere (centres (k, 3), radii (k,), world space) may overlap the camera's window:
+    False only where the sphere lies wholly outside one of the four side planes of the view volume (through the
+    rays of the window's corners, widened by one pixel). Conservative: near and far planes are not tested."""
+    x0, y0, w, h = cam.window
+    cx = np.array([x0 - 1, x0 + w + 1, x0 + w + 1, x0 - 1], np.float32)
+    cy = np.array([y0 - 1, y0 - 1, y0 + h + 1, y0 + h + 1], np.float32)
+    o, d, _far = generate_rays(cam, cx, cy)
+    o, d = o.T.astype(np.float64), d.T.astype(np.float64)
+    mid_o, mid_d, _f = generate_rays(cam, np.array([x0 + w / 2], np.float32), np.array([y0 + h / 2], np.float32))
+    inside = mid_o[:, 0].astype(np.float64) + mid_d[:, 0].astype(np.float64)  # a point inside the view volume
+    out = np.ones(len(centers), bool)
+    c = np.asarray(centers, np.float64)
+    for i in range(4):  # the four side planes (a loop over planes, not over spheres)
+        j = (i + 1) % 4
+        p1, p2, p3 = o[i], o[i] + d[i], o[j] + d[j]
+        n = np.cross(p2 - p1, p3 - p1)
+        ln = np.linalg.norm(n)
+        if not np.isfinite(ln) or ln < 1e-12:
+            continue
+        n /= ln
+        if np.dot(n, inside - p1) < 0:
+            n = -n
+        out &= (c - p1) @ n >= -np.asarray(radii, np.float64)
+    return out
+
+
+def emitter_pixels(cam: Camera, tris: np.ndarray, centers: np.ndarray, radii: np.ndarray,
+                   margin: float = 1.0) -> np.ndarray:
+    """(h, w) bool over the camera's window: the pixels that triangles (k, 3, 3) and spheres (centres (m, 3),
+    radii (m,)) may cover, world space. A triangle marks the box of its projected corners, a sphere the box around
+    the projections of its centre and of the six points at ± r along the world axes widened by half again (its
+    outline lies within it), each widened by ``margin`` pixels; anything reaching behind the camera's plane marks
+    the whole window. Vectorized: the boxes are summed into a difference array."""
+    x0, y0, w, h = cam.window
+    boxes = []
+    if len(tris):
+        raster, depth = project(cam, np.asarray(tris, np.float32).reshape(-1, 3).T)
+        if (depth <= 1e-6).any():
+            return np.ones((h, w), bool)
+        r = raster.reshape(-1, 3, 2)
+        boxes.append((r.min(axis=1) - margin, r.max(axis=1) + margin))
+    if len(centers):
+        c = np.asarray(centers, np.float32)
+        rad = np.asarray(radii, np.float32)
+        offs = np.concatenate([np.zeros((1, 3)), np.eye(3), -np.eye(3)]).astype(np.float32)  # (7, 3)
+        pts = (c[None, :, :] + offs[:, None, :] * rad[None, :, None]).reshape(-1, 3)
+        raster, depth = project(cam, pts.T)
+        if (depth <= 1e-6).any():
+            return np.ones((h, w), bool)
+        raster = raster.reshape(7, len(c), 2)
+        lo, hi = raster.min(axis=0), raster.max(axis=0)
+        mid, half = (lo + hi) / 2, (hi - lo) / 2 * 1.5 + margin
+        boxes.append((mid - half, mid + half))
+    if not boxes:
+        return np.zeros((h, w), bool)
+    lo = np.concatenate([b[0] for b in boxes])
+    hi = np.concatenate([b[1] for b in boxes])
+    bx0 = np.clip(np.floor(lo[:, 0] - x0), 0, w).astype(np.int64)
+    bx1 = np.clip(np.ceil(hi[:, 0] - x0), 0, w).astype(np.int64)
+    by0 = np.clip(np.floor(lo[:, 1] - y0), 0, h).astype(np.int64)
+    by1 = np.clip(np.ceil(hi[:, 1] - y0), 0, h).astype(np.int64)
+    ok = (bx1 > bx0) & (by1 > by0)
+    diff = np.zeros((h + 1, w + 1), np.int64)
+    np.add.at(diff, (by0[ok], bx0[ok]), 1)
+    np.add.at(diff, (by0[ok], bx1[ok]), -1)
+    np.add.at(diff, (by1[ok], bx0[ok]), -1)
+    np.add.at(diff, (by1[ok], bx1[ok]), 1)
+    return np.cumsum(np.cumsum(diff, axis=0), axis=1)[:h, :w] > 0

@@ -100,12 +100,13 @@ class RenderSettings:
     gi_target: str = "INTEGRAND"  # GI target function (gi.GI_TARGETS); the alternative is kept for measurements only
 
 
-def coverage_samples(setting: int, lights, lamps) -> tuple[int, str]:
+def coverage_samples(setting: int, lights, lamps, camera=None) -> tuple[int, str]:
     """Strata per pixel for the emission seen directly (a square number) and why: ``setting`` rounded down to a
-    square, or when 0 (automatic): 1 where the camera can see no emitter; MANY_COVERAGE where it sees many
-    emissive triangles (at least MANY_EMITTERS: small emitters partly covering many pixels), else AUTO_COVERAGE.
-    Measured (docs/RESULTS.md, "Pixel coverage"; relMSE of Combined at equal time against 1 ray): many_lights
-    10k 2.5x (4 rays) and 3.6x (16), 1k 1.8x and 1.6x, the Cornell box 1.05x and 0.8x."""
+    square, or when 0 (automatic): 1 where the camera can see no emitter (none visible to camera rays, or, given
+    the ``camera``, none inside its view); MANY_COVERAGE where it sees many emissive triangles (at least
+    MANY_EMITTERS: small emitters partly covering many pixels), else AUTO_COVERAGE. Measured (docs/RESULTS.md,
+    "Pixel coverage"; relMSE of Combined at equal time against 1 ray): many_lights 10k 2.5x (4 rays) and 3.6x
+    (16), 1k 1.8x and 1.6x, the Cornell box 1.05x and 0.8x."""
     if setting > 0:
         g = max(1, int(np.sqrt(setting + 1e-9)))
         return g * g, "set by the user"
@@ -113,8 +114,51 @@ def coverage_samples(setting: int, lights, lamps) -> tuple[int, str]:
     if lights.n_geom >= MANY_EMITTERS:
         return MANY_COVERAGE, f"{lights.n_geom} emissive triangles: small emitters partly cover many pixels"
     if lights.n_geom > 0 or lamps_seen:
+        if camera is not None and not _emitters_in_view(camera, lights, lamps):
+            return 1, "no emitter in view"
         return AUTO_COVERAGE, "emitters can be seen directly"
     return 1, "no emitter can be seen directly"
+
+
+def _seen_emitter_spheres(lights, lamps):
+    """Bounding spheres (centres (k, 3), radii (k,)) of the emitters camera rays can see: emissive triangles, and
+    lamps visible to camera rays (point/spot spheres by their radius)."""
+    v = lights.tri_verts.astype(np.float64)
+    if len(v) == 0:
+        return np.zeros((0, 3)), np.zeros(0)
+    centers = v.mean(axis=1)
+    radii = np.linalg.norm(v - centers[:, None, :], axis=2).max(axis=1)
+    sph = lights.sphere_r > 0
+    centers[sph] = v[sph, 0]
+    radii[sph] = lights.sphere_r[sph]
+    seen = _seen_lights(lights, lamps)
+    return centers[seen], radii[seen] * 1.001 + 1e-6
+
+
+def _seen_lights(lights, lamps) -> np.ndarray:
+    """(n_tri,) bool: the light entries camera rays can see (emissive triangles; lamps visible to the camera)."""
+    seen = np.ones(lights.n_tri, bool)
+    if len(lights.lamp_ids):
+        seen[lights.n_geom:] = lamps.camera_visible[lights.lamp_ids]
+    return seen
+
+
+def _emitters_in_view(camera, lights, lamps) -> bool:
+    """Whether a bounding sphere of an emitter the camera can see overlaps the camera's view."""
+    centers, radii = _seen_emitter_spheres(lights, lamps)
+    return bool(len(centers) and camera_mod.spheres_in_view(camera, centers, radii).any())
+
+
+def coverage_pixels(camera, lights, lamps):
+    """(h * w,) bool: the pixels near an emitter the camera can see, where the extra coverage rays pay (elsewhere
+    the shaded ray's emission alone is the estimate: both unbiased); None (every pixel) from MANY_EMITTERS on."""
+    if lights.n_geom >= MANY_EMITTERS:
+        return None
+    v = lights.tri_verts
+    seen = _seen_lights(lights, lamps)
+    sph = lights.sphere_r > 0
+    tri = seen & ~sph
+    return camera_mod.emitter_pixels(camera, v[tri], v[seen & sph, 0], lights.sphere_r[seen & sph] * 1.001).ravel()
 
 
 AUTO_COVERAGE = 4
@@ -252,8 +296,6 @@ class FrameRenderer:
                                                 lamps.sun_irradiance, self.ctx.scene.world_radiance,
                                                 getattr(self.ctx.scene, "world_image", None))
         self.space = di.LightSpace(self.ctx.lights)
-        self.coverage, self.coverage_reason = coverage_samples(settings.coverage_samples, self.ctx.lights,
-                                                               self.ctx.scene.lamps)
         self.build_seconds = time.perf_counter() - t0
         self.set_camera(scene.camera)
         if history is not None and history.fits(scene.camera):
@@ -287,6 +329,11 @@ class FrameRenderer:
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
         self.ctx.scene.camera = camera
+        self.coverage, self.coverage_reason = coverage_samples(self.settings.coverage_samples, self.ctx.lights,
+                                                               self.ctx.scene.lamps, camera)
+        self.coverage_mask = None  # the pixels that get the coverage rays (None: all)
+        if self.coverage > 1 and self.settings.coverage_samples == 0:
+            self.coverage_mask = coverage_pixels(camera, self.ctx.lights, self.ctx.scene.lamps)
         _x0, _y0, w, h = camera.window
         self.release()
         self.acc = {"emit": _BUFFERS.zeros((h, w, 3)), "direct": _BUFFERS.zeros((h, w, 3)),
@@ -387,6 +434,7 @@ class FrameRenderer:
         ctx = self.ctx
 
         strata = self.coverage
+        cover = self.coverage_mask
 
         def primary(c: _Chunk):
             r = rng(st.seed, st.frame, s, STREAM_CAMERA, c.index)
@@ -399,17 +447,21 @@ class FrameRenderer:
                 c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
                 return
             # the shaded ray where the pass puts it (uniform over the pixel, so uniform within the stratum it
-            # falls in), one more ray in each other stratum
+            # falls in), one more ray in each other stratum, in the pixels near an emitter (coverage_mask)
             g = int(round(np.sqrt(strata)))
             c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
-            k0 = np.minimum((j[:, 0] * g).astype(np.int64), g - 1) + g * np.minimum((j[:, 1] * g).astype(np.int64), g - 1)
+            sel = slice(None) if cover is None else np.flatnonzero(cover[c.pixels])
+            jx, jy, sx, sy = j[sel, 0], j[sel, 1], px[sel], py[sel]
+            if len(jx) == 0:
+                return
+            k0 = np.minimum((jx * g).astype(np.int64), g - 1) + g * np.minimum((jy * g).astype(np.int64), g - 1)
             k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
             jj = r.random((2,) + k.shape, dtype=np.float32)
-            em, al = pathtracer.seen_emission(ctx, (px + ((k % g).astype(np.float32) + jj[0]) / g).ravel(),
-                                              (py + ((k // g).astype(np.float32) + jj[1]) / g).ravel())
+            em, al = pathtracer.seen_emission(ctx, (sx + ((k % g).astype(np.float32) + jj[0]) / g).ravel(),
+                                              (sy + ((k // g).astype(np.float32) + jj[1]) / g).ravel())
             inv = np.float32(1.0 / strata)
-            c.hits.emitted = (c.hits.emitted + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
-            c.hits.alpha = (c.hits.alpha + al.reshape(strata - 1, -1).sum(axis=0)) * inv
+            c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
+            c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
 
         with clock.stage("primary"):
             self._map(primary, chunks, stop)
