@@ -395,10 +395,11 @@ def glass_material(name, kind, ior=1.45, color=(1.0, 1.0, 1.0), transmission=1.0
     return m
 
 
-def glass_scene(size=(96, 64), only=None):
+def glass_scene(size=(96, 64), only=None, window=False):
     """Three smooth glass spheres in front of a checkered wall on a grey floor, lit by an area light from above
     and the front: a Glass BSDF (IOR 1.45), a tinted Principled with Transmission 1 (IOR 1.5) and a red Principled
-    with Transmission 0.5 (half glass, half diffuse under a clear coat of reflection); ``only``: just that one."""
+    with Transmission 0.5 (half glass, half diffuse under a clear coat of reflection); ``only``: just that one;
+    ``window``: a 2 cm glass pane across the lower half of the view in front of them."""
     scene = reset()
     plane("Floor", 8, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
     wall = principled("Checker wall", (1, 1, 1), roughness=1.0)
@@ -414,6 +415,11 @@ def glass_scene(size=(96, 64), only=None):
         bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(x, 0.0, 0.5), segments=48, ring_count=24)
         bpy.ops.object.shade_smooth()
         bpy.context.active_object.data.materials.append(mat)
+    if window:
+        bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, -2.6, 0.6))
+        pane = bpy.context.active_object
+        pane.scale = (4.0, 0.02, 1.2)
+        pane.data.materials.append(glass_material("Pane", "GLASS", 1.5))
     light("AREA", (0, -2.0, 3.5), (math.radians(30), 0, 0), energy=400.0, size=2.0)
     camera((0, -4.2, 1.3), (math.radians(83), 0, 0), lens=35)
     black_world(scene)

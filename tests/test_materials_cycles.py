@@ -186,22 +186,24 @@ def test_bump_maps_match_cycles(addon):
     assert_cells_match(*path_vs_cycles_cells(bump_scene, 0), [f"cell {k}" for k in range(16)], power=range(16))
 
 
-@pytest.mark.parametrize("integrator", ["PATH", "RESTIR"])
-def test_smooth_glass_matches_cycles(addon, integrator):
+@pytest.mark.parametrize("integrator,window", [("PATH", False), ("RESTIR", False), ("RESTIR", True)])
+def test_smooth_glass_matches_cycles(addon, integrator, window):
     """Smooth glass spheres (a Glass BSDF, a tinted Principled with Transmission 1, a half-transmissive red
     Principled) before a checkered wall, 4 bounces: refraction, reflection, total internal reflection and the
     caustics under them (BSDF paths through delta interfaces hitting the lamp), by the path tracer and by the
-    default integrator (light seen through glass is path traced behind the glass), per 4 x 4 image cell, every
-    cell able to see a 3 % error. (With Base Color tinting each crossing instead of its square root, as Cycles'
-    Principled does, the tinted sphere's cells read 4 % dark.)"""
+    default integrator (camera paths continue through the glass to the surface behind, where resampling runs,
+    with the bounces they have left), also with a glass pane across the lower half of the view; per 4 x 4 image
+    cell, every cell able to see a 3 % error except cells 8-10 (the spheres' caustics: rel SE 0.4-0.6 %, so
+    5 SE + 0.5 % reaches 3 %; they are held to the bound only). (With Base Color tinting each crossing instead of
+    its square root, as Cycles' Principled does, the tinted sphere's cells read 4 % dark.)"""
     from bpy_scenes import glass_scene
     size = (96, 64)
     cells = image_cells(size)
     kw = {"integrator": "PATH"} if integrator == "PATH" else {}
-    ours = render_reps(lambda: glass_scene(size), "RESTIR", 4, 64, **kw)
-    ref = render_reps(lambda: glass_scene(size), "CYCLES", 4, 128)
+    ours = render_reps(lambda: glass_scene(size, window=window), "RESTIR", 4, 64, **kw)
+    ref = render_reps(lambda: glass_scene(size, window=window), "CYCLES", 4, 128)
     assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
-                       power=range(16))
+                       power=[k for k in range(16) if k not in (8, 9, 10)])
 
 
 def test_rough_diffuse_matches_cycles(addon):

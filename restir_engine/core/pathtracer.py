@@ -147,21 +147,23 @@ def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax))
 
 
-def _seen(ctx: TraceContext, o, d, tmax, hits):
+def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True):
     """Emission (3, n) camera rays meet first: visible lamps in front of the hit, emissive surfaces, the world
     where nothing is hit (unless the film is transparent); alpha (n,) 0 where nothing is hit on a transparent
-    film."""
+    film. ``camera`` False: rays continuing a camera ray through delta interfaces (every lamp is seen, the film's
+    transparency does not apply)."""
     n = len(hits.prim)
     emitted = np.zeros((3, n), np.float32)
     alpha = np.ones(n, np.float32)
     if len(ctx.scene.lamps.tris):  # lamps seen by the camera (those marked visible to camera rays)
-        lh = lamp_hits(ctx, o, d, np.minimum(hits.t, tmax))
+        lh = lamp_hits(ctx, o, d, hits.t if tmax is None else np.minimum(hits.t, tmax))
         sel = np.flatnonzero(lh.prim >= 0)
-        sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
+        if camera:
+            sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
         if sel.size:
             emitted[:, sel] += _lamp_emission(ctx, lh, o, d, sel)[0]
     miss = hits.prim < 0
-    if ctx.film_transparent:
+    if ctx.film_transparent and camera:
         alpha[miss] = 0.0
     elif miss.any():
         m = np.flatnonzero(miss)
@@ -173,6 +175,67 @@ def _seen(ctx: TraceContext, o, d, tmax, hits):
             emitted[:, em] += emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em],
                                                hits.v[em])
     return finite(emitted), alpha
+
+
+@dataclass
+class SpecularChains:
+    """Camera paths continued through smooth glass to the first other surface (:func:`follow_specular`): per
+    remaining hit row, the throughput (3, k) of the delta interfaces crossed and their number ``depth`` (k,)."""
+
+    throughput: np.ndarray
+    depth: np.ndarray
+
+
+def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generator) -> SpecularChains | None:
+    """Continue the camera rays that met smooth glass through its delta interfaces (reflection or refraction
+    drawn by Fresnel) until they meet another surface, in place: ``hits.surf`` becomes that surface (so resampling
+    runs where the light is actually shaded), the emission met on the way (lamps, emissive surfaces, the world,
+    times the throughput so far; MIS weight 1 after a delta interface) joins ``hits.emitted``, and rows that
+    escape, die on a shading-normal artefact or exceed the bounce budget leave ``hits.rows``. Returns the chains
+    (None when no camera ray met glass)."""
+    s = hits.surf
+    if s.glass is None or ctx.max_bounces == 0:
+        return None
+    n = len(hits.rows)
+    prim, b1, b2 = s.prim.copy(), s.b1.copy(), s.b2.copy()
+    o, d, t = s.p.copy(), -s.wo, np.zeros(n, np.float32)
+    thr = np.ones((3, n), np.float32)
+    depth = np.zeros(n, np.int64)
+    alive = np.ones(n, bool)
+    idx = np.flatnonzero(s.glass)
+    cur = s.take(idx)
+    for k in range(ctx.max_bounces + 1):  # as the path tracer: rays from vertices 0..max_bounces find emission,
+        ray = sample_rays(cur, rng.random((3, len(idx)), dtype=np.float32))  # vertices up to max_bounces are shaded
+        alive[np.setdiff1d(idx, idx[ray.rows])] = False
+        idx = idx[ray.rows]
+        if idx.size == 0:
+            break
+        thr[:, idx] *= ray.f
+        depth[idx] += 1
+        hit = ctx.geom_accel.intersect(ray.o, ray.d)
+        em, _a = _seen(ctx, ray.o, ray.d, None, hit, camera=False)
+        pix = hits.rows[idx]
+        hits.emitted[:, pix] += finite(cols(thr, idx) * em)
+        got = (hit.prim >= 0) & (depth[idx] <= ctx.max_bounces)
+        alive[idx[~got]] = False
+        sel = np.flatnonzero(got)
+        idx = idx[sel]
+        if idx.size == 0:
+            break
+        prim[idx], b1[idx], b2[idx], t[idx] = hit.prim[sel], hit.u[sel], hit.v[sel], hit.t[sel]
+        o[:, idx], d[:, idx] = cols(ray.o, sel), cols(ray.d, sel)
+        cur = Surface(ctx, prim[idx], b1[idx], b2[idx], o[:, idx], d[:, idx], t[idx])
+        more = np.zeros(len(idx), bool) if cur.glass is None else cur.glass
+        if not more.any():
+            idx = idx[:0]
+            break
+        cur = cur.take(np.flatnonzero(more))
+        idx = idx[more]
+    alive[idx] = False  # still on glass when the bounce budget ran out
+    keep = np.flatnonzero(alive)
+    hits.rows = hits.rows[keep]
+    hits.surf = Surface(ctx, prim[keep], b1[keep], b2[keep], o[:, keep], d[:, keep], t[keep])
+    return SpecularChains(thr[:, keep], depth[keep])
 
 
 def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False):
@@ -314,12 +377,13 @@ class FirstBounce:
 
 
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
-                   first_ray=None, first_bounce: bool = False):
+                   first_ray=None, first_bounce: bool = False, budget: np.ndarray | None = None):
     """Continue paths from primary surfaces s (n). Returns (direct (3, n): the first BSDF ray's emitter hits
     (MIS-weighted; none when ``direct_resampled``) and the world it escapes to; indirect (3, n): bounces
     1..max_bounces). ``first_ray`` (a traced :class:`BsdfRay` from s, e.g. ReSTIR's BSDF candidate) is used as
     the first ray instead of drawing a new one. With ``first_bounce`` a third value, :class:`FirstBounce`, tells
-    where the first rays went and what radiance left there (indirect is then its throughput · lo)."""
+    where the first rays went and what radiance left there (indirect is then its throughput · lo). ``budget`` (n,)
+    (optional): the bounces each path may still take (fewer than max_bounces behind a specular chain)."""
     n = len(s)
     direct = np.zeros((3, n), np.float32)
     indirect = np.zeros((3, n), np.float32)
@@ -402,6 +466,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         if hsel.size == 0:
             break
         hp = hits.prim[hsel]
+        last = None if budget is None else budget[idx[hsel]] <= bounce  # this path's bounces are spent
         if collect is None or collect.any():
             light = ctx.lights.geom_to_light[hp]
             em = np.flatnonzero((light >= 0) if collect is None else (light >= 0) & collect[hsel])
@@ -417,6 +482,10 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
                     first.lo_d[:, idx[hs]] += finite(cols(dthr, hs) * le)
         if bounce == ctx.max_bounces:
             break
+        if last is not None and last.any():
+            hsel, hp = hsel[~last], hp[~last]
+            if hsel.size == 0:
+                break
         idx, throughput = idx[hsel], cols(throughput, hsel)
         if dthr is not None:
             dthr = cols(dthr, hsel)
@@ -425,6 +494,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             # from here on the path estimates the radiance leaving x2: throughput 1, accumulated per first hit
             first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.ng, s.params,
                                 np.zeros((3, len(idx)), np.float32), np.zeros((3, len(idx)), np.float32))
+            if budget is not None:
+                budget = budget[idx]
             idx = np.arange(len(idx))
             throughput = np.ones((3, len(idx)), np.float32)
     if not first_bounce:

@@ -43,7 +43,7 @@ from .profile import NullClock
 from .restir import di, gi, reuse
 from .restir.gbuffer import GBuffer
 from .restir.history import TemporalHistory
-from .sampling import (STREAM_CAMERA, STREAM_GI_SPATIAL, STREAM_GI_TEMPORAL, STREAM_INITIAL, STREAM_PATH,
+from .sampling import (STREAM_CAMERA, STREAM_GI_SPATIAL, STREAM_CHAIN, STREAM_GI_TEMPORAL, STREAM_INITIAL, STREAM_PATH,
                        STREAM_PIXEL_OFFSET, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, STREAM_TILES, finite,
                        pass_jitter, rng)
 from .scene import Scene
@@ -229,6 +229,7 @@ class _Chunk:
     path_indirect: np.ndarray = None  # the path tracer's indirect light (used when a pass skips GI reuse)
     gi_share: tuple = (0.0, 0.0)  # luminance sums: (path-traced indirect light, the part the reservoirs carry)
     glossy: np.ndarray = None  # (surfaces,) bool: GI resamples only the diffuse lobe there (gi.glossy_x1)
+    chain: object = None   # pathtracer.SpecularChains: its surfaces seen through smooth glass (ReSTIR)
 
     @property
     def surfaces(self) -> slice:
@@ -445,6 +446,7 @@ class FrameRenderer:
             py = (y0 + c.pixels // w).astype(np.float32)
             if strata == 1:
                 c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
+                through_glass(c)
                 return
             # the shaded ray where the pass puts it (uniform over the pixel, so uniform within the stratum it
             # falls in), one more ray in each other stratum, in the pixels near an emitter (coverage_mask)
@@ -453,6 +455,7 @@ class FrameRenderer:
             sel = slice(None) if cover is None else np.flatnonzero(cover[c.pixels])
             jx, jy, sx, sy = j[sel, 0], j[sel, 1], px[sel], py[sel]
             if len(jx) == 0:
+                through_glass(c)
                 return
             k0 = np.minimum((jx * g).astype(np.int64), g - 1) + g * np.minimum((jy * g).astype(np.int64), g - 1)
             k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
@@ -462,6 +465,12 @@ class FrameRenderer:
             inv = np.float32(1.0 / strata)
             c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
             c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
+            through_glass(c)
+
+        def through_glass(c: _Chunk):
+            # ReSTIR: camera rays that met smooth glass continue to the surface behind it, where resampling runs
+            if st.integrator == "RESTIR" and ctx.has_glass:
+                c.chain = pathtracer.follow_specular(ctx, c.hits, rng(st.seed, st.frame, s, STREAM_CHAIN, c.index))
 
         with clock.stage("primary"):
             self._map(primary, chunks, stop)
@@ -507,7 +516,8 @@ class FrameRenderer:
                 return
             out = pathtracer.continue_paths(
                 ctx, c.hits.surf, rng(st.seed, st.frame, s, STREAM_PATH, c.index), direct_resampled=resampled,
-                first_ray=c.bsdf_ray, first_bounce=gi_on)
+                first_ray=c.bsdf_ray, first_bounce=gi_on,
+                budget=None if c.chain is None else ctx.max_bounces - c.chain.depth)
             c.bsdf_ray = None
             c.direct, c.indirect = out[0], out[1]
             if gi_on:
@@ -709,9 +719,10 @@ class FrameRenderer:
             flat["alpha"][span] += c.hits.alpha
             hit = c.hits.rows
             pix = span if len(hit) == len(c.pixels) else c.pixels[hit]  # every pixel hit: a slice, no scatter
+            chain = None if c.chain is None else c.chain.throughput  # what the glass in front passes
             for key, value in (("direct", c.direct), ("indirect", c.indirect)):
                 if value is not None:
-                    flat[key][pix] += np.ascontiguousarray(value.T)
+                    flat[key][pix] += np.ascontiguousarray((value if chain is None else value * chain).T)
             if resampled:
                 flat["res_m"][pix] += c.res.M
                 flat["res_w"][pix] += c.res.W
@@ -720,7 +731,8 @@ class FrameRenderer:
                 flat["gi_w"][pix] += c.gi_res.W
             if "albedo" in flat and len(hit):
                 surf = c.hits.surf
-                flat["albedo"][pix] += np.ascontiguousarray(denoising_albedo(surf).T)
+                albedo = denoising_albedo(surf)
+                flat["albedo"][pix] += np.ascontiguousarray((albedo if chain is None else albedo * chain).T)
                 flat["dnormal"][pix] += np.ascontiguousarray((world_to_cam @ surf.ns).T)
 
         world_to_cam = np.ascontiguousarray(self.ctx.scene.camera.cam_to_world[:3, :3].T, dtype=np.float32)
