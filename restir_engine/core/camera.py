@@ -89,33 +89,6 @@ def project(cam: Camera, points: np.ndarray):
     return raster, depth.astype(np.float32, copy=False)
 
 
-def spheres_in_view(cam: Camera, centers: np.ndarray, radii: np.ndarray) -> np.ndarray:
-    """(k,) bool: whether each sphere (centres (k, 3), radii (k,), world space) may overlap the camera's window:
-    False only where the sphere lies wholly outside one of the four side planes of the view volume (through the
-    rays of the window's corners, widened by one pixel). Conservative: near and far planes are not tested."""
-    x0, y0, w, h = cam.window
-    cx = np.array([x0 - 1, x0 + w + 1, x0 + w + 1, x0 - 1], np.float32)
-    cy = np.array([y0 - 1, y0 - 1, y0 + h + 1, y0 + h + 1], np.float32)
-    o, d, _far = generate_rays(cam, cx, cy)
-    o, d = o.T.astype(np.float64), d.T.astype(np.float64)
-    mid_o, mid_d, _f = generate_rays(cam, np.array([x0 + w / 2], np.float32), np.array([y0 + h / 2], np.float32))
-    inside = mid_o[:, 0].astype(np.float64) + mid_d[:, 0].astype(np.float64)  # a point inside the view volume
-    out = np.ones(len(centers), bool)
-    c = np.asarray(centers, np.float64)
-    for i in range(4):  # the four side planes (a loop over planes, not over spheres)
-        j = (i + 1) % 4
-        p1, p2, p3 = o[i], o[i] + d[i], o[j] + d[j]
-        n = np.cross(p2 - p1, p3 - p1)
-        ln = np.linalg.norm(n)
-        if not np.isfinite(ln) or ln < 1e-12:
-            continue
-        n /= ln
-        if np.dot(n, inside - p1) < 0:
-            n = -n
-        out &= (c - p1) @ n >= -np.asarray(radii, np.float64)
-    return out
-
-
 def emitter_pixels(cam: Camera, tris: np.ndarray, centers: np.ndarray, radii: np.ndarray,
                    margin: float = 1.0) -> np.ndarray:
     """(h, w) bool over the camera's window: the pixels that triangles (k, 3, 3) and spheres (centres (m, 3),

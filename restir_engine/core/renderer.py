@@ -114,25 +114,10 @@ def coverage_samples(setting: int, lights, lamps, camera=None) -> tuple[int, str
     if lights.n_geom >= MANY_EMITTERS:
         return MANY_COVERAGE, f"{lights.n_geom} emissive triangles: small emitters partly cover many pixels"
     if lights.n_geom > 0 or lamps_seen:
-        if camera is not None and not _emitters_in_view(camera, lights, lamps):
+        if camera is not None and not coverage_pixels(camera, lights, lamps).any():
             return 1, "no emitter in view"
         return AUTO_COVERAGE, "emitters can be seen directly"
     return 1, "no emitter can be seen directly"
-
-
-def _seen_emitter_spheres(lights, lamps):
-    """Bounding spheres (centres (k, 3), radii (k,)) of the emitters camera rays can see: emissive triangles, and
-    lamps visible to camera rays (point/spot spheres by their radius)."""
-    v = lights.tri_verts.astype(np.float64)
-    if len(v) == 0:
-        return np.zeros((0, 3)), np.zeros(0)
-    centers = v.mean(axis=1)
-    radii = np.linalg.norm(v - centers[:, None, :], axis=2).max(axis=1)
-    sph = lights.sphere_r > 0
-    centers[sph] = v[sph, 0]
-    radii[sph] = lights.sphere_r[sph]
-    seen = _seen_lights(lights, lamps)
-    return centers[seen], radii[seen] * 1.001 + 1e-6
 
 
 def _seen_lights(lights, lamps) -> np.ndarray:
@@ -141,12 +126,6 @@ def _seen_lights(lights, lamps) -> np.ndarray:
     if len(lights.lamp_ids):
         seen[lights.n_geom:] = lamps.camera_visible[lights.lamp_ids]
     return seen
-
-
-def _emitters_in_view(camera, lights, lamps) -> bool:
-    """Whether a bounding sphere of an emitter the camera can see overlaps the camera's view."""
-    centers, radii = _seen_emitter_spheres(lights, lamps)
-    return bool(len(centers) and camera_mod.spheres_in_view(camera, centers, radii).any())
 
 
 def coverage_pixels(camera, lights, lamps):
