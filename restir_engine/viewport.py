@@ -122,7 +122,6 @@ def pass_image(renderer: FrameRenderer, name: str) -> tuple[np.ndarray, dict]:
     direct light is not resampled) is black, with the reason."""
     acc = renderer.acc
     h, w = acc["alpha"].shape
-    inv = np.float32(1.0 / max(1, renderer.samples_done))
     out = np.zeros((h, w, 4), np.float32)
     out[..., 3] = 1.0
     info: dict = {}
@@ -130,7 +129,7 @@ def pass_image(renderer: FrameRenderer, name: str) -> tuple[np.ndarray, dict]:
         return renderer.combined(), info
     light = {"DIRECT": "direct", "INDIRECT": "indirect", "EMISSION": "emit"}
     if name in light:
-        out[..., :3] = acc[light[name]] * inv
+        out[..., :3] = renderer.mean(light[name])
         return out, info
     if name in ("RES_M", "RES_UCW", "GI_M", "GI_UCW"):
         key = {"RES_M": "res_m", "RES_UCW": "res_w", "GI_M": "gi_m", "GI_UCW": "gi_w"}[name]
@@ -138,7 +137,7 @@ def pass_image(renderer: FrameRenderer, name: str) -> tuple[np.ndarray, dict]:
             info["missing"] = "no reservoirs: " + ("ReSTIR GI is off" if name.startswith("GI")
                                                    else f"the direct light uses {renderer.method}")
             return out, info
-        mean = acc[key] * inv
+        mean = renderer.mean(key)[..., 0]
         if name.endswith("_M"):
             out[..., :3] = m_colour(mean)
             info["mean"] = float(mean[mean > 0].mean()) if (mean > 0).any() else 0.0
@@ -174,9 +173,7 @@ class ViewportStats:
     mean_m: float | None = None     # mean ReSTIR DI confidence over the pixels with a surface (None: no DI reservoirs)
     gi_mean_m: float | None = None  # the same for ReSTIR GI
     navigation_passes: int = 0    # passes rendered right after a view change
-    interrupted_passes: int = 0   # refinement passes stopped by a view change, an edit or a stop
-    scenes: int = 0               # scenes (exports) the session rendered
-    extra: dict = field(default_factory=dict)
+    extra: dict = field(default_factory=dict)  # the shown pass's mapping facts (pass_image): range, missing
 
     def text(self) -> str:
         s = f"Viewport | {self.samples} samples | {self.width}x{self.height}"
@@ -187,6 +184,11 @@ class ViewportStats:
             s += f" | mean M {self.mean_m:.1f}"
         if self.gi_mean_m is not None:
             s += f" | GI mean M {self.gi_mean_m:.1f}"
+        if "range" in self.extra:
+            lo, hi = self.extra["range"]
+            s += f" | range {lo:.3g} to {hi:.3g}"
+        if "missing" in self.extra:
+            s += f" | {self.extra['missing']}"
         return s
 
 
@@ -340,7 +342,6 @@ class ViewportSession:
         if old is not None:
             old.release()
         self._key = None  # the next pass is a navigation pass: an edit's first image comes as fast as a move's
-        self.stats.scenes += 1
 
     def _move(self, camera: Camera, key) -> None:
         """Point the renderer at the view (at the current divider); the scene's motion holds the previous view
@@ -375,7 +376,6 @@ class ViewportSession:
             self._navigating = False
         seconds = self.clock() - t0
         if not done:
-            self.stats.interrupted_passes += 1
             return
         _x0, _y0, w, h = r.ctx.scene.camera.window
         per_pixel = seconds / max(1, w * h)

@@ -66,16 +66,22 @@ MIX_GRID = [[
 ]]
 
 
-def checker_image(name="Checker", n=8):
-    """An n x n black/white checker (Non-Color), made in memory."""
-    img = bpy.data.images.new(name, n, n, float_buffer=True)
+def packed_image(name, rgb: np.ndarray):
+    """A Non-Color float image made in memory from ``rgb`` (h, w, 3), row 0 at the bottom, alpha 1, packed."""
+    h, w = rgb.shape[:2]
+    img = bpy.data.images.new(name, w, h, float_buffer=True)
     img.colorspace_settings.name = "Non-Color"
-    ij = np.add.outer(np.arange(n), np.arange(n)) % 2
-    px = np.repeat(ij.astype(np.float32)[..., None], 4, axis=2)
-    px[..., 3] = 1
+    px = np.ones((h, w, 4), np.float32)
+    px[..., :3] = rgb
     img.pixels.foreach_set(px.ravel())
     img.pack()
     return img
+
+
+def checker_image(name="Checker", n=8):
+    """An n x n black/white checker (Non-Color), made in memory."""
+    ij = (np.add.outer(np.arange(n), np.arange(n)) % 2).astype(np.float32)
+    return packed_image(name, np.repeat(ij[..., None], 3, axis=2))
 
 
 def _shader_node(tree, spec):
@@ -292,29 +298,31 @@ def world_scene(kind="IMAGE", size=(96, 64), rotation_z=0.0):
 
 def bump_normal_image(name="Bumps", n=64, waves=4, slope=0.6):
     """A tangent-space normal map (Non-Color) of ridges along u: normal ∝ (-slope cos(2π waves u), 0, 1)."""
-    img = bpy.data.images.new(name, n, n, float_buffer=True)
-    img.colorspace_settings.name = "Non-Color"
     u = (np.arange(n) + 0.5) / n
     nx = -slope * np.cos(2 * np.pi * waves * u)
     nrm = np.stack([nx, np.zeros(n), np.ones(n)], axis=1)
     nrm /= np.linalg.norm(nrm, axis=1)[:, None]
-    px = np.ones((n, n, 4), np.float32)
-    px[..., :3] = (0.5 + 0.5 * nrm)[None, :, :]
-    img.pixels.foreach_set(px.ravel())
-    img.pack()
-    return img
+    return packed_image(name, np.broadcast_to((0.5 + 0.5 * nrm)[None, :, :], (n, n, 3)))
 
 
-def _ridged(name, strength):
+def _image_normal(name, image, node_type, image_socket, **inputs):
+    """A Principled BSDF (roughness 0.4) whose Normal comes from a ``node_type`` node (inputs set from
+    ``inputs``) fed by an Image Texture of ``image`` on its ``image_socket``; returns (material, node)."""
     m = principled(name, (0.7, 0.6, 0.5), roughness=0.4)
     tree = m.node_tree
     tex = tree.nodes.new("ShaderNodeTexImage")
-    tex.image = bpy.data.images.get("Bumps") or bump_normal_image()
-    nmap = tree.nodes.new("ShaderNodeNormalMap")
-    nmap.inputs["Strength"].default_value = strength
-    tree.links.new(tex.outputs["Color"], nmap.inputs["Color"])
-    tree.links.new(nmap.outputs["Normal"], tree.nodes["Principled BSDF"].inputs["Normal"])
-    return m
+    tex.image = image
+    node = tree.nodes.new(node_type)
+    for key, value in inputs.items():
+        node.inputs[key].default_value = value
+    tree.links.new(tex.outputs["Color"], node.inputs[image_socket])
+    tree.links.new(node.outputs["Normal"], tree.nodes["Principled BSDF"].inputs["Normal"])
+    return m, node
+
+
+def _ridged(name, strength):
+    image = bpy.data.images.get("Bumps") or bump_normal_image()
+    return _image_normal(name, image, "ShaderNodeNormalMap", "Color", Strength=strength)[0]
 
 
 def normal_map_scene(size=(96, 64), sphere=False):
@@ -339,27 +347,14 @@ def normal_map_scene(size=(96, 64), sphere=False):
 
 def ridge_height_image(name="Heights", n=64, waves=4):
     """A Non-Color height map of ridges along u: H = 0.5 + 0.5 sin(2π waves u), grey."""
-    img = bpy.data.images.new(name, n, n, float_buffer=True)
-    img.colorspace_settings.name = "Non-Color"
     h = 0.5 + 0.5 * np.sin(2 * np.pi * waves * (np.arange(n) + 0.5) / n)
-    px = np.ones((n, n, 4), np.float32)
-    px[..., :3] = h[None, :, None]
-    img.pixels.foreach_set(px.ravel())
-    img.pack()
-    return img
+    return packed_image(name, np.broadcast_to(h[None, :, None], (n, n, 3)))
 
 
 def _bumped(name, strength, distance, invert=False):
-    m = principled(name, (0.7, 0.6, 0.5), roughness=0.4)
-    tree = m.node_tree
-    tex = tree.nodes.new("ShaderNodeTexImage")
-    tex.image = bpy.data.images.get("Heights") or ridge_height_image()
-    bump = tree.nodes.new("ShaderNodeBump")
-    bump.inputs["Strength"].default_value = strength
-    bump.inputs["Distance"].default_value = distance
+    image = bpy.data.images.get("Heights") or ridge_height_image()
+    m, bump = _image_normal(name, image, "ShaderNodeBump", "Height", Strength=strength, Distance=distance)
     bump.invert = invert
-    tree.links.new(tex.outputs["Color"], bump.inputs["Height"])
-    tree.links.new(bump.outputs["Normal"], tree.nodes["Principled BSDF"].inputs["Normal"])
     return m
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bsdf import fresnel_exact
 from .sampling import dot
 
 DELTA_PDF = np.float32(1e15)  # "pdf" of a delta direction: power_heuristic(DELTA_PDF, any light pdf) = 1
@@ -31,10 +32,8 @@ def sample_glass(wo: np.ndarray, n: np.ndarray, ng: np.ndarray, front: np.ndarra
     sin2_t = (1.0 - c * c) / (eta * eta)
     tir = sin2_t >= 1.0
     cos_t = np.sqrt(np.maximum(0.0, 1.0 - sin2_t))
-    # exact dielectric Fresnel from cos θi, cos θt (s and p polarizations averaged)
-    rs = (c - eta * cos_t) / np.maximum(c + eta * cos_t, 1e-12)
-    rp = (eta * c - cos_t) / np.maximum(eta * c + cos_t, 1e-12)
-    fresnel = np.where(tir, 1.0, 0.5 * (rs * rs + rp * rp))
+    # the exact dielectric Fresnel (its η² - 1 form holds for η < 1 too, wherever the refraction exists)
+    fresnel = np.where(tir, 1.0, fresnel_exact(c, np.where(tir, 0.0, eta * eta - 1.0).astype(np.float32)))
     reflect = u < fresnel
     wr = 2.0 * c * n - wo
     wt = -wo / eta + (c / eta - cos_t) * n

@@ -101,23 +101,29 @@ class RenderSettings:
 
 
 def coverage_samples(setting: int, lights, lamps, camera=None) -> tuple[int, str]:
+    return _coverage(setting, lights, lamps, camera)[:2]
+
+
+def _coverage(setting: int, lights, lamps, camera=None) -> tuple[int, str, np.ndarray | None]:
     """Strata per pixel for the emission seen directly (a square number) and why: ``setting`` rounded down to a
     square, or when 0 (automatic): 1 where the camera can see no emitter (none visible to camera rays, or, given
     the ``camera``, none inside its view); MANY_COVERAGE where it sees many emissive triangles (at least
     MANY_EMITTERS: small emitters partly covering many pixels), else AUTO_COVERAGE. Measured (docs/RESULTS.md,
     "Pixel coverage"; relMSE of Combined at equal time against 1 ray): many_lights 10k 2.5x (4 rays) and 3.6x
-    (16), 1k 1.8x and 1.6x, the Cornell box 1.05x and 0.8x."""
+    (16), 1k 1.8x and 1.6x, the Cornell box 1.05x and 0.8x. The third value: the pixels that get the extra rays
+    (coverage_pixels; None: all of them)."""
     if setting > 0:
         g = max(1, int(np.sqrt(setting + 1e-9)))
-        return g * g, "set by the user"
+        return g * g, "set by the user", None
     lamps_seen = bool(len(lamps.tris) and lamps.camera_visible.any())
     if lights.n_geom >= MANY_EMITTERS:
-        return MANY_COVERAGE, f"{lights.n_geom} emissive triangles: small emitters partly cover many pixels"
+        return MANY_COVERAGE, f"{lights.n_geom} emissive triangles: small emitters partly cover many pixels", None
     if lights.n_geom > 0 or lamps_seen:
-        if camera is not None and not coverage_pixels(camera, lights, lamps).any():
-            return 1, "no emitter in view"
-        return AUTO_COVERAGE, "emitters can be seen directly"
-    return 1, "no emitter can be seen directly"
+        mask = None if camera is None else coverage_pixels(camera, lights, lamps)
+        if mask is not None and not mask.any():
+            return 1, "no emitter in view", None
+        return AUTO_COVERAGE, "emitters can be seen directly", mask
+    return 1, "no emitter can be seen directly", None
 
 
 def _seen_lights(lights, lamps) -> np.ndarray:
@@ -309,11 +315,9 @@ class FrameRenderer:
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
         self.ctx.scene.camera = camera
-        self.coverage, self.coverage_reason = coverage_samples(self.settings.coverage_samples, self.ctx.lights,
-                                                               self.ctx.scene.lamps, camera)
-        self.coverage_mask = None  # the pixels that get the coverage rays (None: all)
-        if self.coverage > 1 and self.settings.coverage_samples == 0:
-            self.coverage_mask = coverage_pixels(camera, self.ctx.lights, self.ctx.scene.lamps)
+        # coverage_mask: the pixels that get the coverage rays (None: all)
+        self.coverage, self.coverage_reason, self.coverage_mask = _coverage(
+            self.settings.coverage_samples, self.ctx.lights, self.ctx.scene.lamps, camera)
         _x0, _y0, w, h = camera.window
         self.release()
         self.acc = {"emit": _BUFFERS.zeros((h, w, 3)), "direct": _BUFFERS.zeros((h, w, 3)),
@@ -417,6 +421,12 @@ class FrameRenderer:
         cover = self.coverage_mask
 
         def primary(c: _Chunk):
+            camera_rays(c)
+            if st.integrator == "RESTIR" and ctx.has_glass:
+                # camera rays that met smooth glass continue to the surface behind it, where resampling runs
+                c.chain = pathtracer.follow_specular(ctx, c.hits, rng(st.seed, st.frame, s, STREAM_CHAIN, c.index))
+
+        def camera_rays(c: _Chunk):
             r = rng(st.seed, st.frame, s, STREAM_CAMERA, c.index)
             # the pass's position in the pixel: Sobol point s, shifted per pixel (the shift keyed without the pass)
             shift = rng(st.seed, st.frame, 0, STREAM_PIXEL_OFFSET, c.index).bit_generator.random_raw(len(c.pixels))
@@ -425,7 +435,6 @@ class FrameRenderer:
             py = (y0 + c.pixels // w).astype(np.float32)
             if strata == 1:
                 c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
-                through_glass(c)
                 return
             # the shaded ray where the pass puts it (uniform over the pixel, so uniform within the stratum it
             # falls in), one more ray in each other stratum, in the pixels near an emitter (coverage_mask)
@@ -434,7 +443,6 @@ class FrameRenderer:
             sel = slice(None) if cover is None else np.flatnonzero(cover[c.pixels])
             jx, jy, sx, sy = j[sel, 0], j[sel, 1], px[sel], py[sel]
             if len(jx) == 0:
-                through_glass(c)
                 return
             k0 = np.minimum((jx * g).astype(np.int64), g - 1) + g * np.minimum((jy * g).astype(np.int64), g - 1)
             k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
@@ -444,12 +452,6 @@ class FrameRenderer:
             inv = np.float32(1.0 / strata)
             c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
             c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
-            through_glass(c)
-
-        def through_glass(c: _Chunk):
-            # ReSTIR: camera rays that met smooth glass continue to the surface behind it, where resampling runs
-            if st.integrator == "RESTIR" and ctx.has_glass:
-                c.chain = pathtracer.follow_specular(ctx, c.hits, rng(st.seed, st.frame, s, STREAM_CHAIN, c.index))
 
         with clock.stage("primary"):
             self._map(primary, chunks, stop)
@@ -728,15 +730,16 @@ class FrameRenderer:
         np.multiply(self.acc["alpha"], inv, out=out[..., 3], casting="unsafe")
         return finite(out)
 
+    def mean(self, key: str) -> np.ndarray:
+        """The running mean of accumulator ``key`` as (h, w, c) float32 (c = 1 for scalar ones), finite."""
+        a = self.acc[key]
+        out = np.multiply(a, np.float32(1.0 / max(1, self.samples_done)), out=np.empty(a.shape, np.float32),
+                          casting="unsafe")
+        return finite(out if out.ndim == 3 else out[..., None])
+
     def passes(self) -> dict:
         """All passes (see :class:`FrameResult`); float32, finite everywhere."""
-        inv = np.float32(1.0 / max(1, self.samples_done))
-
-        def mean(key):
-            a = self.acc[key]
-            out = np.multiply(a, inv, out=np.empty(a.shape, np.float32), casting="unsafe")
-            return finite(out if out.ndim == 3 else out[..., None])
-
+        mean = self.mean
         jobs = {"Combined": self.combined, "Direct": lambda: mean("direct"), "Indirect": lambda: mean("indirect"),
                 "Emission": lambda: mean("emit")}
         if self.candidates is not None:

@@ -88,7 +88,7 @@ class Surface:
             self.params.scale(scale)
         # smooth glass (core/glass.py): picked per point with the material's transmission share; black for every
         # evaluation, sampled as a delta closure by pathtracer.sample_rays
-        self.glass = None
+        self.glass = self.glass_front = self.glass_ior = self.glass_reflect = self.glass_refract = None
         if ctx.has_glass:
             cand = np.flatnonzero(mats.transmission[mat] > 0)
             if cand.size:
@@ -170,14 +170,10 @@ class Surface:
         out = Surface.__new__(Surface)
         for name in ("prim", "b1", "b2", "mat", "bsdf_mat", "albedo", "layer"):
             setattr(out, name, getattr(self, name)[idx])
-        out.glass = None
-        if self.glass is not None:
-            for name in ("glass", "glass_front", "glass_ior"):
-                setattr(out, name, getattr(self, name)[idx])
-            for name in ("glass_reflect", "glass_refract"):
-                a = getattr(self, name)
-                setattr(out, name, a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1))
-        for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l", "bump_n", "spec_n"):
+        for name in ("glass", "glass_front", "glass_ior"):
+            a = getattr(self, name)
+            setattr(out, name, None if a is None else a[idx])
+        for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l", "bump_n", "spec_n", "glass_reflect", "glass_refract"):
             a = getattr(self, name)
             setattr(out, name, None if a is None else a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1))
         out.bump_a2 = None if self.bump_a2 is None else self.bump_a2[idx]
@@ -207,10 +203,7 @@ def normal_map(mats, geom, mat, prim, u, v, ns, rows) -> np.ndarray:
     tan = barycentric(tg[:, 0, :3].T, tg[:, 1, :3].T, tg[:, 2, :3].T, u[rows], v[rows])
     n = ns[:, rows]
     b = np.cross(n.T, tan.T).T * tg[:, 0, 3]
-    out = col[0] * tan + col[1] * b + col[2] * n
-    ln = norm(out)
-    ok = np.isfinite(ln) & (ln > 1e-12)
-    return np.where(ok, out / np.where(ok, ln, 1.0), n).astype(np.float32)
+    return _unit_or(col[0] * tan + col[1] * b + col[2] * n, n)
 
 
 def bump_map(mats, geom, mat, prim, u, v, n, rows) -> np.ndarray:
@@ -242,14 +235,19 @@ def bump_map(mats, geom, mat, prim, u, v, n, rows) -> np.ndarray:
     det = dot(dpdu, r1)
     dist = mats.bump_distance[m]
     strength = mats.bump_strength[m]
-    out = np.abs(det) * n - (dist * np.sign(det)) * (dh[0] * r1 + dh[1] * r2)
-    ln = norm(out)
-    good = ok & np.isfinite(ln) & (ln > 1e-20)
-    out = np.where(good, out / np.where(good, ln, 1.0), n)
-    out = strength * out + (1.0 - strength) * n
-    ln = norm(out)
-    good = np.isfinite(ln) & (ln > 1e-12)
-    return np.where(good, out / np.where(good, ln, 1.0), n).astype(np.float32)
+    out = _unit_or(np.abs(det) * n - (dist * np.sign(det)) * (dh[0] * r1 + dh[1] * r2), n, ok, eps=1e-20)
+    return _unit_or(strength * out + (1.0 - strength) * n, n)
+
+
+def _unit_or(v: np.ndarray, fallback: np.ndarray, valid: np.ndarray | None = None, eps: float = 1e-12
+             ) -> np.ndarray:
+    """(3, k) ``v`` normalized, ``fallback`` where it has no direction (length not finite or <= ``eps``) or
+    ``valid`` is False."""
+    ln = norm(v)
+    ok = np.isfinite(ln) & (ln > eps)
+    if valid is not None:
+        ok &= valid
+    return np.where(ok, v / np.where(ok, ln, 1.0), fallback).astype(np.float32)
 
 
 def valid_reflection_normal(ng: np.ndarray, wo: np.ndarray, n: np.ndarray):

@@ -27,30 +27,9 @@ def sample_nearest(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return image[np.floor(y).astype(np.int64) % h, np.floor(x).astype(np.int64) % w].astype(np.float32)
 
 
-def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
-    h, w = image.shape[:2]
-    x = uv[:, 0] * w - 0.5
-    y = uv[:, 1] * h - 0.5
-    x = np.where(np.isfinite(x), x, 0.0)
-    y = np.where(np.isfinite(y), y, 0.0)
-    x0 = np.floor(x)
-    y0 = np.floor(y)
-    fx = (x - x0).astype(np.float32)[:, None]
-    fy = (y - y0).astype(np.float32)[:, None]
-    x0 = x0.astype(np.int64) % w
-    y0 = y0.astype(np.int64) % h
-    x1 = (x0 + 1) % w
-    y1 = (y0 + 1) % h
-    top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
-    bot = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
-    return (top * (1 - fy) + bot * fy).astype(np.float32)
-
-
-def gradient(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
-    """(n, 2) derivatives d/du, d/dv of the first channel of ``image`` as :func:`sample` interpolates it at ``uv``
-    (bilinear: the exact derivative inside the texel cell; nearest: zero, the image being constant there)."""
-    if isinstance(image, NearestImage):
-        return np.zeros((len(uv), 2), np.float32)
+def _bilinear_cell(image: np.ndarray, uv: np.ndarray):
+    """The texel cell bilinear interpolation reads at ``uv`` (repeat wrap): its column and row indices x0, x1,
+    y0, y1 (n,) and the fractions fx, fy (n,) float32 of the position inside it."""
     h, w = image.shape[:2]
     x = uv[:, 0] * w - 0.5
     y = uv[:, 1] * h - 0.5
@@ -62,8 +41,24 @@ def gradient(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     fy = (y - y0).astype(np.float32)
     x0 = x0.astype(np.int64) % w
     y0 = y0.astype(np.int64) % h
-    x1 = (x0 + 1) % w
-    y1 = (y0 + 1) % h
+    return x0, (x0 + 1) % w, y0, (y0 + 1) % h, fx, fy
+
+
+def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    x0, x1, y0, y1, fx, fy = _bilinear_cell(image, uv)
+    fx, fy = fx[:, None], fy[:, None]
+    top = image[y0, x0] * (1 - fx) + image[y0, x1] * fx
+    bot = image[y1, x0] * (1 - fx) + image[y1, x1] * fx
+    return (top * (1 - fy) + bot * fy).astype(np.float32)
+
+
+def gradient(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """(n, 2) derivatives d/du, d/dv of the first channel of ``image`` as :func:`sample` interpolates it at ``uv``
+    (bilinear: the exact derivative inside the texel cell; nearest: zero, the image being constant there)."""
+    if isinstance(image, NearestImage):
+        return np.zeros((len(uv), 2), np.float32)
+    h, w = image.shape[:2]
+    x0, x1, y0, y1, fx, fy = _bilinear_cell(image, uv)
     c = image[..., 0]
     a, b, cc, d = c[y0, x0], c[y0, x1], c[y1, x0], c[y1, x1]
     du = ((b - a) * (1 - fy) + (d - cc) * fy) * w

@@ -13,7 +13,6 @@ Levels, from cheapest:
 from __future__ import annotations
 
 import dataclasses
-import time
 
 import bpy
 
@@ -65,12 +64,10 @@ class SceneExporter:
         self.mesh_cache: dict = {}
         self.counts = {level: 0 for level in LEVELS}
         self.last_level = None
-        self.last_seconds = 0.0
 
     def export(self, depsgraph, camera, level: str = "FULL"):
         """The core Scene for ``depsgraph`` seen by ``camera`` (a core Camera), doing the ``level`` of work
         (update_level) when the previous export allows it."""
-        t0 = time.perf_counter()
         out, done = None, level
         if self.last is None:
             done = "FULL"
@@ -88,7 +85,6 @@ class SceneExporter:
             out.export_stats["material_needs"] = _needs(out)
         self.counts[done] += 1
         self.last, self.last_level = out, done
-        self.last_seconds = time.perf_counter() - t0
         return out
 
     def _shading(self, depsgraph, camera):
@@ -108,7 +104,6 @@ class SceneExporter:
         if registry.index != stats["material_index"]:  # a mix gained or lost a component: rows moved
             return None
         out = export_shading(depsgraph, registry, last.geometry, camera, warnings)
-        out.motion = None
         out.export_stats = dict(stats, material_index=dict(registry.index))
         if _needs(out) != stats["material_needs"]:
             return None
