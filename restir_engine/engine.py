@@ -51,7 +51,8 @@ def with_data_passes(settings: RenderSettings, view_layer) -> RenderSettings:
     """``settings`` computing Depth/Normal/Vector only when the view layer writes one of them."""
     wanted = bool(view_layer.use_pass_z or view_layer.use_pass_normal or view_layer.use_pass_vector)
     reservoirs = bool(view_layer.restir.use_pass_reservoir_m or view_layer.restir.use_pass_reservoir_ucw)
-    return replace(settings, data_passes=wanted, reservoir_passes=reservoirs,
+    gi_reservoirs = bool(view_layer.restir.use_pass_gi_reservoir_m or view_layer.restir.use_pass_gi_reservoir_ucw)
+    return replace(settings, data_passes=wanted, reservoir_passes=reservoirs, gi_reservoir_passes=gi_reservoirs,
                    denoise_data=bool(view_layer.restir.use_pass_denoising_data))
 
 
@@ -117,7 +118,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         # AUTO may resolve to ReSTIR (known once the scene is exported): keep and preroll its history too
         wants_temporal = settings.integrator == "RESTIR" and settings.temporal_reuse and (
             settings.direct_method in ("RESTIR", "AUTO") or
-            (settings.indirect_method == "RESTIR_GI" and settings.max_bounces > 0))
+            (settings.indirect_method in ("RESTIR_GI", "AUTO") and settings.max_bounces > 0))
         key = (scene.name, view_layer.name)
         prev = _TEMPORAL_HISTORY.pop(key, None)
         history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None
@@ -161,6 +162,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
                                                                   "coverage_samples", "coverage_reason",
                                                                   "spatial_radius", "indirect_method",
+                                                                  "indirect_reason",
                                                                   "gi_spatial_radius", "gi_skipped_passes")}
         LAST_CHOICES[scene.name]["samples"] = result.samples_done
         LAST_FRAME_STATS.clear()
@@ -228,11 +230,12 @@ class RestirRenderEngine(bpy.types.RenderEngine):
     def _viewport_settings(scene, context) -> RenderSettings:
         """The render settings, one sample per pass, data passes only on demand (the Depth/Normal/Motion viewport
         passes compute them lazily); a reservoir pass on screen makes Auto resample, as in a final render."""
-        from .viewport import RESERVOIR_PASSES
+        from .viewport import GI_RESERVOIR_PASSES, RESERVOIR_PASSES
         settings = settings_from_scene(scene)
         settings.samples = 1
         settings.data_passes = False
         settings.reservoir_passes = _viewport_pass(context) in RESERVOIR_PASSES
+        settings.gi_reservoir_passes = _viewport_pass(context) in GI_RESERVOIR_PASSES
         settings.tile_pixels = 16384  # small chunks: a stop request is seen within one chunk of one stage
         return settings
 
@@ -251,7 +254,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         import gpu
         from gpu_extras.presets import draw_texture_2d
 
-        from .viewport import DATA_PASSES, RESERVOIR_PASSES
+        from .viewport import DATA_PASSES, GI_RESERVOIR_PASSES, RESERVOIR_PASSES
         session = self._viewport
         if session is None:
             return
@@ -259,9 +262,11 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         session.set_view(cam, key)
         name = _viewport_pass(context)
         last = self._viewport_settings_last
-        if last is not None and last.reservoir_passes != (name in RESERVOIR_PASSES) and self._exporter.last is not None:
-            # Auto picks its direct-light method with the reservoir passes in mind: re-plan with the same scene
-            settings = replace(last, reservoir_passes=name in RESERVOIR_PASSES)
+        wants = (name in RESERVOIR_PASSES, name in GI_RESERVOIR_PASSES)
+        if last is not None and (last.reservoir_passes, last.gi_reservoir_passes) != wants and \
+                self._exporter.last is not None:
+            # Auto picks its methods with the reservoir passes in mind: re-plan with the same scene
+            settings = replace(last, reservoir_passes=wants[0], gi_reservoir_passes=wants[1])
             self._viewport_settings_last = settings
             session.set_scene(self._exporter.export(depsgraph, cam, "SETTINGS"), settings)
         session.set_pass(name)

@@ -12,7 +12,7 @@ def has_reservoirs(scene) -> bool:
 
 def has_gi_reservoirs(scene) -> bool:
     s = scene.restir
-    return s.integrator == "RESTIR" and s.indirect_method == "RESTIR_GI" and s.max_bounces > 0
+    return s.integrator == "RESTIR" and s.indirect_method in ("RESTIR_GI", "AUTO") and s.max_bounces > 0  # as above
 
 
 PASSES = (

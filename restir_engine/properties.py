@@ -134,13 +134,16 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
     indirect_method: EnumProperty(
         name="Indirect Method",
         description="How the ReSTIR integrator estimates indirect light (bounces) at the first hit",
-        items=[("OFF", "Off", "No indirect light (direct light only, whatever Max Bounces says)", 0),
+        items=[("AUTO", "Auto", "ReSTIR GI where its reservoirs carry most of the indirect light's noise, path "
+                "tracing where they cannot (measured in each frame's first pass; the choice and its reason show "
+                "below)", 3),
+               ("OFF", "Off", "No indirect light (direct light only, whatever Max Bounces says)", 0),
                ("PATH", "Path Tracing", "One path per pixel and sample, as the path tracer", 1),
                ("RESTIR_GI", "ReSTIR GI", "Resample the first bounce: each pixel's path finds a point x2 and the "
                 "light leaving it; reservoirs of x2 points are reused over frames (temporal) and neighbouring "
                 "pixels (spatial) with the reconnection shift. Glossy surfaces keep path-traced samples for "
                 "their sharp lobes", 2)],
-        default="RESTIR_GI", update=_update_passes)
+        default="AUTO", update=_update_passes)
     gi_spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring GI reservoirs merged per spatial "
                                       "pass (unbiased mode: one visibility ray each)",
                                       default=GISettings.neighbors, min=0, soft_max=16)

@@ -50,6 +50,7 @@ VIEWPORT_PASSES = (
     ("VECTOR", "Motion", "Screen motion since the previous view, 0.5 + v / 32 px in red/green"),
 )
 RESERVOIR_PASSES = {"RES_M", "RES_UCW"}  # passes that make the Auto direct method resample
+GI_RESERVOIR_PASSES = {"GI_M", "GI_UCW"}  # passes that make the Auto indirect method resample
 DATA_PASSES = {"RES_M", "RES_UCW", "GI_M", "GI_UCW", "DEPTH", "NORMAL", "VECTOR"}  # shown without view transform
 M_FULL_SCALE = 64.0  # Reservoir M at the top of its colour ramp
 

@@ -12,7 +12,7 @@ relative variance whatever its coverage.)
     .venv/bin/python scripts/benchmark_direct_methods.py            # -> docs/results/direct_methods/
     .venv/bin/python scripts/benchmark_direct_methods.py --size tiny --reps 3   # a quick look
 
-The AUTO direct method (restir_engine/core/direct_choice.py) was chosen from these numbers (docs/RESULTS.md).
+The AUTO direct method (restir_engine/core/method_choice.py) was chosen from these numbers (docs/RESULTS.md).
 """
 from __future__ import annotations
 
@@ -35,7 +35,7 @@ from harness.reference import reference_image, reference_lit  # noqa: E402
 from harness.scenes import ensure_blend  # noqa: E402
 from restir_engine.core import pathtracer  # noqa: E402
 from restir_engine.core.context_cache import context_for  # noqa: E402
-from restir_engine.core.direct_choice import choose_direct_method  # noqa: E402
+from restir_engine.core.method_choice import choose_direct_method  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 

@@ -373,28 +373,29 @@ def bump_scene(size=(96, 64)):
     return scene
 
 
-def glass_material(name, kind, ior=1.45, color=(1.0, 1.0, 1.0), transmission=1.0):
-    """A smooth glass: kind "GLASS" (Glass BSDF, roughness 0) or "PRINCIPLED" (Transmission Weight
-    ``transmission``, roughness 0)."""
+def glass_material(name, kind, ior=1.45, color=(1.0, 1.0, 1.0), transmission=1.0, roughness=0.0):
+    """A glass: kind "GLASS" (Glass BSDF) or "PRINCIPLED" (Transmission Weight ``transmission``), smooth unless
+    ``roughness``."""
     if kind == "GLASS":
         from harness.scenes import _replace_surface
         m, g = _replace_surface(name, "ShaderNodeBsdfGlass")
         g.inputs["Color"].default_value = (*color, 1)
-        g.inputs["Roughness"].default_value = 0.0
+        g.inputs["Roughness"].default_value = roughness
         g.inputs["IOR"].default_value = ior
         return m
-    m = principled(name, color, roughness=0.0)
+    m = principled(name, color, roughness=roughness)
     b = m.node_tree.nodes["Principled BSDF"]
     b.inputs["IOR"].default_value = ior
     b.inputs["Transmission Weight"].default_value = transmission
     return m
 
 
-def glass_scene(size=(96, 64), only=None, window=False):
+def glass_scene(size=(96, 64), only=None, window=False, roughness=None):
     """Three smooth glass spheres in front of a checkered wall on a grey floor, lit by an area light from above
     and the front: a Glass BSDF (IOR 1.45), a tinted Principled with Transmission 1 (IOR 1.5) and a red Principled
     with Transmission 0.5 (half glass, half diffuse under a clear coat of reflection); ``only``: just that one;
-    ``window``: a 2 cm glass pane across the lower half of the view in front of them."""
+    ``window``: a 2 cm glass pane across the lower half of the view in front of them; ``roughness``: the three
+    spheres' roughness (r, r, r) instead of smooth."""
     scene = reset()
     plane("Floor", 8, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
     wall = principled("Checker wall", (1, 1, 1), roughness=1.0)
@@ -403,9 +404,10 @@ def glass_scene(size=(96, 64), only=None, window=False):
     tex.interpolation = "Closest"
     wall.node_tree.links.new(tex.outputs["Color"], wall.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
     _with_uvs(plane("Wall", 6, (0, 1.2, 2), (math.pi / 2, 0, 0), material=wall))
-    specs = [(-1.1, glass_material("Glass", "GLASS")),
-             (0.0, glass_material("Tinted", "PRINCIPLED", 1.5, (0.8, 0.9, 1.0))),
-             (1.1, glass_material("Half", "PRINCIPLED", 1.5, (0.8, 0.3, 0.2), transmission=0.5))]
+    r = roughness or (0.0, 0.0, 0.0)
+    specs = [(-1.1, glass_material("Glass", "GLASS", roughness=r[0])),
+             (0.0, glass_material("Tinted", "PRINCIPLED", 1.5, (0.8, 0.9, 1.0), roughness=r[1])),
+             (1.1, glass_material("Half", "PRINCIPLED", 1.5, (0.8, 0.3, 0.2), transmission=0.5, roughness=r[2]))]
     for x, mat in specs if only is None else [specs[only]]:
         bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(x, 0.0, 0.5), segments=48, ring_count=24)
         bpy.ops.object.shade_smooth()

@@ -13,6 +13,11 @@ Tables (all for height-correlated Smith GGX, single scattering, no cosine-weight
   S[α, μ, z]    the exact dielectric Fresnel's interpolation factor s = (F(ωo·h, η) - F0)/(1 - F0) averaged over
                 the reflected light: ∫ s f_ss cos / ∫ f_ss cos. The specular layer of a Principled BSDF with
                 normal-incidence reflectance f0 (tinted) then reflects E · mix(f0, 1, S) (single scattering).
+  GLASS_OUT[α, μ, z], GLASS_IN[α, μ, z]
+                directional albedo of a rough dielectric interface (GGX glass: reflection weighted by the exact
+                Fresnel F(ωo·h), refraction by 1 - F, total internal reflection included), entered from the optically
+                thinner side (relative IOR η = η(z) > 1) and from the denser side (1/η); Cycles scales its
+                multiscatter glass by 1/E (core/glass.py).
 """
 from __future__ import annotations
 
@@ -90,8 +95,39 @@ def compute_tables(strata: int = STRATA) -> dict:
         s_tab[i] = (s * w[..., None]).mean(axis=1) / np.maximum(e_tab[i][:, None], 1e-12)
         wa, _ = weights(mu_avg)
         e_avg[i] = (2 * mu_avg * wa.mean(axis=1)).mean()
+    glass = {side: np.empty((N_ALPHA, N_MU, N_Z)) for side in ("GLASS_OUT", "GLASS_IN")}
+    for i, a in enumerate(ALPHAS):
+        for side, rel in (("GLASS_OUT", eta), ("GLASS_IN", 1.0 / eta)):
+            glass[side][i] = glass_albedo(a, MUS, rel, u1, u2)
     return {"E": np.clip(e_tab, 1e-3, 1.0).astype(np.float32), "E_avg": np.clip(e_avg, 1e-3, 1.0).astype(np.float32),
-            "S": np.clip(s_tab, 0.0, 1.0).astype(np.float32)}
+            "S": np.clip(s_tab, 0.0, 1.0).astype(np.float32),
+            **{k: np.clip(v, 1e-3, 1.0).astype(np.float32) for k, v in glass.items()}}
+
+
+def glass_albedo(alpha: float, mus: np.ndarray, eta: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """(len(mus), len(eta)) directional albedo of a GGX dielectric interface of roughness ``alpha`` and relative IOR
+    ``eta`` (transmitted side over incident side) seen at cos θ = ``mus``: the mean over normals h drawn from
+    D(h) cos θh (from the uniforms u1, u2) of (F · G(ωo, ωr) + (1 - F) · G(ωo, ωt)) ωo·h / (μ cos θh), a reflection
+    or refraction counting only where it leaves on its own side."""
+    tan2 = alpha * alpha * u1 / np.maximum(1 - u1, 1e-12)
+    hz = 1 / np.sqrt(1 + tan2)
+    hx = np.sqrt(np.maximum(0, 1 - hz * hz)) * np.cos(2 * np.pi * u2)
+    mu = mus[:, None, None]
+    c = np.sqrt(1 - mu * mu) * hx[None, :, None] + mu * hz[None, :, None]          # ωo·h (nμ, samples, 1)
+    e = np.asarray(eta, np.float64)[None, None, :]
+    fr = fresnel_dielectric(np.clip(c, 0, 1), e)  # its η² - 1 + c² form is 1 on total internal reflection
+    hz3 = hz[None, :, None]
+    lam_o = smith_lambda(alpha, np.broadcast_to(mu, c.shape))
+    r_z = 2 * c * hz3 - mu                                                          # reflected ωr·n
+    sin2_t = (1 - c * c) / (e * e)
+    cos_t = np.sqrt(np.maximum(0, 1 - sin2_t))
+    t_z = -mu / e + (c / e - cos_t) * hz3                                           # refracted ωt·n
+    g_r = 1 / (1 + lam_o + smith_lambda(alpha, np.maximum(r_z, 1e-9)))
+    g_t = 1 / (1 + lam_o + smith_lambda(alpha, np.maximum(-t_z, 1e-9)))
+    w = c / (mu * hz3)
+    val = np.where(r_z > 0, fr * g_r, 0.0) + np.where((t_z < 0) & (sin2_t < 1), (1 - fr) * g_t, 0.0)
+    return np.where(c > 0, val * w, 0.0).mean(axis=1)
+
 
 
 def tables() -> dict:
@@ -100,8 +136,8 @@ def tables() -> dict:
     if _TABLES is None:
         try:
             with np.load(TABLE_FILE) as data:
-                _TABLES = {k: data[k].astype(np.float32) for k in ("E", "E_avg", "S")}
-        except OSError:
+                _TABLES = {k: data[k].astype(np.float32) for k in ("E", "E_avg", "S", "GLASS_OUT", "GLASS_IN")}
+        except (OSError, KeyError):
             _TABLES = compute_tables()
     return _TABLES
 
@@ -127,6 +163,26 @@ def average_albedo(alpha):
     t = tables()["E_avg"]
     i, fi = _axis(alpha, ALPHAS)
     return t[i] * (1 - fi) + t[i + 1] * fi
+
+
+def glass_albedo_at(alpha, mu, eta):
+    """The rough dielectric's directional albedo (GLASS_OUT where the relative IOR ``eta`` >= 1, else GLASS_IN at
+    1/eta), trilinear in (α, μ, z); arrays of one shape."""
+    eta = np.asarray(eta, np.float32)
+    inside = eta < 1
+    e = np.where(inside, 1.0 / np.maximum(eta, 1e-6), eta)
+    z = np.sqrt(np.clip((e - 1) / (e + 1), 0.0, 1.0))
+    t_out, t_in = tables()["GLASS_OUT"], tables()["GLASS_IN"]
+    i, fi = _axis(alpha, ALPHAS)
+    j, fj = _axis(mu, MUS)
+    k, fk = _axis(z, ZS)
+    out = 0.0
+    for di, wi in ((0, 1 - fi), (1, fi)):
+        for dj, wj in ((0, 1 - fj), (1, fj)):
+            for dk, wk in ((0, 1 - fk), (1, fk)):
+                v = np.where(inside, t_in[i + di, j + dj, k + dk], t_out[i + di, j + dj, k + dk])
+                out = out + wi * wj * wk * v
+    return np.asarray(out, np.float32)
 
 
 def layer_s(alpha, mu, f0):

@@ -18,7 +18,7 @@ resampled estimator (ReSTIR DI) and the ray may be the one that estimator alread
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -62,6 +62,9 @@ class TraceContext:
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
     lamp_ng_rows: np.ndarray = None     # (3, n_lamp) lamp_ng as rows
     geom_derived: "GeometryDerived" = None  # the geometry-only arrays above, kept for a rebuild over the same triangles
+    # what rendering this content measured (shared by the frames and views that reuse this context): "indirect" ->
+    # the AUTO indirect method and its reason (renderer, method_choice.choose_indirect_method)
+    measured: dict = field(default_factory=dict)
 
 
 def power_heuristic(a, b):
@@ -335,7 +338,8 @@ def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
     if s.glass is not None:
         g = np.flatnonzero(s.glass)
         wg, weight, valid = sample_glass(cols(s.wo, g), cols(s.ns, g), cols(s.ng, g), s.glass_front[g],
-                                         s.glass_ior[g], cols(s.glass_reflect, g), cols(s.glass_refract, g), u[0, g])
+                                         s.glass_ior[g], cols(s.glass_reflect, g), cols(s.glass_refract, g), u[0, g],
+                                         s.glass_alpha[g], u[1, g], u[2, g], s.glass_ms[g])
         wi[:, g] = wg
         wi_l[:, g] = 0.0
         wi_l[2, g] = 1.0  # unused for delta rows (their throughput is the weight)

@@ -36,7 +36,7 @@ from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
 from .bsdf import denoising_albedo, luminance_rows
 from .context_cache import context_for, fingerprint
-from .direct_choice import choose_direct_method
+from .method_choice import GI_MIN_SHARE, choose_direct_method, choose_indirect_method
 from .light_blocks import BlockLightTiles
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
 from .profile import NullClock
@@ -70,7 +70,7 @@ class RenderSettings:
     frame: int = 0
     integrator: str = "PATH"
     direct_method: str = "RIS"  # with integrator RESTIR: "AUTO", "LIGHT_SAMPLING" (NEE + MIS), "RIS" or "RESTIR"
-    reservoir_passes: bool = False  # a reservoir pass is wanted (AUTO then resamples: direct_choice)
+    reservoir_passes: bool = False  # a reservoir pass is wanted (AUTO then resamples: method_choice)
     light_candidates: int = di.CandidateSettings.light_candidates
     bsdf_candidates: int = di.CandidateSettings.bsdf_candidates
     spatial_neighbors: int = reuse.SpatialSettings.neighbors
@@ -90,7 +90,9 @@ class RenderSettings:
     denoise_data: bool = False  # Denoising Albedo / Normal: first-hit albedo and camera-space normal, per sample
     tile_pixels: int = CHUNK_PIXELS  # pixels per chunk of work (smaller: finer progress and cancellation)
     coverage_samples: int = 0  # camera rays per pixel for the emission seen directly: 1, 4, 9, 16 ...; 0 = automatic
-    indirect_method: str = "PATH"  # with integrator RESTIR: "OFF" (no bounces), "PATH" or "RESTIR_GI" (restir/gi.py)
+    indirect_method: str = "PATH"  # with integrator RESTIR: "AUTO" (method_choice), "OFF" (no bounces), "PATH" or
+    #                                "RESTIR_GI" (restir/gi.py)
+    gi_reservoir_passes: bool = False  # a GI reservoir pass is wanted (AUTO then resamples the indirect light)
     gi_spatial_neighbors: int = gi.GISettings.neighbors
     gi_spatial_radius: float = gi.GISettings.radius  # pixels; 0 = automatic (GI_RADIUS_FACTOR x reuse.auto_radius)
     gi_spatial_passes: int = gi.GISettings.passes
@@ -147,7 +149,8 @@ def coverage_pixels(camera, lights, lamps):
 
 
 AUTO_COVERAGE = 4
-GI_MIN_SHARE = 0.05  # a pass whose GI reservoirs would carry less of its indirect light skips GI reuse
+MEASURE_DECAY = 0.8  # AUTO indirect: weight of the earlier passes' measurements per pass (FrameRenderer)
+PROBE_EVERY = 4  # AUTO indirect while path tracing: one chunk in this many measures (in a frame's first pass)
 GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's: 6 px at 640x360 (measured on interior_gi:
 #                          relMSE 0.23 at 5 px, 0.29 at 8, 0.71 at 16 with 4 passes, 1 spp)
 MANY_COVERAGE = 16
@@ -212,7 +215,9 @@ class _Chunk:
     indirect: np.ndarray = None
     gi_res: object = None  # gi.GIReservoirs of its surfaces
     path_indirect: np.ndarray = None  # the path tracer's indirect light (used when a pass skips GI reuse)
-    gi_share: tuple = (0.0, 0.0)  # luminance sums: (path-traced indirect light, the part the reservoirs carry)
+    gi_share: tuple = (0.0, 0.0, 0.0, 0.0)  # over its pixels: luminance sums of the path-traced indirect light and
+    #                                        of the part the reservoirs carry; sums of squares of the path-traced
+    #                                        and of the part they do not carry
     glossy: np.ndarray = None  # (surfaces,) bool: GI resamples only the diffuse lobe there (gi.glossy_x1)
     chain: object = None   # pathtracer.SpecularChains: its surfaces seen through smooth glass (ReSTIR)
 
@@ -247,25 +252,34 @@ class FrameRenderer:
         self.ctx, self.context_reused = context_for(scene, bounces, settings.film_transparent,
                                                     pathtracer.build_context)
         self.gi = None  # gi.GISettings when the indirect light is resampled
+        # the indirect method: AUTO measures in each frame's first pass (method_choice.choose_indirect_method); the
+        # frame's other passes follow, and the frames after it start from the last measurement of this content
+        self.gi_auto = settings.integrator == "RESTIR" and settings.indirect_method == "AUTO" and bounces > 0 and \
+            not settings.gi_reservoir_passes
+        self.indirect_method = "PATH" if bounces > 0 else "OFF"
+        self.indirect_reason = "path tracer" if settings.integrator == "PATH" else "no bounces" if bounces == 0 else \
+            "set by the user"
+        if settings.integrator == "RESTIR" and bounces > 0 and settings.indirect_method != "PATH":
+            self.indirect_method = "RESTIR_GI"
+            if self.gi_auto:
+                self.indirect_method, self.indirect_reason = self.ctx.measured.get(
+                    "indirect", ("RESTIR_GI", "not measured yet: the first pass measures"))
+            elif settings.indirect_method == "AUTO":
+                self.indirect_reason = "a GI reservoir pass is enabled"
         if settings.integrator == "RESTIR":
-            self.method, self.method_reason = settings.direct_method, "set by the user"
-            if self.method == "AUTO":
-                self.method, self.method_reason = choose_direct_method(self.ctx.lights, settings.reservoir_passes,
-                                                                        bounces)
             tiles = TileSettings(settings.light_tiles, settings.light_tile_count, settings.light_tile_size)
             if tiles.mode not in TILE_MODES:
                 raise ValueError(f"unknown light tile mode {tiles.mode!r}; available: {TILE_MODES}")
             if settings.bias_correction not in reuse.BIAS_CORRECTIONS:
                 raise ValueError(f"unknown bias correction {settings.bias_correction!r}")
-            if self.method in ("RIS", "RESTIR"):
-                self.candidates = di.CandidateSettings(self.method, max(0, settings.light_candidates),
-                                                       max(0, settings.bsdf_candidates), tiles)
+            self.tile_settings = tiles
+            self._choose_direct(bounces)
             cam = scene.camera
             radius = float(settings.spatial_radius) if settings.spatial_radius > 0 else \
                 reuse.auto_radius(cam.width, cam.height)
             self.spatial = reuse.SpatialSettings(max(0, settings.spatial_neighbors), max(1.0, radius),
                                                  max(0, settings.spatial_passes), settings.bias_correction)
-            if settings.indirect_method == "RESTIR_GI" and bounces > 0:
+            if settings.indirect_method in ("RESTIR_GI", "AUTO") and bounces > 0:
                 gi_radius = float(settings.gi_spatial_radius) if settings.gi_spatial_radius > 0 else \
                     max(reuse.AUTO_RADIUS_MIN, GI_RADIUS_FACTOR * reuse.auto_radius(cam.width, cam.height))
                 self.gi = gi.GISettings(max(0, int(settings.gi_spatial_neighbors)), max(1.0, gi_radius),
@@ -286,6 +300,19 @@ class FrameRenderer:
         self.set_camera(scene.camera)
         if history is not None and history.fits(scene.camera):
             self.adopt_history(history)
+
+    def _choose_direct(self, bounces: int) -> None:
+        """The direct method (AUTO: method_choice.choose_direct_method, knowing whether ReSTIR GI takes the
+        indirect light) and its candidate settings."""
+        st = self.settings
+        self.method, self.method_reason = st.direct_method, "set by the user"
+        if self.method == "AUTO":
+            self.method, self.method_reason = choose_direct_method(self.ctx.lights, st.reservoir_passes, bounces,
+                                                                    self.indirect_method == "RESTIR_GI")
+        self.candidates = None
+        if self.method in ("RIS", "RESTIR"):
+            self.candidates = di.CandidateSettings(self.method, max(0, st.light_candidates),
+                                                   max(0, st.bsdf_candidates), self.tile_settings)
 
     def adopt_history(self, history) -> None:
         """Reuse ``history`` (restir.history.TemporalHistory, from another frame or view of this scene or of an
@@ -410,7 +437,10 @@ class FrameRenderer:
         chunks = [_Chunk(i, np.arange(sl.start, sl.stop)) for i, sl in enumerate(self._spans(npix))]
         resampled = self.candidates is not None
         reusing = self.method == "RESTIR"
-        gi_on = self.gi is not None
+        # ReSTIR GI runs in this pass (AUTO: while its last measurement says so); AUTO measures in every pass that
+        # runs GI, and while it path-traces, in a quarter of the chunks of each frame's first pass (``probe``)
+        gi_on = self.gi is not None and (not self.gi_auto or self.indirect_method == "RESTIR_GI")
+        probe = self.gi_auto and not gi_on and s == 0
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
         chunk_stages = 4 + int(resampled) + (int(self.spatial.passes) + 1 if reusing else 0) + \
             (int(self.gi.passes) + 1 if gi_on else 0)
@@ -476,7 +506,7 @@ class FrameRenderer:
         # the frame's target terms, one (27, surfaces) block the chunks write into (reuse gathers from it)
         terms = np.empty((WIDTH, first), np.float32) if resampled else None
         # ReSTIR GI's target terms: the same, with the specular lobe off at glossy primary surfaces
-        gi_terms = np.empty((WIDTH, first), np.float32) if gi_on else None
+        gi_terms = np.empty((WIDTH, first), np.float32) if gi_on or probe else None
 
         def initial(c: _Chunk):
             surf = c.hits.surf
@@ -497,11 +527,11 @@ class FrameRenderer:
                 return
             out = pathtracer.continue_paths(
                 ctx, c.hits.surf, rng(st.seed, st.frame, s, STREAM_PATH, c.index), direct_resampled=resampled,
-                first_ray=c.bsdf_ray, first_bounce=gi_on,
+                first_ray=c.bsdf_ray, first_bounce=gi_on or (probe and c.index % PROBE_EVERY == 0),
                 budget=None if c.chain is None else ctx.max_bounces - c.chain.depth)
             c.bsdf_ray = None
             c.direct, c.indirect = out[0], out[1]
-            if gi_on:
+            if len(out) > 2:  # the first bounces: GI's initial samples (and the AUTO measurement)
                 surf = c.hits.surf
                 block = gi_terms[:, c.surfaces]
                 if resampled:
@@ -512,24 +542,33 @@ class FrameRenderer:
                 t = gi.diffuse_only(ShadingTerms(block), c.glossy)
                 c.path_indirect = c.indirect
                 c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi_space)
-                total = float(luminance_rows(c.path_indirect).sum())
-                c.gi_share = (total, total - float(luminance_rows(c.indirect).sum()))
+                lum_all, lum_rest = luminance_rows(c.path_indirect), luminance_rows(c.indirect)
+                total = float(lum_all.sum())
+                c.gi_share = (total, total - float(lum_rest.sum()), float(np.dot(lum_all, lum_all)),
+                              float(np.dot(lum_rest, lum_rest)))
 
         with clock.stage("paths"):
             self._map(paths, chunks, stop)
-        if gi_on:
+        if gi_on or probe:
             # GI reuse only pays where its reservoirs carry the indirect light: a scene with no bounce light to
             # cache (the default cube: nothing for its rays to hit) keeps the path-traced indirect light as it is
-            total = sum(c.gi_share[0] for c in chunks)
-            share = sum(c.gi_share[1] for c in chunks) / total if total > 0 else 0.0
-            self.reuse_stats["gi_share"] = share
-            if share < GI_MIN_SHARE:
+            sums = np.sum([c.gi_share for c in chunks], axis=0)
+            share = float(sums[1] / sums[0]) if sums[0] > 0 else 0.0
+            uncached = float(sums[3] / sums[2]) if sums[2] > 0 else 1.0
+            self.reuse_stats["gi_share"], self.reuse_stats["gi_uncached"] = share, uncached
+            if self.gi_auto:
+                self._measured_indirect(sums)
+                gi_on = gi_on and self.indirect_method == "RESTIR_GI"  # a probe's choice applies from the next pass
+            elif share < GI_MIN_SHARE:
                 gi_on = False
-                self.gi_skipped += 1
+            if not gi_on:
                 for c in chunks:
-                    c.indirect, c.gi_res = c.path_indirect, None
+                    if c.path_indirect is not None:
+                        c.indirect, c.gi_res = c.path_indirect, None
             for c in chunks:
                 c.path_indirect = None
+        if self.gi is not None and not gi_on:
+            self.gi_skipped += 1
         gb = res = gi_res = gb_gi = gi_history = None
         if reusing or gi_on:
             with clock.stage("gbuffer"):
@@ -580,6 +619,23 @@ class FrameRenderer:
             self._map(shade, chunks, stop)
         with clock.stage("passes"):
             self._accumulate(chunks, resampled, stop)
+
+    def _measured_indirect(self, sums: np.ndarray) -> None:
+        """AUTO: the indirect method for this pass from the measured sums (_Chunk.gi_share) of the passes so far
+        of this content (kept on the shared context, so frames and views carry them; older passes count less:
+        MEASURE_DECAY per pass, a memory of about five passes). The AUTO direct method is chosen again when its
+        premise (GI or not) changed; it applies from the next pass on."""
+        acc = self.ctx.measured.get("gi_sums")
+        acc = sums if acc is None else acc * MEASURE_DECAY + sums
+        self.ctx.measured["gi_sums"] = acc
+        share = float(acc[1] / acc[0]) if acc[0] > 0 else 0.0
+        uncached = float(acc[3] / acc[2]) if acc[2] > 0 else 1.0
+        self.reuse_stats["gi_share_measured"], self.reuse_stats["gi_uncached_measured"] = share, uncached
+        before = self.indirect_method
+        self.indirect_method, self.indirect_reason = choose_indirect_method(share, uncached)
+        self.ctx.measured["indirect"] = (self.indirect_method, self.indirect_reason)
+        if self.indirect_method != before and self.settings.direct_method == "AUTO":
+            self._choose_direct(self.ctx.max_bounces)
 
     def _gbuffer(self, chunks, terms) -> GBuffer:
         """The frame's G-buffer from the chunks' primary hits (surfaces in chunk order)."""
@@ -815,8 +871,10 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
              "direct_method": fr.method, "direct_reason": fr.method_reason,
              "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None, "reuse": dict(fr.reuse_stats),
              "coverage_reason": fr.coverage_reason,
-             "indirect_method": ("OFF" if ctx.max_bounces == 0 else "PATH" if fr.gi is None or
-                                 fr.gi_skipped == fr.samples_done else "RESTIR_GI"),
+             # AUTO: the latest choice; otherwise ReSTIR GI unless every pass kept the path-traced light
+             "indirect_method": ("OFF" if ctx.max_bounces == 0 else "PATH" if fr.gi is None else fr.indirect_method
+                                 if fr.gi_auto else "PATH" if fr.gi_skipped == fr.samples_done else "RESTIR_GI"),
+             "indirect_reason": fr.indirect_reason,
              "gi_skipped_passes": fr.gi_skipped,
              "gi_spatial_radius": fr.gi.radius if fr.gi is not None else None}
     if clock is not None:

@@ -74,6 +74,8 @@ class MaterialTable:
                         x Transmission Weight; the row's other parameters are then the rest of the BSDF)
     glass_ior   (m,)    its index of refraction (inside over outside, the geometric normal pointing outside)
     glass_reflect, glass_refract (m, 3) the tints of its reflection and its refraction
+    glass_alpha (m,)    its GGX α (roughness²; below glass.ROUGH_ALPHA_MIN smooth, a delta closure)
+    glass_multiscatter (m,) 1: Multiscatter GGX (energy compensated, Blender's default), 0: GGX
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
@@ -102,6 +104,8 @@ class MaterialTable:
     glass_ior: np.ndarray = None
     glass_reflect: np.ndarray = None
     glass_refract: np.ndarray = None
+    glass_alpha: np.ndarray = None
+    glass_multiscatter: np.ndarray = None
     alpha: np.ndarray = None
     alpha_tex: np.ndarray = None
     alpha_sign: np.ndarray = None
@@ -134,6 +138,7 @@ class MaterialTable:
             bump_distance=col("bump_distance", 1.0),
             transmission=col("transmission", 0.0), glass_ior=col("glass_ior", 1.5),
             glass_reflect=col("glass_reflect", (1.0, 1.0, 1.0)), glass_refract=col("glass_refract", (1.0, 1.0, 1.0)),
+            glass_alpha=col("glass_alpha", 0.0), glass_multiscatter=col("glass_multiscatter", 1.0),
             diffuse_roughness=col("diffuse_roughness", 0.0),
             **_mix_arrays(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

@@ -89,6 +89,7 @@ class Surface:
         # smooth glass (core/glass.py): picked per point with the material's transmission share; black for every
         # evaluation, sampled as a delta closure by pathtracer.sample_rays
         self.glass = self.glass_front = self.glass_ior = self.glass_reflect = self.glass_refract = None
+        self.glass_alpha = self.glass_ms = None
         if ctx.has_glass:
             cand = np.flatnonzero(mats.transmission[mat] > 0)
             if cand.size:
@@ -103,6 +104,10 @@ class Surface:
                     w = np.ones(rows.size, np.float32) if scale is None else scale[rows]
                     self.glass_ior = np.ones(n, np.float32)
                     self.glass_ior[rows] = mats.glass_ior[gm]
+                    self.glass_alpha = np.zeros(n, np.float32)
+                    self.glass_alpha[rows] = mats.glass_alpha[gm]
+                    self.glass_ms = np.zeros(n, bool)
+                    self.glass_ms[rows] = mats.glass_multiscatter[gm] > 0
                     self.glass_reflect = np.zeros((3, n), np.float32)
                     self.glass_reflect[:, rows] = mats.glass_reflect[gm].T * w
                     self.glass_refract = np.zeros((3, n), np.float32)
@@ -170,7 +175,7 @@ class Surface:
         out = Surface.__new__(Surface)
         for name in ("prim", "b1", "b2", "mat", "bsdf_mat", "albedo", "layer"):
             setattr(out, name, getattr(self, name)[idx])
-        for name in ("glass", "glass_front", "glass_ior"):
+        for name in ("glass", "glass_front", "glass_ior", "glass_alpha", "glass_ms"):
             a = getattr(self, name)
             setattr(out, name, None if a is None else a[idx])
         for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l", "bump_n", "spec_n", "glass_reflect", "glass_refract"):

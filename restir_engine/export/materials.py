@@ -22,7 +22,6 @@ def srgb_to_linear(c: np.ndarray) -> np.ndarray:
 
 
 
-SMOOTH_GLASS_ROUGHNESS = 0.05  # glass rougher than this is rendered smooth, with a warning
 
 
 class MaterialRegistry:
@@ -151,9 +150,10 @@ class MaterialRegistry:
         if t == "BSDF_GLASS":
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
             ior = self._float_input(material, node.inputs["IOR"])
-            self._smooth_glass_warning(material, self._float_input(material, node.inputs["Roughness"]))
+            rough = float(np.clip(self._float_input(material, node.inputs["Roughness"]), 0, 1))
             return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transmission": 1.0, "glass_ior": max(ior, 1e-3),
-                    "glass_reflect": tuple(c), "glass_refract": tuple(c)}
+                    "glass_reflect": tuple(c), "glass_refract": tuple(c), "glass_alpha": rough * rough,
+                    "glass_multiscatter": self._multiscatter(material, node)}
         if t == "BSDF_TRANSPARENT":
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
             if min(c) < 0.999:
@@ -210,11 +210,9 @@ class MaterialRegistry:
             self._warn(material, "Specular Tint does not tint the reflection of Principled transmission here")
         if row.get("base_tex", -1) >= 0:
             self._warn(material, "a textured Base Color tints refraction by its constant colour, not the image")
-        self._smooth_glass_warning(material, float(row.get("roughness", 0.5)))
-
-    def _smooth_glass_warning(self, material, roughness: float) -> None:
-        if roughness > SMOOTH_GLASS_ROUGHNESS:
-            self._warn(material, f"rough glass/transmission (roughness {roughness:.2f}) is rendered as smooth glass")
+        rough = float(np.clip(row.get("roughness", 0.5), 0, 1))
+        row["glass_alpha"] = rough * rough
+        row["glass_multiscatter"] = row.get("multiscatter", 1.0)
 
     # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/mix.py) ---------
     def _normal(self, material, node, row: dict) -> None:

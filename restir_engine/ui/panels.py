@@ -134,12 +134,18 @@ class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
         layout = self.split_layout()
         s = context.scene.restir
         layout.prop(s, "indirect_method")
-        if s.indirect_method != "RESTIR_GI":
+        if s.indirect_method not in ("RESTIR_GI", "AUTO"):
             return
         if s.max_bounces == 0:
             layout.label(text="Max Bounces is 0: there is no indirect light", icon="INFO")
         last = _last_choices(context.scene)
-        if last and last.get("gi_skipped_passes"):
+        if last and s.indirect_method == "AUTO" and last.get("indirect_reason"):
+            box = layout.box()
+            box.scale_y = 0.8
+            label = {"RESTIR_GI": "ReSTIR GI", "PATH": "Path Tracing"}.get(last["indirect_method"], "Off")
+            box.label(text=f"Last render: {label}", icon="INFO")
+            box.label(text=last["indirect_reason"])
+        elif last and last.get("gi_skipped_passes"):
             layout.label(text=f"Last render: path-traced indirect light in {last['gi_skipped_passes']} of "
                               f"{last.get('samples', '?')} passes (almost no bounce light to cache)", icon="INFO")
         if s.direct_method in ("RESTIR", "AUTO"):
@@ -212,7 +218,9 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl.restir, "use_pass_reservoir_ucw")
         col = layout.column(heading="ReSTIR GI", align=True)
         sc = context.scene.restir
-        col.active = sc.integrator == "RESTIR" and sc.indirect_method == "RESTIR_GI" and sc.max_bounces > 0
+        col.active = sc.integrator == "RESTIR" and sc.indirect_method in ("RESTIR_GI", "AUTO") and sc.max_bounces > 0
+        if sc.indirect_method == "AUTO":
+            col.label(text="Auto uses ReSTIR GI when a GI reservoir pass is on")
         col.prop(vl.restir, "use_pass_gi_reservoir_m")
         col.prop(vl.restir, "use_pass_gi_reservoir_ucw")
         col = layout.column(heading="Denoising", align=True)

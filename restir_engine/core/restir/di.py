@@ -32,7 +32,7 @@ from ..sampling import cols, dot, finite, to_local, uniform_ints, vmax
 from ..target import FramePoints, with_spots
 from .reservoir import Reservoirs, Stream
 
-DIRECT_METHODS = ("AUTO", "LIGHT_SAMPLING", "RIS", "RESTIR")  # AUTO: core/direct_choice.py
+DIRECT_METHODS = ("AUTO", "LIGHT_SAMPLING", "RIS", "RESTIR")  # AUTO: core/method_choice.py
 CANDIDATE_BLOCK = 65536  # candidate x surface elements evaluated per pass over memory (256 kB per float32 array)
 
 

@@ -42,7 +42,7 @@ from ..sampling import cols, dot, finite, norm, to_local, vmax
 from ..target import LUM as _LUM
 from .reservoir import Reservoirs
 
-INDIRECT_METHODS = ("OFF", "PATH", "RESTIR_GI")
+INDIRECT_METHODS = ("AUTO", "OFF", "PATH", "RESTIR_GI")  # AUTO: core/method_choice.py
 GI_TARGETS = ("INTEGRAND", "RADIANCE")  # p̂ = lum(f · Lo) |cos θ1| G  or  lum(Lo) G (measured: docs/RESULTS.md)
 JACOBIAN_LIMIT = 10.0  # biased mode: shifts whose |J| is outside [1/10, 10] are rejected (as RTXDI's sample app)
 

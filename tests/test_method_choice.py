@@ -1,0 +1,88 @@
+"""The automatic direct and indirect methods (core/method_choice.py) and that the renderer applies and reports them."""
+from scenes_core import bounce_room, floor_with_emitter, plane_under_world
+from test_light_tiles import _many_coloured_lights
+from test_sphere_lights import floor_under_sphere
+
+from restir_engine.core import pathtracer
+from restir_engine.core.method_choice import (FEW_LIGHTS, GI_MAX_UNCACHED, GI_MIN_SHARE, choose_direct_method,
+                                              choose_indirect_method)
+from restir_engine.core.renderer import RenderSettings, render_frame
+
+
+def lights_of(scene):
+    return pathtracer.build_context(scene, 0).lights
+
+
+def test_rules():
+    sphere, square, many = lights_of(floor_under_sphere()), lights_of(floor_with_emitter()), lights_of(_many_coloured_lights())
+    assert many.n_tri > FEW_LIGHTS >= square.n_tri
+    assert choose_direct_method(sphere, False, 0)[0] == "LIGHT_SAMPLING"  # cone-sampled lamps
+    assert choose_direct_method(square, False, 0)[0] == "RESTIR"          # area light, direct only
+    assert choose_direct_method(square, False, 4)[0] == "LIGHT_SAMPLING"  # indirect noise dominates
+    assert choose_direct_method(square, False, 4, gi_expected=True)[0] == "RESTIR"  # unless GI takes it away
+    assert choose_direct_method(sphere, False, 4, gi_expected=True)[0] == "LIGHT_SAMPLING"
+    assert choose_direct_method(many, False, 4)[0] == "RESTIR"
+    assert choose_direct_method(sphere, True, 4)[0] == "RESTIR"          # a reservoir pass needs reservoirs
+    method, reason = choose_direct_method(many, False, 0)
+    assert str(many.n_tri) in reason
+
+
+def test_renderer_applies_and_reports_the_choice():
+    r = render_frame(floor_under_sphere(width=16), RenderSettings(samples=1, integrator="RESTIR", direct_method="AUTO",
+                                                                  max_bounces=1))
+    assert r.stats["direct_method"] == "LIGHT_SAMPLING" and "Reservoir M" not in r.passes
+    r = render_frame(_many_coloured_lights(16), RenderSettings(samples=1, integrator="RESTIR", direct_method="AUTO",
+                                                               max_bounces=0))
+    assert r.stats["direct_method"] == "RESTIR" and "Reservoir M" in r.passes
+    assert r.stats["spatial_radius"] >= 4.0
+
+
+def test_indirect_rules():
+    assert choose_indirect_method(GI_MIN_SHARE / 2, 0.0)[0] == "PATH"       # nothing to cache
+    assert choose_indirect_method(0.9, 0.0)[0] == "RESTIR_GI"
+    assert choose_indirect_method(0.9, GI_MAX_UNCACHED * 1.5)[0] == "PATH"  # noise GI cannot touch
+    assert "cannot cache" in choose_indirect_method(0.9, 0.9)[1]
+
+
+DIFFUSE = {"base_color": (0.7, 0.7, 0.7), "roughness": 1.0, "f0": 0.0}
+MIRROR = {"base_color": (0.9, 0.9, 0.9), "roughness": 0.05, "metallic": 1.0}
+
+
+def _auto(scene, samples=2, frame=0, **kw):
+    st = dict(samples=samples, max_bounces=2, seed=3, frame=frame, integrator="RESTIR", direct_method="AUTO",
+              indirect_method="AUTO", data_passes=False)
+    return render_frame(scene, RenderSettings(**{**st, **kw}))
+
+
+def test_auto_indirect_follows_what_the_reservoirs_can_carry():
+    """A room lit by bounce light off diffuse walls: ReSTIR GI in every pass, and ReSTIR DI for its one panel
+    (the direct light's noise is what GI leaves). The same room with a mirror floor (what the camera sees of it
+    and what lights the walls is specular, which GI does not cache) and a plane under the world (nothing to
+    cache): path tracing, and light sampling for the panel; the reason is reported."""
+    r = _auto(bounce_room(DIFFUSE, DIFFUSE, 48, 36))
+    assert r.stats["indirect_method"] == "RESTIR_GI" and r.stats["gi_skipped_passes"] == 0
+    assert r.stats["reuse"]["gi_uncached_measured"] < GI_MAX_UNCACHED / 4
+    assert r.stats["direct_method"] == "RESTIR" and "GI" in r.stats["direct_reason"]
+    r = _auto(bounce_room(MIRROR, DIFFUSE, 48, 36), samples=4)
+    assert r.stats["indirect_method"] == "PATH" and r.stats["gi_skipped_passes"] >= 3, r.stats["reuse"]
+    assert r.stats["reuse"]["gi_uncached_measured"] > 2 * GI_MAX_UNCACHED
+    assert "cannot cache" in r.stats["indirect_reason"]
+    # a pass that expected GI resampled the direct light; the passes after the choice light-sample it
+    assert r.stats["direct_method"] == "LIGHT_SAMPLING"
+    r = _auto(plane_under_world(width=16))
+    assert r.stats["indirect_method"] == "PATH" and "no bounce light" in r.stats["indirect_reason"]
+
+
+def test_auto_indirect_choice_carries_to_the_next_frame():
+    """The measurement is kept with the scene's context: the next frame of the mirror room chooses light sampling
+    for its direct light from its first pass on (no resampling pass spent on the wrong premise)."""
+    scene = bounce_room(MIRROR, DIFFUSE, 48, 36)
+    _auto(scene, samples=1, frame=0)
+    r = _auto(scene, samples=1, frame=1)
+    assert r.stats["direct_method"] == "LIGHT_SAMPLING" and "Reservoir M" not in r.passes
+    assert r.stats["indirect_method"] == "PATH"
+
+
+def test_gi_reservoir_pass_makes_auto_resample():
+    r = _auto(bounce_room(MIRROR, DIFFUSE, 48, 36), gi_reservoir_passes=True)
+    assert r.stats["indirect_method"] == "RESTIR_GI" and "GI Reservoir M" in r.passes
