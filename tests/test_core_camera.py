@@ -20,3 +20,23 @@ def test_affine_rays_match_the_projective_form(cam, monkeypatch):
     np.testing.assert_allclose(o, o2, atol=1e-5)
     np.testing.assert_allclose(d, d2, atol=1e-6)
     np.testing.assert_allclose(far, far2, rtol=1e-5)
+
+
+def test_box_pixels_hold_every_projected_point_of_the_boxes():
+    """Random points inside two boxes project into marked pixels (perspective and orthographic); the marked share is
+    small for small boxes, and a box reaching behind the camera marks the whole window."""
+    rng = np.random.default_rng(3)
+    lo = np.array([[-0.5, -0.2, 0.0], [0.6, 0.1, 0.2]], np.float32)
+    hi = np.array([[-0.2, 0.1, 0.3], [0.9, 0.4, 0.4]], np.float32)
+    for cam in (perspective_camera((0.0, -3.0, 1.5), (0.0, 0.0, 0.0), 64, 48), top_down_camera(48, 48)):
+        mask = camera_mod.box_pixels(cam, lo, hi)
+        k = rng.integers(0, 2, 5000)
+        pts = lo[k] + rng.random((5000, 3), dtype=np.float32) * (hi[k] - lo[k])
+        raster, depth = camera_mod.project(cam, pts.T)
+        x0, y0, w, h = cam.window
+        px, py = np.floor(raster[:, 0] - x0).astype(int), np.floor(raster[:, 1] - y0).astype(int)
+        inside = (px >= 0) & (px < w) & (py >= 0) & (py < h)
+        assert inside.sum() > 1000 and mask[py[inside], px[inside]].all()
+        assert mask.mean() < 0.5
+    cam = perspective_camera((0.0, -3.0, 1.5), (0.0, 0.0, 0.0), 64, 48)
+    assert camera_mod.box_pixels(cam, np.array([[-1, -5, 0]], np.float32), np.array([[1, 1, 1]], np.float32)).all()

@@ -190,3 +190,50 @@ def test_restir_integrator_splits_direct_and_indirect_exactly_in_the_furnace():
         se = m.std(ddof=1) / np.sqrt(len(m))
         assert 5 * se < 0.02 * exact, (name, se)
         assert abs(m.mean() - exact) < 5 * se, (name, m.mean(), exact, se)
+
+
+def _objects_under_world(width=48, height=36):
+    """Two small instanced quads (one level, one tilted) and a small point lamp above them in a wide view of a
+    constant world: most camera rays meet nothing."""
+    import dataclasses
+
+    from scenes_core import concat, perspective_camera, quad, tris
+
+    from restir_engine.core.scene import MaterialTable, Scene
+    from test_sphere_lights import floor_under_sphere
+    mats = MaterialTable.build([{"base_color": (0.6, 0.5, 0.4), "roughness": 0.4},
+                                {"base_color": (0, 0, 0), "f0": 0.0, "emission": (5.0,) * 3,
+                                 "two_sided_emission": False}])
+    a = tris(quad((-0.6, 0, 0), (0.25, 0, 0), (0, 0.25, 0)), 0)
+    b = tris(quad((0.7, 0.2, 0.3), (0.2, 0, 0.1), (0, 0.2, 0)), 0)
+    geom = concat([a, b])
+    geom = dataclasses.replace(geom, instance=np.array([0, 0, 1, 1], np.int32))
+    cam = perspective_camera((0.0, -3.0, 1.5), (0.0, 0.0, 0.0), width, height)
+    lamps = floor_under_sphere(radius=0.08, height=0.9).lamps  # a point lamp in view, its proxy's material 1
+    return Scene(geom, mats, lamps, cam, world_radiance=np.full(3, 0.7, np.float32))
+
+
+def test_camera_rays_outside_the_objects_boxes_are_not_traced(monkeypatch):
+    """The window pixels outside the projected boxes of the instances (camera.box_pixels) skip the geometry, those
+    outside the visible lamps' boxes the lamps: the image is bit-identical to tracing every camera ray against
+    everything (same seed), on both integrators."""
+    from restir_engine.core import renderer
+    scene = _objects_under_world()
+    for integrator in ("PATH", "RESTIR"):
+        st = RenderSettings(samples=2, max_bounces=2, seed=5, integrator=integrator, direct_method="AUTO",
+                            indirect_method="AUTO", data_passes=False)
+        masked = render_frame(scene, st)
+        ctx_mask = renderer._geometry_mask(renderer.context_for(scene, 2, False, renderer.pathtracer.build_context)[0],
+                                           scene.camera)
+        assert ctx_mask is not None and 0.02 < ctx_mask.mean() < 0.5
+        lamp_mask = renderer._lamp_mask(renderer.context_for(scene, 2, False, renderer.pathtracer.build_context)[0],
+                                        scene.camera)
+        assert lamp_mask is not None and 0.001 < lamp_mask.mean() < 0.2
+        with monkeypatch.context() as m:
+            m.setattr(renderer, "_geometry_mask", lambda ctx, camera: None)
+            m.setattr(renderer, "_lamp_mask", lambda ctx, camera: None)
+            full = render_frame(scene, st)
+        assert np.array_equal(masked.passes["Combined"], full.passes["Combined"])
+        # the objects are in the image: the mask did not just cover an empty view
+        assert (np.abs(full.passes["Combined"][..., :3] - 0.7).max(axis=2) > 0.05).sum() > 20
+        assert full.passes["Emission"].max() > 4.0  # the lamp is seen

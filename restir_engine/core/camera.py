@@ -99,11 +99,10 @@ def emitter_pixels(cam: Camera, tris: np.ndarray, centers: np.ndarray, radii: np
     x0, y0, w, h = cam.window
     boxes = []
     if len(tris):
-        raster, depth = project(cam, np.asarray(tris, np.float32).reshape(-1, 3).T)
-        if (depth <= 1e-6).any():
+        box = _projected_boxes(cam, tris, margin)
+        if box is None:
             return np.ones((h, w), bool)
-        r = raster.reshape(-1, 3, 2)
-        boxes.append((r.min(axis=1) - margin, r.max(axis=1) + margin))
+        boxes.append(box)
     if len(centers):
         c = np.asarray(centers, np.float32)
         rad = np.asarray(radii, np.float32)
@@ -118,8 +117,38 @@ def emitter_pixels(cam: Camera, tris: np.ndarray, centers: np.ndarray, radii: np
         boxes.append((mid - half, mid + half))
     if not boxes:
         return np.zeros((h, w), bool)
-    lo = np.concatenate([b[0] for b in boxes])
-    hi = np.concatenate([b[1] for b in boxes])
+    return _mark_boxes(cam, np.concatenate([b[0] for b in boxes]), np.concatenate([b[1] for b in boxes]))
+
+
+def box_pixels(cam: Camera, lo: np.ndarray, hi: np.ndarray, margin: float = 1.0) -> np.ndarray:
+    """(h, w) bool over the camera's window: the pixels whose camera rays may meet something inside the world-space
+    axis-aligned boxes ``lo`` / ``hi`` (k, 3): the box of each one's eight projected corners, widened by ``margin``
+    pixels (the whole window when a box reaches behind the camera's plane). Outside, a camera ray meets nothing."""
+    x0, y0, w, h = cam.window
+    if len(lo) == 0:
+        return np.zeros((h, w), bool)
+    lo, hi = np.asarray(lo, np.float32), np.asarray(hi, np.float32)
+    sel = np.array([[(i >> a) & 1 for a in range(3)] for i in range(8)], bool)  # (8, 3): which corner takes hi
+    corners = np.where(sel[None], hi[:, None, :], lo[:, None, :])             # (k, 8, 3)
+    box = _projected_boxes(cam, corners, margin)
+    return np.ones((h, w), bool) if box is None else _mark_boxes(cam, *box)
+
+
+def _projected_boxes(cam: Camera, groups: np.ndarray, margin: float):
+    """Raster boxes (lo (k, 2), hi (k, 2)) of point groups (k, m, 3) widened by ``margin``; None when a point is
+    not in front of the camera."""
+    g = np.asarray(groups, np.float32)
+    raster, depth = project(cam, g.reshape(-1, 3).T)
+    if (depth <= 1e-6).any():
+        return None
+    r = raster.reshape(len(g), -1, 2)
+    return r.min(axis=1) - margin, r.max(axis=1) + margin
+
+
+def _mark_boxes(cam: Camera, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(h, w) bool over the window: the pixels touched by raster boxes lo / hi (k, 2), summed into a difference
+    array."""
+    x0, y0, w, h = cam.window
     bx0 = np.clip(np.floor(lo[:, 0] - x0), 0, w).astype(np.int64)
     bx1 = np.clip(np.ceil(hi[:, 0] - x0), 0, w).astype(np.int64)
     by0 = np.clip(np.floor(lo[:, 1] - y0), 0, h).astype(np.int64)

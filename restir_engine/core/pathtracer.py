@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import camera as camera_mod
-from .accel import Accel, offset_origin, shadow_rays
+from .accel import Accel, Hits, offset_origin, shadow_rays
 from . import microfacet_tables
 from .cutout import Cutout
 from .world import World
@@ -132,12 +132,22 @@ class PrimaryHits:
     surf: Surface
 
 
-def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray) -> PrimaryHits:
-    """Camera rays through raster points (x, y) (window pixels + jitter, y up)."""
+def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray | None = None,
+            may_see_lamp: np.ndarray | None = None) -> PrimaryHits:
+    """Camera rays through raster points (x, y) (window pixels + jitter, y up). ``may_hit`` / ``may_see_lamp`` (n,)
+    bool: False where the ray is known to meet no geometry / no lamp visible to the camera (projected boxes,
+    camera.box_pixels and camera.emitter_pixels), which is then not traced against it."""
     cam = ctx.scene.camera
     o, d, tmax = camera_mod.generate_rays(cam, x, y)
-    hits = ctx.geom_accel.intersect(o, d, tmax)
-    emitted, alpha = _seen(ctx, o, d, tmax, hits)
+    if may_hit is None or may_hit.all():
+        hits = ctx.geom_accel.intersect(o, d, tmax)
+    else:
+        hits = Hits(len(x))
+        idx = np.flatnonzero(may_hit)
+        if idx.size:
+            sub = ctx.geom_accel.intersect(cols(o, idx), cols(d, idx), None if tmax is None else tmax[idx])
+            hits.prim[idx], hits.t[idx], hits.u[idx], hits.v[idx] = sub.prim, sub.t, sub.u, sub.v
+    emitted, alpha = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
     rows = np.flatnonzero(hits.prim >= 0)
     surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
     return PrimaryHits(emitted, alpha, rows, surf)
@@ -150,21 +160,30 @@ def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax))
 
 
-def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True):
+def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: np.ndarray | None = None):
     """Emission (3, n) camera rays meet first: visible lamps in front of the hit, emissive surfaces, the world
     where nothing is hit (unless the film is transparent); alpha (n,) 0 where nothing is hit on a transparent
     film. ``camera`` False: rays continuing a camera ray through delta interfaces (every lamp is seen, the film's
-    transparency does not apply)."""
+    transparency does not apply). ``lamp_mask`` (n,) bool: only these rays may see a lamp (None: all)."""
     n = len(hits.prim)
     emitted = np.zeros((3, n), np.float32)
     alpha = np.ones(n, np.float32)
-    if len(ctx.scene.lamps.tris):  # lamps seen by the camera (those marked visible to camera rays)
-        lh = lamp_hits(ctx, o, d, hits.t if tmax is None else np.minimum(hits.t, tmax))
-        sel = np.flatnonzero(lh.prim >= 0)
+    rows = None if lamp_mask is None else np.flatnonzero(lamp_mask)
+    if len(ctx.scene.lamps.tris) and (rows is None or rows.size):  # lamps seen (camera rays: those visible to them)
+        far = hits.t if tmax is None else np.minimum(hits.t, tmax)
+        if rows is None:
+            lh = lamp_hits(ctx, o, d, far)
+            sel = np.flatnonzero(lh.prim >= 0)
+            oo, dd = o, d
+        else:
+            oo, dd = cols(o, rows), cols(d, rows)
+            lh = lamp_hits(ctx, oo, dd, far[rows])
+            sel = np.flatnonzero(lh.prim >= 0)
         if camera:
             sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
         if sel.size:
-            emitted[:, sel] += _lamp_emission(ctx, lh, o, d, sel)[0]
+            em = _lamp_emission(ctx, lh, oo, dd, sel)[0]
+            emitted[:, sel if rows is None else rows[sel]] += em
     miss = hits.prim < 0
     if ctx.film_transparent and camera:
         alpha[miss] = 0.0
@@ -555,17 +574,40 @@ class GeometryDerived:
     ng_rows: np.ndarray    # (3, n)
     flat: np.ndarray       # (n,) bool: the three corner normals are equal
     normal_rows: np.ndarray  # (9, n) corner shading normals as rows
+    boxes: tuple = None    # (lo (k, 3), hi (k, 3)): each instance's box (one box without instances; camera.box_pixels)
 
     @staticmethod
     def of(geom) -> "GeometryDerived":
         verts = geom.verts.reshape(-1, 3)
         finite = verts[np.isfinite(verts).all(axis=1)]
         bounds = (finite.min(0), finite.max(0)) if len(finite) else None
+        boxes = instance_boxes(geom, bounds)
         ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
         nrm = geom.normals
         flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
         return GeometryDerived(bounds, ng, np.ascontiguousarray(ng.T), flat,
-                               np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32))
+                               np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32), boxes)
+
+
+def instance_boxes(geom, bounds) -> tuple:
+    """(lo (k, 3), hi (k, 3)) float32: the bounding box of each instance's finite vertices (geometry.instance),
+    or the scene's ``bounds`` as one box when there are no instances; empty without geometry."""
+    empty = (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.float32))
+    if bounds is None:
+        return empty
+    inst = geom.instance
+    if inst is None or len(inst) == 0 or inst.min() == inst.max():
+        return np.asarray(bounds[0], np.float32)[None], np.asarray(bounds[1], np.float32)[None]
+    v = geom.verts
+    ok = np.isfinite(v).all(axis=2)[..., None]
+    tlo = np.where(ok, v, np.inf).min(axis=1)
+    thi = np.where(ok, v, -np.inf).max(axis=1)
+    order = np.argsort(inst, kind="stable")
+    starts = np.flatnonzero(np.r_[True, np.diff(inst[order]) != 0])
+    lo = np.minimum.reduceat(tlo[order], starts)
+    hi = np.maximum.reduceat(thi[order], starts)
+    keep = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
+    return lo[keep].astype(np.float32), hi[keep].astype(np.float32)
 
 
 def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False, accels: dict | None = None

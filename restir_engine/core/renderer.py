@@ -128,6 +128,32 @@ def _coverage(setting: int, lights, lamps, camera=None) -> tuple[int, str, np.nd
     return 1, "no emitter can be seen directly", None
 
 
+GEOMETRY_MASK_MAX = 0.9  # the share of the window above which masking camera rays by object boxes is not worth it
+
+
+def _geometry_mask(ctx, camera) -> np.ndarray | None:
+    """(window pixels,) bool: where a camera ray may meet geometry (the projected boxes of the instances,
+    camera.box_pixels); elsewhere it sees only lamps and the world, and is not traced. None when it would mark
+    most of the window anyway."""
+    derived = ctx.geom_derived
+    if derived is None or derived.boxes is None:
+        return None
+    mask = camera_mod.box_pixels(camera, *derived.boxes).ravel()
+    return None if mask.mean() > GEOMETRY_MASK_MAX else mask
+
+
+def _lamp_mask(ctx, camera) -> np.ndarray | None:
+    """(window pixels,) bool: where a camera ray may see a lamp visible to camera rays (the projected boxes of their
+    triangles and sphere proxies, camera.emitter_pixels); elsewhere lamps are not intersected. None when it would
+    mark most of the window anyway."""
+    lamps = ctx.scene.lamps
+    if len(lamps.tris) == 0:
+        return None
+    vis = lamps.camera_visible
+    mask = camera_mod.emitter_pixels(camera, lamps.tris.verts[vis], np.zeros((0, 3)), np.zeros(0)).ravel()
+    return None if mask.mean() > GEOMETRY_MASK_MAX else mask
+
+
 def _seen_lights(lights, lamps) -> np.ndarray:
     """(n_tri,) bool: the light entries camera rays can see (emissive triangles; lamps visible to the camera)."""
     seen = np.ones(lights.n_tri, bool)
@@ -151,6 +177,7 @@ def coverage_pixels(camera, lights, lamps):
 AUTO_COVERAGE = 4
 MEASURE_DECAY = 0.8  # AUTO indirect: weight of the earlier passes' measurements per pass (FrameRenderer)
 PROBE_EVERY = 4  # AUTO indirect while path tracing: one chunk in this many measures (in a frame's first pass)
+PROBE_FRAMES = 8  # ... in every this many frames (or views) of the same scene content
 GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's: 6 px at 640x360 (measured on interior_gi:
 #                          relMSE 0.23 at 5 px, 0.29 at 8, 0.71 at 16 with 4 passes, 1 spp)
 MANY_COVERAGE = 16
@@ -345,6 +372,8 @@ class FrameRenderer:
         # coverage_mask: the pixels that get the coverage rays (None: all)
         self.coverage, self.coverage_reason, self.coverage_mask = _coverage(
             self.settings.coverage_samples, self.ctx.lights, self.ctx.scene.lamps, camera)
+        self.geometry_mask = _geometry_mask(self.ctx, camera)
+        self.lamp_mask = _lamp_mask(self.ctx, camera)
         _x0, _y0, w, h = camera.window
         self.release()
         self.acc = {"emit": _BUFFERS.zeros((h, w, 3)), "direct": _BUFFERS.zeros((h, w, 3)),
@@ -438,9 +467,14 @@ class FrameRenderer:
         resampled = self.candidates is not None
         reusing = self.method == "RESTIR"
         # ReSTIR GI runs in this pass (AUTO: while its last measurement says so); AUTO measures in every pass that
-        # runs GI, and while it path-traces, in a quarter of the chunks of each frame's first pass (``probe``)
+        # runs GI, and while it path-traces, in a quarter of the chunks of the first pass of every PROBE_FRAMES-th
+        # frame of this content (``probe``: the first bounces' extra work costs about 12 % of such a frame)
         gi_on = self.gi is not None and (not self.gi_auto or self.indirect_method == "RESTIR_GI")
-        probe = self.gi_auto and not gi_on and s == 0
+        probe = False
+        if self.gi_auto and not gi_on and s == 0:
+            since = self.ctx.measured.get("frames_since_probe", PROBE_FRAMES)
+            probe = since >= PROBE_FRAMES
+            self.ctx.measured["frames_since_probe"] = 1 if probe else since + 1
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
         chunk_stages = 4 + int(resampled) + (int(self.spatial.passes) + 1 if reusing else 0) + \
             (int(self.gi.passes) + 1 if gi_on else 0)
@@ -449,11 +483,13 @@ class FrameRenderer:
 
         strata = self.coverage
         cover = self.coverage_mask
+        may_hit, lamp_mask = self.geometry_mask, self.lamp_mask
 
         def primary(c: _Chunk):
             camera_rays(c)
-            if st.integrator == "RESTIR" and ctx.has_glass:
-                # camera rays that met smooth glass continue to the surface behind it, where resampling runs
+            if st.integrator == "RESTIR" and ctx.has_glass and (resampled or gi_on):
+                # camera rays that met glass continue to the surface behind it, where resampling runs (without
+                # resampling, the path continuation handles glass as the path tracer does, at less cost)
                 c.chain = pathtracer.follow_specular(ctx, c.hits, rng(st.seed, st.frame, s, STREAM_CHAIN, c.index))
 
         def camera_rays(c: _Chunk):
@@ -463,13 +499,15 @@ class FrameRenderer:
             j = pass_jitter(shift.view(np.uint32).reshape(-1, 2), s)
             px = (x0 + c.pixels % w).astype(np.float32)
             py = (y0 + c.pixels // w).astype(np.float32)
+            hit_mask = None if may_hit is None else may_hit[c.pixels]
+            lamp_seen = None if lamp_mask is None else lamp_mask[c.pixels]
             if strata == 1:
-                c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
+                c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1], hit_mask, lamp_seen)
                 return
             # the shaded ray where the pass puts it (uniform over the pixel, so uniform within the stratum it
             # falls in), one more ray in each other stratum, in the pixels near an emitter (coverage_mask)
             g = int(round(np.sqrt(strata)))
-            c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1])
+            c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1], hit_mask, lamp_seen)
             sel = slice(None) if cover is None else np.flatnonzero(cover[c.pixels])
             jx, jy, sx, sy = j[sel, 0], j[sel, 1], px[sel], py[sel]
             if len(jx) == 0:
