@@ -279,8 +279,9 @@ class FrameRenderer:
         self.ctx, self.context_reused = context_for(scene, bounces, settings.film_transparent,
                                                     pathtracer.build_context)
         self.gi = None  # gi.GISettings when the indirect light is resampled
-        # the indirect method: AUTO measures in each frame's first pass (method_choice.choose_indirect_method); the
-        # frame's other passes follow, and the frames after it start from the last measurement of this content
+        # the indirect method: AUTO measures on the first bounces of its passes (method_choice.choose_indirect_method)
+        # and a pass follows what the passes before it measured (this frame's, or earlier frames' and views' of the
+        # same content, kept on the context): never its own samples, so the choice does not bias the pass
         self.gi_auto = settings.integrator == "RESTIR" and settings.indirect_method == "AUTO" and bounces > 0 and \
             not settings.gi_reservoir_passes
         self.indirect_method = "PATH" if bounces > 0 else "OFF"
@@ -595,8 +596,7 @@ class FrameRenderer:
             uncached = float(sums[3] / sums[2]) if sums[2] > 0 else 1.0
             self.reuse_stats["gi_share"], self.reuse_stats["gi_uncached"] = share, uncached
             if self.gi_auto:
-                self._measured_indirect(sums)
-                gi_on = gi_on and self.indirect_method == "RESTIR_GI"  # a probe's choice applies from the next pass
+                self._measured_indirect(sums)  # for the next passes
             elif share < GI_MIN_SHARE:
                 gi_on = False
             if not gi_on:
