@@ -1,4 +1,5 @@
 """The automatic direct and indirect methods (core/method_choice.py) and that the renderer applies and reports them."""
+import numpy as np
 from scenes_core import bounce_room, floor_with_emitter, plane_under_world
 from test_light_tiles import _many_coloured_lights
 from test_sphere_lights import floor_under_sphere
@@ -74,13 +75,17 @@ def test_auto_indirect_follows_what_the_reservoirs_can_carry():
 
 
 def test_auto_indirect_choice_carries_to_the_next_frame():
-    """The measurement is kept with the scene's context: the next frame of the mirror room chooses light sampling
-    for its direct light from its first pass on (no resampling pass spent on the wrong premise)."""
+    """The measurement is kept with the scene's context for the next frame: frame 1 of the mirror room chooses
+    light sampling for its direct light and path tracing from its first pass on (no pass spent on the wrong
+    premise). Only frame f + 1 uses frame f's measurement, so rendering a frame again gives the same image."""
     scene = bounce_room(MIRROR, DIFFUSE, 48, 36)
-    _auto(scene, samples=1, frame=0)
+    first = _auto(scene, samples=1, frame=0)
+    assert first.stats["gi_skipped_passes"] == 0  # nothing measured yet: ReSTIR GI, measuring
     r = _auto(scene, samples=1, frame=1)
     assert r.stats["direct_method"] == "LIGHT_SAMPLING" and "Reservoir M" not in r.passes
-    assert r.stats["indirect_method"] == "PATH"
+    assert r.stats["indirect_method"] == "PATH" and r.stats["gi_skipped_passes"] == 1
+    again = _auto(scene, samples=1, frame=0)
+    assert np.array_equal(again.passes["Combined"], first.passes["Combined"])
 
 
 def test_gi_reservoir_pass_makes_auto_resample():

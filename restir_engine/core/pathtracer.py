@@ -62,8 +62,8 @@ class TraceContext:
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
     lamp_ng_rows: np.ndarray = None     # (3, n_lamp) lamp_ng as rows
     geom_derived: "GeometryDerived" = None  # the geometry-only arrays above, kept for a rebuild over the same triangles
-    # what rendering this content measured (shared by the frames and views that reuse this context): "indirect" ->
-    # the AUTO indirect method and its reason (renderer, method_choice.choose_indirect_method)
+    # what rendering this content measured (shared by the frames and views that reuse this context):
+    # "auto_indirect" -> the last frame's AUTO indirect measurement and choice (renderer.FrameRenderer._remember)
     measured: dict = field(default_factory=dict)
 
 

@@ -280,18 +280,23 @@ class FrameRenderer:
                                                     pathtracer.build_context)
         self.gi = None  # gi.GISettings when the indirect light is resampled
         # the indirect method: AUTO measures on the first bounces of its passes (method_choice.choose_indirect_method)
-        # and a pass follows what the passes before it measured (this frame's, or earlier frames' and views' of the
-        # same content, kept on the context): never its own samples, so the choice does not bias the pass
+        # and a pass follows what the passes before it measured: this frame's, or the previous frame's of the same
+        # content (kept on the context, used only by frame f + 1, so rendering a frame again gives the same image).
+        # Never its own samples, so the choice does not bias the pass.
         self.gi_auto = settings.integrator == "RESTIR" and settings.indirect_method == "AUTO" and bounces > 0 and \
             not settings.gi_reservoir_passes
+        self._measure = (None, PROBE_FRAMES)  # AUTO: decayed measurement sums (or None), frames since the last probe
         self.indirect_method = "PATH" if bounces > 0 else "OFF"
         self.indirect_reason = "path tracer" if settings.integrator == "PATH" else "no bounces" if bounces == 0 else \
             "set by the user"
         if settings.integrator == "RESTIR" and bounces > 0 and settings.indirect_method != "PATH":
             self.indirect_method = "RESTIR_GI"
             if self.gi_auto:
-                self.indirect_method, self.indirect_reason = self.ctx.measured.get(
-                    "indirect", ("RESTIR_GI", "not measured yet: the first pass measures"))
+                self.indirect_method, self.indirect_reason = "RESTIR_GI", "not measured yet: the first pass measures"
+                rec = self.ctx.measured.get("auto_indirect")
+                if rec is not None and rec["frame"] == settings.frame - 1:
+                    self.indirect_method, self.indirect_reason = rec["choice"]
+                    self._measure = (rec["sums"], rec["since"])
             elif settings.indirect_method == "AUTO":
                 self.indirect_reason = "a GI reservoir pass is enabled"
         if settings.integrator == "RESTIR":
@@ -473,9 +478,10 @@ class FrameRenderer:
         gi_on = self.gi is not None and (not self.gi_auto or self.indirect_method == "RESTIR_GI")
         probe = False
         if self.gi_auto and not gi_on and s == 0:
-            since = self.ctx.measured.get("frames_since_probe", PROBE_FRAMES)
+            sums, since = self._measure
             probe = since >= PROBE_FRAMES
-            self.ctx.measured["frames_since_probe"] = 1 if probe else since + 1
+            self._measure = (sums, 1 if probe else since + 1)
+            self._remember()
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
         chunk_stages = 4 + int(resampled) + (int(self.spatial.passes) + 1 if reusing else 0) + \
             (int(self.gi.passes) + 1 if gi_on else 0)
@@ -663,17 +669,23 @@ class FrameRenderer:
         of this content (kept on the shared context, so frames and views carry them; older passes count less:
         MEASURE_DECAY per pass, a memory of about five passes). The AUTO direct method is chosen again when its
         premise (GI or not) changed; it applies from the next pass on."""
-        acc = self.ctx.measured.get("gi_sums")
+        acc, since = self._measure
         acc = sums if acc is None else acc * MEASURE_DECAY + sums
-        self.ctx.measured["gi_sums"] = acc
+        self._measure = (acc, since)
         share = float(acc[1] / acc[0]) if acc[0] > 0 else 0.0
         uncached = float(acc[3] / acc[2]) if acc[2] > 0 else 1.0
         self.reuse_stats["gi_share_measured"], self.reuse_stats["gi_uncached_measured"] = share, uncached
         before = self.indirect_method
         self.indirect_method, self.indirect_reason = choose_indirect_method(share, uncached)
-        self.ctx.measured["indirect"] = (self.indirect_method, self.indirect_reason)
+        self._remember()
         if self.indirect_method != before and self.settings.direct_method == "AUTO":
             self._choose_direct(self.ctx.max_bounces)
+
+    def _remember(self) -> None:
+        """Keep the AUTO indirect measurement on the context for the next frame (or view) of the same content."""
+        self.ctx.measured["auto_indirect"] = {"frame": self.settings.frame, "choice": (self.indirect_method,
+                                              self.indirect_reason), "sums": self._measure[0],
+                                              "since": self._measure[1]}
 
     def _gbuffer(self, chunks, terms) -> GBuffer:
         """The frame's G-buffer from the chunks' primary hits (surfaces in chunk order)."""
