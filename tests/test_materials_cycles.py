@@ -221,8 +221,10 @@ def test_rough_glass_matches_cycles(addon, integrator):
     cells = image_cells(size)
     kw = {"integrator": "PATH"} if integrator == "PATH" else {}
     rough = (0.3, 0.2, 0.5)
-    ours = render_reps(lambda: glass_scene(size, roughness=rough), "RESTIR", 4, 64, **kw)
-    ref = render_reps(lambda: glass_scene(size, roughness=rough), "CYCLES", 4, 128)
+    # twice the smooth test's samples: at 64 / 128 spp the Glass BSDF sphere's cell had rel SE 0.4 %, where
+    # 5 SE + 0.5 % no longer sees a 3 % error (Python 3.13 run); 0.23 % at these samples
+    ours = render_reps(lambda: glass_scene(size, roughness=rough), "RESTIR", 4, 128, **kw)
+    ref = render_reps(lambda: glass_scene(size, roughness=rough), "CYCLES", 4, 256)
     assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
                        power=[k for k in range(16) if k not in (8, 9, 10, 11)])
 
