@@ -75,12 +75,14 @@ def test_auto_indirect_follows_what_the_reservoirs_can_carry():
 
 
 def test_auto_indirect_choice_carries_to_the_next_frame():
-    """The measurement is kept with the scene's context for the next frame: frame 1 of the mirror room chooses
-    light sampling for its direct light and path tracing from its first pass on (no pass spent on the wrong
-    premise). Only frame f + 1 uses frame f's measurement, so rendering a frame again gives the same image."""
+    """A frame without a measurement probes a sixteenth of its pixels (their own random stream) before its first
+    pass; the measurement is kept with the scene's context for the next frame: frame 1 of the mirror room chooses
+    light sampling for its direct light and path tracing from its first pass on, without a probe. Only frame f + 1
+    uses frame f's measurement, so rendering a frame again gives the same image."""
     scene = bounce_room(MIRROR, DIFFUSE, 48, 36)
     first = _auto(scene, samples=1, frame=0)
-    assert first.stats["gi_skipped_passes"] == 0  # nothing measured yet: ReSTIR GI, measuring
+    assert first.stats["gi_skipped_passes"] == 1  # nothing measured yet: a probe chose before the first pass
+    assert first.stats["direct_method"] == "LIGHT_SAMPLING"
     r = _auto(scene, samples=1, frame=1)
     assert r.stats["direct_method"] == "LIGHT_SAMPLING" and "Reservoir M" not in r.passes
     assert r.stats["indirect_method"] == "PATH" and r.stats["gi_skipped_passes"] == 1

@@ -43,7 +43,8 @@ from .profile import NullClock
 from .restir import di, gi, reuse
 from .restir.gbuffer import GBuffer
 from .restir.history import TemporalHistory
-from .sampling import (STREAM_CAMERA, STREAM_GI_SPATIAL, STREAM_CHAIN, STREAM_GI_TEMPORAL, STREAM_INITIAL, STREAM_PATH,
+from .sampling import (STREAM_CAMERA, STREAM_CHAIN, STREAM_GI_SPATIAL, STREAM_GI_TEMPORAL, STREAM_INITIAL, STREAM_PATH,
+                       STREAM_PROBE,
                        STREAM_PIXEL_OFFSET, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, STREAM_TILES, finite,
                        pass_jitter, rng)
 from .scene import Scene
@@ -178,6 +179,7 @@ AUTO_COVERAGE = 4
 MEASURE_DECAY = 0.8  # AUTO indirect: weight of the earlier passes' measurements per pass (FrameRenderer)
 PROBE_EVERY = 4  # AUTO indirect while path tracing: one chunk in this many measures (in a frame's first pass)
 PROBE_FRAMES = 8  # ... in every this many frames (or views) of the same scene content
+PROBE_PIXELS = 16  # a frame without a measurement first probes one pixel in this many (FrameRenderer._probe)
 GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's: 6 px at 640x360 (measured on interior_gi:
 #                          relMSE 0.23 at 5 px, 0.29 at 8, 0.71 at 16 with 4 passes, 1 spp)
 MANY_COVERAGE = 16
@@ -470,6 +472,9 @@ class FrameRenderer:
         x0, y0, w, h = self.ctx.scene.camera.window
         npix = w * h
         chunks = [_Chunk(i, np.arange(sl.start, sl.stop)) for i, sl in enumerate(self._spans(npix))]
+        if self.gi_auto and s == 0 and self._measure[0] is None:
+            with clock.stage("probe"):  # nothing measured yet (a still, a first frame): measure before choosing
+                self._probe()
         resampled = self.candidates is not None
         reusing = self.method == "RESTIR"
         # ReSTIR GI runs in this pass (AUTO: while its last measurement says so); AUTO measures in every pass that
@@ -587,10 +592,7 @@ class FrameRenderer:
                 t = gi.diffuse_only(ShadingTerms(block), c.glossy)
                 c.path_indirect = c.indirect
                 c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi_space)
-                lum_all, lum_rest = luminance_rows(c.path_indirect), luminance_rows(c.indirect)
-                total = float(lum_all.sum())
-                c.gi_share = (total, total - float(lum_rest.sum()), float(np.dot(lum_all, lum_all)),
-                              float(np.dot(lum_rest, lum_rest)))
+                c.gi_share = _share_sums(c.path_indirect, c.indirect)
 
         with clock.stage("paths"):
             self._map(paths, chunks, stop)
@@ -663,6 +665,30 @@ class FrameRenderer:
             self._map(shade, chunks, stop)
         with clock.stage("passes"):
             self._accumulate(chunks, resampled, stop)
+
+    def _probe(self) -> None:
+        """AUTO indirect without a measurement: camera paths through one pixel in PROBE_PIXELS (their own random
+        stream, so the frame's passes are independent of it and the image is unbiased and deterministic) measure
+        what the GI reservoirs would carry, and the frame's first pass follows that. A few percent of a pass."""
+        st, ctx = self.settings, self.ctx
+        x0, y0, w, h = ctx.scene.camera.window
+        r = rng(st.seed, st.frame, 0, STREAM_PROBE)
+        pix = r.integers(0, w * h, max(1, (w * h) // PROBE_PIXELS))
+        jit = r.random((2, len(pix)), dtype=np.float32)
+        hits = pathtracer.primary(ctx, (x0 + pix % w).astype(np.float32) + jit[0],
+                                  (y0 + pix // w).astype(np.float32) + jit[1],
+                                  None if self.geometry_mask is None else self.geometry_mask[pix])
+        surf = hits.surf
+        sums = np.zeros(4)
+        if len(surf):
+            out = pathtracer.continue_paths(ctx, surf, r, direct_resampled=False, first_bounce=True)
+            block = np.empty((WIDTH, len(surf)), np.float32)
+            ShadingTerms.of_surfaces(surf, block)
+            glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
+            _res, rest = gi.initial(out[2], gi.diffuse_only(ShadingTerms(block), glossy), len(surf), glossy,
+                                    self.gi_space)
+            sums = _share_sums(out[1], rest)
+        self._measured_indirect(sums)
 
     def _measured_indirect(self, sums: np.ndarray) -> None:
         """AUTO: the indirect method for this pass from the measured sums (_Chunk.gi_share) of the passes so far
@@ -862,6 +888,15 @@ class FrameRenderer:
         if self.settings.data_passes:
             out["Depth"], out["Normal"], out["Vector"] = (finite(a) for a in self.data_passes())
         return out
+
+
+def _share_sums(indirect: np.ndarray, rest: np.ndarray) -> np.ndarray:
+    """(4,) over surfaces: luminance sums of the path-traced indirect light (3, n) and of the part the GI reservoirs
+    carry (indirect - rest); sums of squares of the indirect light and of ``rest``, the part they do not carry."""
+    lum_all, lum_rest = luminance_rows(indirect), luminance_rows(rest)
+    total = float(lum_all.sum())
+    return np.array([total, total - float(lum_rest.sum()), float(np.dot(lum_all, lum_all)),
+                     float(np.dot(lum_rest, lum_rest))])
 
 
 def _chunk_size(n: int, target: int) -> int:
