@@ -179,7 +179,8 @@ AUTO_COVERAGE = 4
 MEASURE_DECAY = 0.8  # AUTO indirect: weight of the earlier passes' measurements per pass (FrameRenderer)
 PROBE_EVERY = 4  # AUTO indirect while path tracing: one chunk in this many measures (in a frame's first pass)
 PROBE_FRAMES = 8  # ... in every this many frames (or views) of the same scene content
-PROBE_PIXELS = 16  # a frame without a measurement first probes one pixel in this many (FrameRenderer._probe)
+PROBE_PIXELS = 32  # a frame without a measurement first probes one pixel in this many (FrameRenderer._probe),
+PROBE_BOUNCES = 2  # with paths of at most this many bounces (the split is decided at the first two vertices)
 GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's: 6 px at 640x360 (measured on interior_gi:
 #                          relMSE 0.23 at 5 px, 0.29 at 8, 0.71 at 16 with 4 passes, 1 spp)
 MANY_COVERAGE = 16
@@ -667,9 +668,9 @@ class FrameRenderer:
             self._accumulate(chunks, resampled, stop)
 
     def _probe(self) -> None:
-        """AUTO indirect without a measurement: camera paths through one pixel in PROBE_PIXELS (their own random
-        stream, so the frame's passes are independent of it and the image is unbiased and deterministic) measure
-        what the GI reservoirs would carry, and the frame's first pass follows that. A few percent of a pass."""
+        """AUTO indirect without a measurement: camera paths of up to PROBE_BOUNCES bounces through one pixel in
+        PROBE_PIXELS (their own random stream, so the frame's passes are independent of it and the image is unbiased
+        and deterministic) measure what the GI reservoirs would carry, and the frame's first pass follows that."""
         st, ctx = self.settings, self.ctx
         x0, y0, w, h = ctx.scene.camera.window
         r = rng(st.seed, st.frame, 0, STREAM_PROBE)
@@ -681,7 +682,8 @@ class FrameRenderer:
         surf = hits.surf
         sums = np.zeros(4)
         if len(surf):
-            out = pathtracer.continue_paths(ctx, surf, r, direct_resampled=False, first_bounce=True)
+            out = pathtracer.continue_paths(ctx, surf, r, direct_resampled=False, first_bounce=True,
+                                            budget=np.full(len(surf), min(PROBE_BOUNCES, ctx.max_bounces)))
             block = np.empty((WIDTH, len(surf)), np.float32)
             ShadingTerms.of_surfaces(surf, block)
             glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
