@@ -690,6 +690,7 @@ class FrameRenderer:
             _res, rest = gi.initial(out[2], gi.diffuse_only(ShadingTerms(block), glossy), len(surf), glossy,
                                     self.gi_space)
             sums = _share_sums(out[1], rest)
+        self._measure = (None, 1)  # measured now: no periodic probe in this frame's first pass
         self._measured_indirect(sums)
 
     def _measured_indirect(self, sums: np.ndarray) -> None:
