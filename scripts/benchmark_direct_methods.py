@@ -31,6 +31,7 @@ import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
 from harness.metrics import rel_mse  # noqa: E402
+from harness.report import efficiency_bars, save_bar_figure  # noqa: E402
 from harness.reference import reference_image, reference_lit  # noqa: E402
 from harness.scenes import ensure_blend  # noqa: E402
 from restir_engine.core import pathtracer  # noqa: E402
@@ -119,22 +120,14 @@ def chart(results, path):
     fig, axes = plt.subplots(1, len(cases), figsize=(5 * len(cases), 4.5), sharey=True)
     for ax, (b, c) in zip(axes, cases):
         rows = [r for r in results if r["bounces"] == b and r["case"] == c]
-        x = np.arange(len(rows))
-        for i, m in enumerate(METHODS):
-            gain = [r["methods"][m]["efficiency"] / r["methods"]["LIGHT_SAMPLING"]["efficiency"] for r in rows]
-            ax.bar(x + (i - 1) * 0.27, gain, 0.27, label=m)
+        gains = {m: [r["methods"][m]["efficiency"] / r["methods"]["LIGHT_SAMPLING"]["efficiency"] for r in rows]
+                 for m in METHODS}
+        efficiency_bars(ax, [r["scene"] for r in rows], gains, f"{c}, {b} bounces", rotation=60)
         for j, r in enumerate(rows):
             ax.text(j, 0.02, "auto: " + r["auto"].replace("LIGHT_SAMPLING", "NEE"), rotation=90, fontsize=7,
                     va="bottom", ha="center", transform=ax.get_xaxis_transform())
-        ax.set_yscale("log")
-        ax.axhline(1.0, color="k", lw=0.6)
-        ax.set_xticks(x, [r["scene"] for r in rows], rotation=60, ha="right", fontsize=8)
-        ax.set_title(f"{c}, {b} bounces")
-    axes[0].set_ylabel("efficiency 1/(relMSE x s), relative to light sampling")
-    axes[0].legend(fontsize=8)
-    fig.suptitle("Direct-light method efficiency (higher is better)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_bar_figure(fig, axes, "efficiency 1/(relMSE x s), relative to light sampling",
+                    "Direct-light method efficiency (higher is better)", path)
 
 
 if __name__ == "__main__":

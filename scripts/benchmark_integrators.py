@@ -32,6 +32,7 @@ import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
 from harness.metrics import rel_mse  # noqa: E402
+from harness.report import efficiency_bars, save_bar_figure  # noqa: E402
 from harness.reference import reference_image  # noqa: E402
 from harness.scenes import CACHE, SIZES, ensure_blend  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
@@ -151,20 +152,10 @@ def chart(results, path):
     for ax, c in zip(axes, cases):
         rows = [r for r in results if r["case"] == c]
         keys = [k for k in CONFIGS if rows and k in rows[0]["configs"]]
-        x = np.arange(len(rows))
-        wbar = 0.8 / max(1, len(keys))
-        for i, k in enumerate(keys):
-            gain = [r["configs"][k]["efficiency"] / r["configs"]["PT"]["efficiency"] for r in rows]
-            ax.bar(x + (i - (len(keys) - 1) / 2) * wbar, gain, wbar, label=k)
-        ax.set_yscale("log")
-        ax.axhline(1.0, color="k", lw=0.6)
-        ax.set_xticks(x, [r["scene"] for r in rows], rotation=40, ha="right", fontsize=8)
-        ax.set_title(f"{c}, {rows[0]['bounces'] if rows else ''} bounces, 1 spp")
-    axes[0].set_ylabel("efficiency 1/(relMSE x s) relative to the path tracer")
-    axes[0].legend(fontsize=8)
-    fig.suptitle("Integrator configurations (higher is better)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+        gains = {k: [r["configs"][k]["efficiency"] / r["configs"]["PT"]["efficiency"] for r in rows] for k in keys}
+        efficiency_bars(ax, [r["scene"] for r in rows], gains, f"{c}, {rows[0]['bounces'] if rows else ''} bounces, 1 spp")
+    save_bar_figure(fig, axes, "efficiency 1/(relMSE x s) relative to the path tracer",
+                    "Integrator configurations (higher is better)", path)
 
 
 if __name__ == "__main__":

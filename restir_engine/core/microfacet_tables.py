@@ -172,25 +172,20 @@ def glass_albedo_at(alpha, mu, eta):
     inside = eta < 1
     e = np.where(inside, 1.0 / np.maximum(eta, 1e-6), eta)
     z = np.sqrt(np.clip((e - 1) / (e + 1), 0.0, 1.0))
-    t_out, t_in = tables()["GLASS_OUT"], tables()["GLASS_IN"]
-    i, fi = _axis(alpha, ALPHAS)
-    j, fj = _axis(mu, MUS)
-    k, fk = _axis(z, ZS)
-    out = 0.0
-    for di, wi in ((0, 1 - fi), (1, fi)):
-        for dj, wj in ((0, 1 - fj), (1, fj)):
-            for dk, wk in ((0, 1 - fk), (1, fk)):
-                v = np.where(inside, t_in[i + di, j + dj, k + dk], t_out[i + di, j + dj, k + dk])
-                out = out + wi * wj * wk * v
-    return np.asarray(out, np.float32)
+    return np.where(inside, _trilinear(tables()["GLASS_IN"], alpha, mu, z),
+                    _trilinear(tables()["GLASS_OUT"], alpha, mu, z)).astype(np.float32)
 
 
 def layer_s(alpha, mu, f0):
     """S(α, μ, z(f0)), trilinear (arrays of one shape)."""
-    t = tables()["S"]
+    return _trilinear(tables()["S"], alpha, mu, z_of_f0(f0))
+
+
+def _trilinear(t: np.ndarray, alpha, mu, z) -> np.ndarray:
+    """A (α, μ, z) table at points of one shape, trilinear."""
     i, fi = _axis(alpha, ALPHAS)
     j, fj = _axis(mu, MUS)
-    k, fk = _axis(z_of_f0(f0), ZS)
+    k, fk = _axis(z, ZS)
     out = 0.0
     for di, wi in ((0, 1 - fi), (1, fi)):
         for dj, wj in ((0, 1 - fj), (1, fj)):

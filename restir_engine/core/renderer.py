@@ -583,16 +583,11 @@ class FrameRenderer:
             c.bsdf_ray = None
             c.direct, c.indirect = out[0], out[1]
             if len(out) > 2:  # the first bounces: GI's initial samples (and the AUTO measurement)
-                surf = c.hits.surf
                 block = gi_terms[:, c.surfaces]
                 if resampled:
                     block[:] = terms[:, c.surfaces]
-                else:
-                    ShadingTerms.of_surfaces(surf, block)
-                c.glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
-                t = gi.diffuse_only(ShadingTerms(block), c.glossy)
                 c.path_indirect = c.indirect
-                c.gi_res, c.indirect = gi.initial(out[2], t, len(surf), c.glossy, self.gi_space)
+                c.glossy, c.gi_res, c.indirect = self._gi_initial(c.hits.surf, out[2], block, filled=resampled)
                 c.gi_share = _share_sums(c.path_indirect, c.indirect)
 
         with clock.stage("paths"):
@@ -667,6 +662,16 @@ class FrameRenderer:
         with clock.stage("passes"):
             self._accumulate(chunks, resampled, stop)
 
+    def _gi_initial(self, surf, first, block: np.ndarray, filled: bool = False):
+        """ReSTIR GI's initial reservoirs at surfaces ``surf`` from their first bounces (pathtracer.FirstBounce):
+        (glossy x1 (n,) bool, gi.GIReservoirs, the path-traced indirect light they do not carry (3, n)). ``block``
+        (WIDTH, n) receives the GI target terms (already holding the surfaces' target terms when ``filled``)."""
+        if not filled:
+            ShadingTerms.of_surfaces(surf, block)
+        glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
+        res, rest = gi.initial(first, gi.diffuse_only(ShadingTerms(block), glossy), len(surf), glossy, self.gi_space)
+        return glossy, res, rest
+
     def _probe(self) -> None:
         """AUTO indirect without a measurement: camera paths of up to PROBE_BOUNCES bounces through one pixel in
         PROBE_PIXELS (their own random stream, so the frame's passes are independent of it and the image is unbiased
@@ -684,11 +689,7 @@ class FrameRenderer:
         if len(surf):
             out = pathtracer.continue_paths(ctx, surf, r, direct_resampled=False, first_bounce=True,
                                             budget=np.full(len(surf), min(PROBE_BOUNCES, ctx.max_bounces)))
-            block = np.empty((WIDTH, len(surf)), np.float32)
-            ShadingTerms.of_surfaces(surf, block)
-            glossy = gi.glossy_x1(surf.params, self.gi.roughness_threshold)
-            _res, rest = gi.initial(out[2], gi.diffuse_only(ShadingTerms(block), glossy), len(surf), glossy,
-                                    self.gi_space)
+            _glossy, _res, rest = self._gi_initial(surf, out[2], np.empty((WIDTH, len(surf)), np.float32))
             sums = _share_sums(out[1], rest)
         self._measure = (None, 1)  # measured now: no periodic probe in this frame's first pass
         self._measured_indirect(sums)

@@ -153,3 +153,25 @@ def chart_animation(anim: dict, methods, path: str):
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
+
+
+def efficiency_bars(ax, labels, gains: dict, title: str, rotation: int = 40) -> None:
+    """Grouped bars of efficiency ratios (``gains``: series name -> one value per label) on a log axis with the
+    1x line: the chart of the method/integrator benchmarks."""
+    x = np.arange(len(labels))
+    width = 0.8 / max(1, len(gains))
+    for i, (name, values) in enumerate(gains.items()):
+        ax.bar(x + (i - (len(gains) - 1) / 2) * width, values, width, label=name)
+    ax.set_yscale("log")
+    ax.axhline(1.0, color="k", lw=0.6)
+    ax.set_xticks(x, labels, rotation=rotation, ha="right", fontsize=8)
+    ax.set_title(title)
+
+
+def save_bar_figure(fig, axes, ylabel: str, title: str, path: str) -> None:
+    """Label, title and save a row of :func:`efficiency_bars` axes."""
+    axes[0].set_ylabel(ylabel)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
