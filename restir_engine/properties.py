@@ -60,6 +60,12 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                                   default=CandidateSettings.light_candidates, min=0, soft_max=256)
     bsdf_candidates: IntProperty(name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",
                                  default=CandidateSettings.bsdf_candidates, min=0, soft_max=8)
+    world_candidates: IntProperty(
+        name="World Candidates",
+        description="Directions per pixel drawn from the world (environment image or colour) and resampled with the "
+                    "lights, so the reservoirs reuse world light across pixels and frames. 0: the world is light-"
+                    "sampled at each shaded point instead",
+        default=CandidateSettings.world_candidates, min=0, soft_max=8)
     light_tiles: EnumProperty(
         name="Light Tiles",
         description="Draw light candidates from small presampled tiles of light points (one tile per 16x16 "

@@ -195,6 +195,14 @@ def test_history_remap_when_lights_switch():
     assert new.had_light.tolist() == [True, True, False]
     assert res.W.tolist() == [1, 1, 1, 1]  # the original history is untouched
     assert hist.remapped(Lights(("other",), np.array([0, 1]), (4, 0), 2)) is None  # other triangles: no map
+    # with the world's points (light index n_tri, stable id 6 + 2 = 8): a world sample follows the world's new index
+    res_w = res.replace(light=np.array([0, 3, 2, -1], np.int32))
+    hist_w = TemporalHistory(None, res_w, None, ("old", True), 3, np.array([0, 2, 5, 8]), (6, 2))
+    new_w = hist_w.remapped(Lights(("new", True), np.array([2, 5, 7, 6, 8]), (6, 2), 4))
+    assert new_w.res.light.tolist() == [-1, 4, 1, -1]
+    assert new_w.had_light.tolist() == [True, True, False, False, True]
+    gone = hist_w.remapped(Lights(("new", False), np.array([2, 5, 7]), (6, 2), 3))  # the world turned black
+    assert gone.res.light.tolist() == [-1, -1, 1, -1] and gone.res.W.tolist() == [0, 0, 1, 1]
 
 
 def test_reuse_over_a_slice_equals_reuse_over_its_indices(monkeypatch):

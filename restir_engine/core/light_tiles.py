@@ -76,9 +76,10 @@ class PackedPoints:
 def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out: np.ndarray | None = None) -> LightPoints:
     """The points (b1, b2) of triangle lights ``light`` of a lights.LightTable, built in packed form (column
     gathers from the table's (3, n_tri) corner, edge, normal and radiance rows), into ``out`` ((11, n)) if
-    given."""
+    given. Index ``lights.env_index`` is a point of the world (world_points.py) when one is attached."""
     n = len(light)
-    if lights.n_tri == 0:  # no triangle lights: every point is an empty placeholder
+    env = lights.env_rows(light)
+    if lights.n_tri == 0 and env.size < n:  # no triangle lights: every point is an empty placeholder
         z3 = np.zeros((3, n), np.float32)
         return LightPoints(np.full(n, -1, np.int32), np.zeros(n, np.float32), np.zeros(n, np.float32), z3, z3.copy(),
                            z3.copy(), np.zeros(n, np.float32), np.zeros(n, bool), np.full(n, -1, np.int32))
@@ -86,6 +87,17 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out:
     b1 = np.asarray(b1, np.float32)
     b2 = np.asarray(b2, np.float32)
     blk = np.empty((11, n), np.float32) if out is None else out
+    if env.size < n:
+        _fill_surface(lights, light if not env.size else np.where(light == lights.env_index, 0, light), b1, b2, blk)
+    if env.size:  # world points (world_points.py): one-sided, area pdf 0 in the power table
+        blk[0:3, env], blk[3:6, env], blk[6:9, env] = lights.env.points(b1[env], b2[env])
+        blk[9:11, env] = 0.0
+    return LightPoints(light.astype(np.int32), b1, b2, blk[0:3], blk[3:6], blk[6:9], blk[9], blk[10] > 0,
+                       lights.spot_lamp_tri(light), block=blk)
+
+
+def _fill_surface(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, blk: np.ndarray) -> None:
+    """The packed rows (11, n) of points (b1, b2) on surface lights ``light``."""
     lights.positions(light, b1, b2, out=blk[0:3])
     lights.normals(light, b1, b2, out=blk[3:6])
     np.take(lights.rows_le, light, axis=1, out=blk[6:9])
@@ -95,8 +107,6 @@ def light_points(lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, out:
             blk[6:9, tex] = lights.radiance_of(light[tex], b1[tex], b2[tex], None)
     np.take(lights.tri_pdf_area, light, out=blk[9])
     blk[10] = lights.tri_two_sided[light]
-    return LightPoints(light.astype(np.int32), b1, b2, blk[0:3], blk[3:6], blk[6:9], blk[9], blk[10] > 0,
-                       lights.spot_lamp_tri(light), block=blk)
 
 
 def sample_points(lights, u: np.ndarray) -> LightPoints:

@@ -185,7 +185,20 @@ class LightTable:
         # stable ids across frames: scene triangle index, or len(scene triangles) + lamp triangle index
         self.light_uid = np.concatenate([g_idx, len(geom) + l_idx]).astype(np.int64)
         self.uid_space = (len(geom), len(lamps.tris))
-        self.signature = (self.n_tri, self.n_sun, hash(power.tobytes()))
+        self.signature = (self.n_tri, self.n_sun, hash(power.tobytes()), False)
+        self.env = None  # world_points.WorldSphere: the world as light points for reservoirs (attach_world)
+        self.env_index = self.n_tri  # the light index of a world point in reservoirs
+
+    def attach_world(self, sphere) -> None:
+        """Let reservoirs hold points of the world (a world_points.WorldSphere) under light index ``env_index``
+        (= n_tri, after every surface light); its stable id is one past the lamp triangles'."""
+        self.env = sphere
+        self.light_uid = np.concatenate([self.light_uid, [int(sum(self.uid_space))]]).astype(np.int64)
+        self.signature = self.signature[:3] + (True,)
+
+    def env_rows(self, light: np.ndarray) -> np.ndarray:
+        """Positions in ``light`` of world points (none without an attached world)."""
+        return np.flatnonzero(light == self.env_index) if self.env is not None else EMPTY
 
     @property
     def empty(self) -> bool:
@@ -288,13 +301,27 @@ class LightTable:
         """Triangle light ``light`` at barycentrics (b1, b2) seen from points p (3, n): the light point
         (3, n), unit direction wi from p (3, n), distance (n,), cos at the light (n,) and the radiance
         arriving at p (3, n) (zero from a back face of a one-sided emitter, spot cones applied)."""
-        q = self.positions(light, b1, b2)
+        env = self.env_rows(light)
+        if env.size == len(light):  # world points only
+            q, nrm, le = self.env.points(b1, b2)
+            two_sided = False
+        else:
+            if env.size:
+                light = light.copy()
+                light[env] = 0
+            q = self.positions(light, b1, b2)
+            nrm = self.normals(light, b1, b2)
+            le = self.radiance_of(light, b1, b2, p)
+            two_sided = self.tri_two_sided[light]
+            if env.size:
+                q[:, env], nrm[:, env], le[:, env] = self.env.points(b1[env], b2[env])
+                two_sided = two_sided.copy()
+                two_sided[env] = False
         d = q - p
         dl = norm(d)
         w = d / np.maximum(dl, np.float32(1e-30))
-        cos_l = -dot(w, self.normals(light, b1, b2))
-        facing = ((cos_l > 0) | self.tri_two_sided[light]) & (dl > 0) & (np.abs(cos_l) > 1e-8)
-        le = self.radiance_of(light, b1, b2, p)
+        cos_l = -dot(w, nrm)
+        facing = ((cos_l > 0) | two_sided) & (dl > 0) & (np.abs(cos_l) > 1e-8)
         le *= facing
         return q, w, dl, cos_l, le
 
@@ -325,7 +352,7 @@ class LightTable:
         out = np.full(len(light), -1, np.int32)
         if not self.any_spots:
             return out
-        lm = np.flatnonzero(light >= self.n_geom)
+        lm = np.flatnonzero((light >= self.n_geom) & (light < self.n_tri))
         if lm.size:
             t = self.lamp_ids[light[lm] - self.n_geom]
             spot = self.scene.lamps.spot_cos[t] > -1.5

@@ -12,6 +12,9 @@ Direct light (chosen when the frame starts):
   is what is left, so ReSTIR DI pays again (Cornell box 1.4x over light sampling with GI).
 - Otherwise (many lights, or a few area/mesh emitters lighting the scene directly): ReSTIR DI (1.2-4x over
   light sampling on those scenes with direct light only).
+- No lights but an environment image: ReSTIR DI with the world in its reservoirs where the direct light is what is
+  left (direct only, or with ReSTIR GI), light sampling beside path-traced bounces
+  (scripts/benchmark_world_reservoirs.py).
 
 Indirect light (measured in the first sample pass of every frame, from the path-traced first bounces):
 - ReSTIR GI caches the diffuse light leaving the first bounce's point x2; light it cannot hold (off glossy and
@@ -41,7 +44,13 @@ def choose_direct_method(lights, reservoir_passes: bool = False, max_bounces: in
     count = int(lights.n_tri)
     plural = "s" if count != 1 else ""
     if count == 0:
-        return "LIGHT_SAMPLING", "no lights to resample (suns and the world only)"
+        env = getattr(lights, "env", None)
+        if env is None or env.world.image is None:
+            return "LIGHT_SAMPLING", "no lights to resample (suns and a constant world only)"
+        if max_bounces > 0 and not gi_expected:
+            return "LIGHT_SAMPLING", f"an environment image and {max_bounces} path-traced bounces: the indirect " \
+                                     "light holds most of the noise, the cheaper direct estimator wins"
+        return "RESTIR", "an environment image: its samples are resampled and reused across pixels and frames"
     if count > FEW_LIGHTS:
         return "RESTIR", f"{count} lights: resampling picks the ones that matter"
     spheres = int((lights.sphere_r[:count] > 0).sum())

@@ -27,6 +27,7 @@ from .accel import Accel, Hits, offset_origin, shadow_rays
 from . import microfacet_tables
 from .cutout import Cutout
 from .world import World
+from .world_points import WorldSphere
 from .bsdf import SurfaceParams, diffuse_f, eval_view, sample_bsdf
 from .glass import DELTA_PDF, sample_glass
 from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
@@ -372,10 +373,10 @@ def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
                    d, delta=None if delta is None else delta[rows])
 
 
-def needs_continuation(ctx: TraceContext, direct_resampled: bool) -> bool:
+def needs_continuation(ctx: TraceContext, direct_resampled: bool, world_resampled: bool = False) -> bool:
     """Whether :func:`continue_paths` has anything to add: bounces, or the first BSDF ray's emitter hits (when
     the direct light is not resampled) or the world it escapes to."""
-    return ctx.max_bounces > 0 or not direct_resampled or ctx.world.sampled
+    return ctx.max_bounces > 0 or not direct_resampled or ctx.world.sampled and not world_resampled
 
 
 @dataclass
@@ -400,9 +401,11 @@ class FirstBounce:
 
 
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
-                   first_ray=None, first_bounce: bool = False, budget: np.ndarray | None = None):
+                   first_ray=None, first_bounce: bool = False, budget: np.ndarray | None = None,
+                   world_resampled: bool = False):
     """Continue paths from primary surfaces s (n). Returns (direct (3, n): the first BSDF ray's emitter hits
-    (MIS-weighted; none when ``direct_resampled``) and the world it escapes to; indirect (3, n): bounces
+    (MIS-weighted; none when ``direct_resampled``) and the world it escapes to (none when ``world_resampled``: the
+    reservoirs hold the world's points too, world_points.py); indirect (3, n): bounces
     1..max_bounces). ``first_ray`` (a traced :class:`BsdfRay` from s, e.g. ReSTIR's BSDF candidate) is used as
     the first ray instead of drawing a new one. With ``first_bounce`` a third value, :class:`FirstBounce`, tells
     where the first rays went and what radiance left there (indirect is then its throughput · lo). ``budget`` (n,)
@@ -477,6 +480,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
                     first.lo_d[:, idx[sel]] += finite(cols(dthr, sel) * le)
         hit = hits.prim >= 0
         esc = np.flatnonzero(~hit)
+        if world_resampled and collect is not None:  # only delta rays, which resampling cannot reach
+            esc = esc[collect[esc]]
         if esc.size and world_on:  # film transparency affects camera rays only
             de = cols(d, esc)
             le = ctx.world.radiance(de)
@@ -623,8 +628,9 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     lamp_verts = lamp_verts[np.isfinite(lamp_verts).all(axis=1)]
     boxes = [b for b in (derived.bounds, (lamp_verts.min(0), lamp_verts.max(0)) if len(lamp_verts) else None)
              if b is not None]
-    radius = float(np.linalg.norm(np.max([b[1] for b in boxes], axis=0) - np.min([b[0] for b in boxes], axis=0))
-                   / 2) if boxes else 1.0
+    lo = np.min([b[0] for b in boxes], axis=0) if boxes else np.zeros(3)
+    hi = np.max([b[1] for b in boxes], axis=0) if boxes else np.zeros(3)
+    radius = float(np.linalg.norm(hi - lo) / 2) if boxes else 1.0
     geom_ng = derived.ng
     lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
     params = SurfaceParams.of_table(scene.materials)
@@ -632,9 +638,13 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     cut = Cutout.of(geom, scene.materials)
     geom_accel = accels["geom"].with_cutout(cut, geom_ng_rows if cut else None) if "geom" in accels else \
         Accel(geom.verts, cut, geom_ng_rows if cut else None)
+    world = World(scene.world_radiance, getattr(scene, "world_image", None), getattr(scene, "world_rotation", None))
+    lights = LightTable(scene, max(radius, 1e-3))
+    if world.sampled:  # the world's points may enter ReSTIR DI reservoirs (di.CandidateSettings.world_candidates)
+        lights.attach_world(WorldSphere(world, (lo + hi) / 2, max(radius, 1e-3)))
     return TraceContext(scene=scene, geom_accel=geom_accel,
                         lamp_accel=accels["lamp"] if "lamp" in accels else Accel(lamps.tris.verts),
-                        lights=LightTable(scene, max(radius, 1e-3)), geom_ng=geom_ng, lamp_ng=lamp_ng,
+                        lights=lights, geom_ng=geom_ng, lamp_ng=lamp_ng,
                         material_params=params, max_bounces=int(max(0, max_bounces)),
                         film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
                         material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),
@@ -644,7 +654,6 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         bump_maps=scene.materials.bump_tex is not None and bool((scene.materials.bump_tex >= 0).any()),
                         has_glass=scene.materials.transmission is not None
                         and bool((scene.materials.transmission > 0).any()),
-                        world=World(scene.world_radiance, getattr(scene, "world_image", None),
-                                    getattr(scene, "world_rotation", None)),
+                        world=world,
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)

@@ -74,6 +74,7 @@ class RenderSettings:
     reservoir_passes: bool = False  # a reservoir pass is wanted (AUTO then resamples: method_choice)
     light_candidates: int = di.CandidateSettings.light_candidates
     bsdf_candidates: int = di.CandidateSettings.bsdf_candidates
+    world_candidates: int = di.CandidateSettings.world_candidates
     spatial_neighbors: int = reuse.SpatialSettings.neighbors
     spatial_radius: float = reuse.SpatialSettings.radius  # pixels; 0 = automatic (reuse.auto_radius)
     spatial_passes: int = reuse.SpatialSettings.passes
@@ -348,7 +349,8 @@ class FrameRenderer:
         self.candidates = None
         if self.method in ("RIS", "RESTIR"):
             self.candidates = di.CandidateSettings(self.method, max(0, st.light_candidates),
-                                                   max(0, st.bsdf_candidates), self.tile_settings)
+                                                   max(0, st.bsdf_candidates), self.tile_settings,
+                                                   world_candidates=max(0, st.world_candidates))
 
     def adopt_history(self, history) -> None:
         """Reuse ``history`` (restir.history.TemporalHistory, from another frame or view of this scene or of an
@@ -553,7 +555,9 @@ class FrameRenderer:
                     tiles = LightTiles(ctx.lights, candidates.tile_settings, w, h, r_tiles)
             candidates = dataclasses.replace(candidates, tiles=tiles)
             self.used_tiles = True
-        continuing = pathtracer.needs_continuation(ctx, resampled)
+        # the world's points in the reservoirs (else the world is light-sampled where the reservoirs are shaded)
+        world_resampled = resampled and candidates.world_resampled(ctx.lights)
+        continuing = pathtracer.needs_continuation(ctx, resampled, world_resampled)
         # the frame's target terms, one (27, surfaces) block the chunks write into (reuse gathers from it)
         terms = np.empty((WIDTH, first), np.float32) if resampled else None
         # ReSTIR GI's target terms: the same, with the specular lobe off at glossy primary surfaces
@@ -579,7 +583,7 @@ class FrameRenderer:
             out = pathtracer.continue_paths(
                 ctx, c.hits.surf, rng(st.seed, st.frame, s, STREAM_PATH, c.index), direct_resampled=resampled,
                 first_ray=c.bsdf_ray, first_bounce=gi_on or (probe and c.index % PROBE_EVERY == 0),
-                budget=None if c.chain is None else ctx.max_bounces - c.chain.depth)
+                budget=None if c.chain is None else ctx.max_bounces - c.chain.depth, world_resampled=world_resampled)
             c.bsdf_ray = None
             c.direct, c.indirect = out[0], out[1]
             if len(out) > 2:  # the first bounces: GI's initial samples (and the AUTO measurement)
@@ -645,9 +649,9 @@ class FrameRenderer:
 
         def shade(c: _Chunk):
             r = rng(st.seed, st.frame, s, STREAM_SHADE, c.index)
-            if resampled:  # the lights from the reservoirs, the world by its own light sample
+            if resampled:  # the lights from the reservoirs, the world from them too or by its own light sample
                 direct = di.shade(ctx, c.hits.surf, c.res, r)
-                if ctx.world.sampled:
+                if ctx.world.sampled and not world_resampled:
                     direct = direct + pathtracer.world_event(ctx, c.hits.surf, r)
             else:
                 direct = pathtracer.next_event(ctx, c.hits.surf, r)

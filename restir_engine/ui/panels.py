@@ -89,6 +89,7 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
             col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
             col.prop(s, "light_candidates")
             col.prop(s, "bsdf_candidates")
+            col.prop(s, "world_candidates")
             col = layout.column(align=True)
             col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
             col.prop(s, "light_tiles")

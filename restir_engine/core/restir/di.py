@@ -7,14 +7,19 @@ strategies by the balance heuristic:
                     sampler from the pixel's block tile (light_blocks.py), p_l = q_block(light) / A
   BSDF candidates:  ``bsdf_candidates`` BSDF-sampled rays; a ray that reaches emitters yields the lamp it
                     crosses and the emissive surface it stops at (each generated with p_b), a ray that
-                    reaches none is a null candidate (it still counts in M_b, never re-drawn)
+                    reaches none is a null candidate (it still counts in M_b, never re-drawn); with the world in
+                    the reservoirs every ray also yields the world's point in its direction
+  world candidates: ``world_candidates`` points of the world (world_points.py: the world on a far sphere, so its
+                    samples are area-measure points too) drawn by the world's own distribution, pdf p_e (area)
 Everything is in AREA measure on the lights, so a sample (a point on a light) and its weight W mean the same
 at every pixel and are reused across pixels without a Jacobian:
   target p̂(y) = luminance(f(ωo, ωi) · Le(y)) · G(x, y), G = |cos θ_s| |cos θ_l| / d²  (target.py)
   BSDF pdf in area measure p_b(y) = p_b,ω · |cos θ_l| / d²
-Resampling weight of candidate y: w = p̂(y) / (M_l p_l(y) + M_b p_b(y)); W = Σw / p̂(y_selected) (m²).
+Resampling weight of candidate y: w = p̂(y) / (M_l p_l(y) + M_e p_e(y) + M_b p_b(y)) (p_l = 0 on the world,
+p_e = 0 on lights); W = Σw / p̂(y_selected) (m²).
 Shading traces one shadow ray: L_direct = f · Le · G · V · W. Suns are not resampled: one light-sampled sun
-per pixel is added.
+per pixel is added; with ``world_candidates`` 0 the world is light-sampled at the shaded point
+(pathtracer.world_event) instead of resampled.
 
 Reservoir memory per pixel: light index (int32), barycentrics b1, b2, M, W, p̂ (float32) = 24 bytes.
 """
@@ -47,11 +52,18 @@ class CandidateSettings:
     """Initial resampling: method (DIRECT_METHODS), candidates per strategy, light tiles (settings, and the
     sample pass's light_tiles.LightTiles or None)."""
 
+    def world_resampled(self, lights) -> bool:
+        """Whether the reservoirs hold the world's points (a sampled world is attached to ``lights``)."""
+        return self.world_candidates > 0 and lights.env is not None
+
     method: str = "RESTIR"
     light_candidates: int = 32
     bsdf_candidates: int = 1
     tile_settings: TileSettings = None
     tiles: object = None
+    world_candidates: int = 1  # > 0: the world's points enter the reservoirs (world_points.py), drawn this many
+    #                            times per surface by the world's own distribution; 0: the world is light-sampled
+    #                            at the shaded surface instead (pathtracer.world_event)
 
 
 class LightSpace:
@@ -124,7 +136,9 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     n = len(surf)
     lights = ctx.lights
     m_l = cfg.light_candidates if lights.tri_alias is not None else 0
-    m_b = cfg.bsdf_candidates if lights.n_tri else 0
+    env = lights.env if cfg.world_resampled(lights) else None
+    m_e = cfg.world_candidates if env is not None else 0
+    m_b = cfg.bsdf_candidates if lights.n_tri or m_e else 0
     stream = Stream(DIReservoirs, n, rng)
     res = stream.res
     tiles = cfg.tiles if px is not None else None
@@ -145,6 +159,16 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
         res.b2[take] = points.b2[flat]
         res.p_hat[take] = p_hats[k_sel[take], take]
         stream.w_sum[:] = total
+    for _ in range(m_e if n else 0):  # world candidates: directions from the world's distribution at the surface
+        u = rng.random((2, n), dtype=np.float32)
+        b1, b2 = env.sample(surf.p, (surf.ns, surf.t, surf.bt), u[0], u[1])
+        cand = DIReservoirs(light=np.full(n, lights.env_index, np.int32), b1=b1, b2=b2, M=None, W=None, p_hat=None)
+        lp = light_points(lights, cand.light, b1, b2)
+        p_hat, pb = terms.evaluate(PackedPoints.of(lp.packed()), want_pdf=m_b > 0)
+        den = m_e * env.pdf_area(surf.p, surf.ns, lp.pos)
+        if pb is not None:
+            den += m_b * pb
+        stream.add(p_hat / np.maximum(den, np.float32(1e-30)), p_hat, cand)
     first_ray = None
     lamps = ctx.scene.lamps
     for j in range(max(m_b, 1 if keep_bsdf_ray else 0)):
@@ -157,12 +181,21 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
             continue
         candidates = []
         hp = np.maximum(hits.prim, 0)
-        candidates.append((np.where(hits.prim >= 0, lights.geom_to_light[hp], -1), hits.u, hits.v))
+        candidates.append((np.where(hits.prim >= 0, lights.geom_to_light[hp], -1), hits.u, hits.v, False))
+        if m_e:
+            # every ray yields the world's point in its direction, occluded or not: the BSDF technique's density of
+            # world points is then p_b everywhere, as the MIS weights assume. (Taking only the rays that escape
+            # would give it density 0 behind geometry: a sample reused from a pixel that sees it occluded to one
+            # that sees it would be underweighted, 1.5 % dark in tests/test_world_light.py.) Shading tests
+            # visibility as for any light point.
+            eb1, eb2 = env.exit_coords(o, d)
+            candidates.append((np.full(len(live), lights.env_index), eb1, eb2, True))
         if len(lamps.tris):
             lh = lamp_hits(ctx, o, d, hits.t)
             lamp_ok = lh.prim >= 0
-            candidates.append((np.where(lamp_ok, lights.lamp_to_light[np.maximum(lh.prim, 0)], -1), lh.u, lh.v))
-        for light, cu, cv in candidates:
+            candidates.append((np.where(lamp_ok, lights.lamp_to_light[np.maximum(lh.prim, 0)], -1), lh.u, lh.v,
+                               False))
+        for light, cu, cv, world in candidates:
             sel = np.flatnonzero(light >= 0)
             if sel.size == 0:
                 continue
@@ -173,10 +206,12 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
             if lp.has_spots:
                 pts = with_spots(pts, lp.spot_tri, lamps, here.p)
             p_hat, pb = here.evaluate(pts)
-            # the light candidates' pdf of this point at this pixel (tiles: per block, or the power table's)
-            pl = pts.pdf if tiles is None else tiles.pdf_area(lp.light, px[r], py[r])
+            if world:  # the world candidates' pdf of the point
+                other = m_e * env.pdf_area(here.p, here.ns, lp.pos)
+            else:  # the light candidates' pdf of this point at this pixel (tiles: per block, or the power table's)
+                other = m_l * (pts.pdf if tiles is None else tiles.pdf_area(lp.light, px[r], py[r]))
             cand = DIReservoirs(light=lp.light, b1=lp.b1, b2=lp.b2, M=None, W=None, p_hat=None)
-            stream.add(p_hat / np.maximum(m_l * pl + m_b * pb, 1e-30), p_hat, cand, rows=r)
+            stream.add(p_hat / np.maximum(other + m_b * pb, 1e-30), p_hat, cand, rows=r)
     return stream.finish(1.0), first_ray
 
 

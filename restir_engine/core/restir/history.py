@@ -24,7 +24,7 @@ class TemporalHistory:
     camera: object
     light_signature: tuple
     frame: int = 0
-    light_uid: np.ndarray | None = None  # (n_tri,) stable id of each light (lights.LightTable.light_uid)
+    light_uid: np.ndarray | None = None  # (n_tri [+ 1 world],) stable id of each light (lights.LightTable.light_uid)
     uid_space: tuple = ()                # (scene triangles, lamp triangles) the ids index into
     had_light: np.ndarray | None = None  # after remapping to a new light table: (n_tri,) bool, lights of the
     #                                      current table that were lights in this history's frame
@@ -48,13 +48,16 @@ class TemporalHistory:
             return dataclasses.replace(self, light_signature=lights.signature)
         if self.light_uid is None or self.uid_space != lights.uid_space:
             return None
-        uid_to_light = np.full(int(sum(self.uid_space)), -1, np.int64)
-        uid_to_light[lights.light_uid] = np.arange(lights.n_tri)
+        ids = int(sum(self.uid_space)) + 1  # the last id: the world's points (lights.LightTable.attach_world)
+        uid_to_light = np.full(ids, -1, np.int64)
+        uid_to_light[lights.light_uid] = np.arange(len(lights.light_uid))
         old = self.res.light
-        light = np.where(old >= 0, uid_to_light[self.light_uid[np.maximum(old, 0)]], -1).astype(np.int32)
+        live = old >= 0
+        light = np.full(len(old), -1, np.int32)
+        light[live] = uid_to_light[self.light_uid[old[live]]]
         res = self.res.replace(light=light, W=self.res.W.copy(), p_hat=self.res.p_hat.copy())
-        res.clear((old >= 0) & (light < 0))
-        had = np.zeros(int(sum(self.uid_space)), bool)
+        res.clear(live & (light < 0))
+        had = np.zeros(ids, bool)
         had[self.light_uid] = True
         return dataclasses.replace(self, res=res, light_signature=lights.signature, light_uid=lights.light_uid,
                                    had_light=had[lights.light_uid])
