@@ -96,10 +96,10 @@ def test_importance_sampling_beats_bsdf_sampling_on_a_sun():
     assert img_off.var() > 10 * img_on.var(), (img_off.var(), img_on.var())
 
 
-def sun_shadow_scene(kind: str, width=24) -> "Scene":
+def sun_shadow_scene(kind: str, width=24):
     """A floor (albedo 0.5) with a glossy slab hovering above part of it (its shadow and penumbra on the floor,
     its lit top in view) and a small emissive square, under the sun sky (``kind`` "image") or a constant world."""
-    from scenes_core import concat, quad, tris
+    from scenes_core import concat, quad, top_down_camera, tris
 
     from restir_engine.core.scene import Lamps, MaterialTable, Scene
     mats = MaterialTable.build([{"base_color": (0.5, 0.5, 0.5), "f0": 0.0},
@@ -109,7 +109,6 @@ def sun_shadow_scene(kind: str, width=24) -> "Scene":
              tris(quad((-0.4, 0.0, 0.3), (0.3, 0, 0), (0, 0.7, 0)), 1),       # slab top (normal +z)
              tris(quad((-0.4, 0.0, 0.3), (0, 0.7, 0), (0.3, 0, 0)), 1),       # its underside
              tris(quad((0.6, -0.6, 0.8), (0, 0.15, 0), (0.15, 0, 0)), 2)]     # emitter facing down
-    from scenes_core import top_down_camera
     scene = Scene(concat(parts), mats, Lamps.empty(), top_down_camera(width, width),
                   world_radiance=np.full(3, 0.8, np.float32))
     if kind == "image":
