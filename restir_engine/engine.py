@@ -32,7 +32,7 @@ def settings_from_scene(scene) -> RenderSettings:
     return RenderSettings(samples=int(s.samples), seed=int(s.seed), max_bounces=int(s.max_bounces),
                           frame=int(scene.frame_current), integrator=s.integrator, direct_method=s.direct_method,
                           light_candidates=int(s.light_candidates), bsdf_candidates=int(s.bsdf_candidates),
-                          world_candidates=int(s.world_candidates),
+                          world_method=s.world_method, world_candidates=int(s.world_candidates),
                           spatial_neighbors=int(s.spatial_neighbors), spatial_radius=float(s.spatial_radius),
                           spatial_passes=int(s.spatial_passes), bias_correction=s.bias_correction,
                           temporal_reuse=bool(s.temporal_reuse), confidence_cap=float(s.confidence_cap),
@@ -161,6 +161,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, msg)
         self._write(result.passes, core_scene.camera.window, scene, view_layer)
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
+                                                                  "world_method", "world_reason",
                                                                   "coverage_samples", "coverage_reason",
                                                                   "spatial_radius", "indirect_method",
                                                                   "indirect_reason",

@@ -60,11 +60,20 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                                   default=CandidateSettings.light_candidates, min=0, soft_max=256)
     bsdf_candidates: IntProperty(name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",
                                  default=CandidateSettings.bsdf_candidates, min=0, soft_max=8)
+    world_method: EnumProperty(
+        name="World Light",
+        description="How resampled direct light treats the world (environment image or colour)",
+        items=[("AUTO", "Auto", "In the reservoirs for an environment image that is the only light, else light-"
+                                "sampled (the Sampling panel shows the last render's choice)"),
+               ("RESAMPLED", "Resampled", "World samples are resampled with the lights and reused across pixels and "
+                                          "frames like any light"),
+               ("LIGHT_SAMPLED", "Light Sampled", "One world light sample per shaded point beside the reservoirs "
+                                                  "(MIS with the BSDF)")],
+        default="AUTO")
     world_candidates: IntProperty(
         name="World Candidates",
-        description="Directions per pixel drawn from the world (environment image or colour) and resampled with the "
-                    "lights, so the reservoirs reuse world light across pixels and frames. 0: the world is light-"
-                    "sampled at each shaded point instead",
+        description="Directions per pixel drawn from the world's own distribution and resampled with the lights "
+                    "(World Light resampled)",
         default=CandidateSettings.world_candidates, min=0, soft_max=8)
     light_tiles: EnumProperty(
         name="Light Tiles",

@@ -167,13 +167,13 @@ def test_world_light_matches_cycles(addon, kind, bounces):
 
 def test_world_in_reservoirs_matches_cycles(addon):
     """The environment-image world of :func:`test_world_light_matches_cycles` with ReSTIR DI holding the world's
-    samples in its reservoirs (World Candidates 1, spatial reuse; core/world_points.py), direct light: per 4 x 4
+    samples in its reservoirs (World Light Resampled, spatial reuse; core/world_points.py), direct light: per 4 x 4
     image cell against Cycles, the same cells able to see a 3 % error."""
     from bpy_scenes import world_scene
     size = (96, 64)
     cells = image_cells(size)
     ours = render_reps(lambda: world_scene("IMAGE", size, rotation_z=0.8), "RESTIR", 0, 32, direct_method="RESTIR",
-                       world_candidates=1)
+                       world_method="RESAMPLED")
     ref = render_reps(lambda: world_scene("IMAGE", size, rotation_z=0.8), "CYCLES", 0, 128)
     assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
                        power=[4, 5, 6] + list(range(8, 16)))

@@ -6,7 +6,7 @@ from test_sphere_lights import floor_under_sphere
 
 from restir_engine.core import pathtracer
 from restir_engine.core.method_choice import (FEW_LIGHTS, GI_MAX_UNCACHED, GI_MIN_SHARE, choose_direct_method,
-                                              choose_indirect_method)
+                                              choose_indirect_method, choose_world_method)
 from restir_engine.core.renderer import RenderSettings, render_frame
 
 
@@ -26,6 +26,32 @@ def test_rules():
     assert choose_direct_method(sphere, True, 4)[0] == "RESTIR"          # a reservoir pass needs reservoirs
     method, reason = choose_direct_method(many, False, 0)
     assert str(many.n_tri) in reason
+
+
+def test_world_rules():
+    """The world enters the reservoirs for an environment image that is the only light; a constant world, or an
+    image beside lamps, is light-sampled; the user's choice holds; a black world is never resampled."""
+    from test_world_light import sun_sky
+    hdri = plane_under_world(width=8)
+    hdri.world_image = sun_sky()
+    hdri_lamp = floor_with_emitter(width=8)
+    hdri_lamp.world_image = sun_sky()
+    const = plane_under_world(width=8)
+    black = floor_with_emitter(width=8)
+    assert choose_world_method(lights_of(hdri))[0] == "RESAMPLED"
+    assert choose_direct_method(lights_of(hdri), False, 0)[0] == "RESTIR"
+    assert choose_direct_method(lights_of(hdri), False, 3)[0] == "LIGHT_SAMPLING"
+    assert choose_direct_method(lights_of(hdri), False, 3, gi_expected=True)[0] == "RESTIR"
+    assert choose_direct_method(lights_of(const), False, 0)[0] == "LIGHT_SAMPLING"
+    assert choose_world_method(lights_of(hdri_lamp))[0] == "LIGHT_SAMPLED"
+    assert choose_world_method(lights_of(const))[0] == "LIGHT_SAMPLED"
+    assert choose_world_method(lights_of(const), "RESAMPLED") == ("RESAMPLED", "set by the user")
+    assert choose_world_method(lights_of(black), "RESAMPLED")[0] == "LIGHT_SAMPLED"
+    r = render_frame(hdri, RenderSettings(samples=1, integrator="RESTIR", direct_method="AUTO", max_bounces=0))
+    assert (r.stats["direct_method"], r.stats["world_method"]) == ("RESTIR", "RESAMPLED")
+    r = render_frame(const, RenderSettings(samples=1, integrator="RESTIR", direct_method="RESTIR", max_bounces=0,
+                                           world_method="RESAMPLED", world_candidates=0))
+    assert r.stats["world_method"] == "LIGHT_SAMPLED" and "0" in r.stats["world_reason"]
 
 
 def test_renderer_applies_and_reports_the_choice():

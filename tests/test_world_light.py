@@ -118,7 +118,7 @@ def sun_shadow_scene(kind: str, width=24):
 
 @pytest.mark.parametrize("kind", ["image", "constant"])
 def test_world_in_reservoirs_is_unbiased(kind):
-    """ReSTIR DI with the world's points in its reservoirs (World Candidates 1; spatial reuse, and temporal reuse
+    """ReSTIR DI with the world's points in its reservoirs (World Light Resampled; spatial reuse, and temporal reuse
     over 3 frames) against the path tracer on the same scene (direct light): per 4 x 4 block and the whole image,
     |z| < 5 over 16 seeds each side (independent repetitions; 17 comparisons)."""
     from stats import compare
@@ -127,8 +127,8 @@ def test_world_in_reservoirs_is_unbiased(kind):
     for seed in range(16):
         hist = None
         for f in range(3):
-            r = render_frame(scene, RenderSettings(integrator="RESTIR", direct_method="RESTIR", world_candidates=1,
-                                                   max_bounces=0, samples=2, seed=seed, frame=f), history=hist)
+            r = render_frame(scene, RenderSettings(integrator="RESTIR", direct_method="RESTIR", world_method="RESAMPLED",
+                                                   world_candidates=1, max_bounces=0, samples=2, seed=seed, frame=f), history=hist)
             hist = r.history
         assert r.stats["reuse"].get("temporal_accepted", 0) > 0.5
         ours.append(r.passes["Combined"][..., :3])
@@ -139,17 +139,17 @@ def test_world_in_reservoirs_is_unbiased(kind):
 
 
 def test_world_in_reservoirs_lowers_the_noise_under_a_sun():
-    """Where the sun-like spot dominates, resampling the world with the lights and reusing it (World Candidates 1)
-    gives a lower per-pixel variance than light-sampling the world at each pixel beside the reservoirs (World
-    Candidates 0), at the same samples (measured: about 3x lower relMSE on the world scene, docs/RESULTS.md)."""
+    """Where the sun-like spot dominates, resampling the world with the lights and reusing it (World Light
+    Resampled) gives a lower per-pixel variance than light-sampling the world at each pixel beside the reservoirs,
+    at the same samples (measured: about 3x lower relMSE on the world scene, docs/RESULTS.md)."""
     scene = sun_shadow_scene("image")
     var = {}
-    for wc in (0, 1):
+    for method in ("LIGHT_SAMPLED", "RESAMPLED"):
         imgs = np.array([render_frame(scene, RenderSettings(integrator="RESTIR", direct_method="RESTIR",
-                                                            world_candidates=wc, max_bounces=0, samples=1, seed=s)
+                                                            world_method=method, max_bounces=0, samples=1, seed=s)
                                       ).passes["Combined"][..., 0] for s in range(8)])
-        var[wc] = float(imgs.var(axis=0, ddof=1).mean())
-    assert var[1] < 0.5 * var[0], var
+        var[method] = float(imgs.var(axis=0, ddof=1).mean())
+    assert var["RESAMPLED"] < 0.5 * var["LIGHT_SAMPLED"], var
 
 
 def test_world_points_on_their_sphere():

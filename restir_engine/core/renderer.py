@@ -36,7 +36,7 @@ from .boiling import THRESHOLD as BOILING_THRESHOLD
 from .boiling import boiling_filter
 from .bsdf import denoising_albedo, luminance_rows
 from .context_cache import context_for, fingerprint
-from .method_choice import GI_MIN_SHARE, choose_direct_method, choose_indirect_method
+from .method_choice import GI_MIN_SHARE, WORLD_METHODS, choose_direct_method, choose_indirect_method, choose_world_method
 from .light_blocks import BlockLightTiles
 from .light_tiles import TILE_MODES, LightTiles, TileSettings
 from .profile import NullClock
@@ -74,6 +74,7 @@ class RenderSettings:
     reservoir_passes: bool = False  # a reservoir pass is wanted (AUTO then resamples: method_choice)
     light_candidates: int = di.CandidateSettings.light_candidates
     bsdf_candidates: int = di.CandidateSettings.bsdf_candidates
+    world_method: str = "AUTO"  # the world with resampled direct light: "AUTO", "RESAMPLED", "LIGHT_SAMPLED"
     world_candidates: int = di.CandidateSettings.world_candidates
     spatial_neighbors: int = reuse.SpatialSettings.neighbors
     spatial_radius: float = reuse.SpatialSettings.radius  # pixels; 0 = automatic (reuse.auto_radius)
@@ -273,6 +274,7 @@ class FrameRenderer:
         self.candidates = None  # di.CandidateSettings when the direct light is resampled
         self.method = "PATH"
         self.method_reason = "path tracer"
+        self.world_method, self.world_reason = "LIGHT_SAMPLED", "the direct light is not resampled"
         if settings.integrator == "RESTIR" and settings.direct_method not in di.DIRECT_METHODS:
             raise ValueError(f"unknown direct method {settings.direct_method!r}; available: {di.DIRECT_METHODS}")
         if settings.integrator == "RESTIR" and settings.indirect_method not in gi.INDIRECT_METHODS:
@@ -347,10 +349,16 @@ class FrameRenderer:
             self.method, self.method_reason = choose_direct_method(self.ctx.lights, st.reservoir_passes, bounces,
                                                                     self.indirect_method == "RESTIR_GI")
         self.candidates = None
+        self.world_method, self.world_reason = "LIGHT_SAMPLED", "the direct light is not resampled"
         if self.method in ("RIS", "RESTIR"):
-            self.candidates = di.CandidateSettings(self.method, max(0, st.light_candidates),
-                                                   max(0, st.bsdf_candidates), self.tile_settings,
-                                                   world_candidates=max(0, st.world_candidates))
+            if st.world_method not in WORLD_METHODS:
+                raise ValueError(f"unknown world method {st.world_method!r}; available: {WORLD_METHODS}")
+            self.world_method, self.world_reason = choose_world_method(self.ctx.lights, st.world_method)
+            if self.world_method == "RESAMPLED" and st.world_candidates <= 0:
+                self.world_method, self.world_reason = "LIGHT_SAMPLED", "World Candidates is 0"
+            self.candidates = di.CandidateSettings(
+                self.method, max(0, st.light_candidates), max(0, st.bsdf_candidates), self.tile_settings,
+                world_candidates=max(0, st.world_candidates) if self.world_method == "RESAMPLED" else 0)
 
     def adopt_history(self, history) -> None:
         """Reuse ``history`` (restir.history.TemporalHistory, from another frame or view of this scene or of an
@@ -962,6 +970,7 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
              "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun, "boiling_dropped": fr.boiling_dropped,
              "context_reused": fr.context_reused, "coverage_samples": fr.coverage,
              "direct_method": fr.method, "direct_reason": fr.method_reason,
+             "world_method": fr.world_method, "world_reason": fr.world_reason,
              "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None, "reuse": dict(fr.reuse_stats),
              "coverage_reason": fr.coverage_reason,
              # AUTO: the latest choice; otherwise ReSTIR GI unless every pass kept the path-traced light

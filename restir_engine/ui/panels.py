@@ -89,7 +89,17 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
             col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
             col.prop(s, "light_candidates")
             col.prop(s, "bsdf_candidates")
-            col.prop(s, "world_candidates")
+            col = layout.column(align=True)
+            col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
+            col.prop(s, "world_method")
+            sub = col.column(align=True)
+            sub.active = s.world_method != "LIGHT_SAMPLED"
+            sub.prop(s, "world_candidates")
+            if last and s.world_method == "AUTO" and last.get("world_reason"):
+                box = col.box()
+                box.scale_y = 0.8
+                box.label(text=f"Last render: {last['world_method'].replace('_', ' ').title()}", icon="INFO")
+                box.label(text=last["world_reason"])
             col = layout.column(align=True)
             col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
             col.prop(s, "light_tiles")
