@@ -63,6 +63,7 @@ class TraceContext:
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
     lamp_ng_rows: np.ndarray = None     # (3, n_lamp) lamp_ng as rows
     geom_derived: "GeometryDerived" = None  # the geometry-only arrays above, kept for a rebuild over the same triangles
+    emit_accel: Accel = None  # the emissive scene triangles alone (light index = primitive index), or None
     # what rendering this content measured (shared by the frames and views that reuse this context):
     # "auto_indirect" -> the last frame's AUTO indirect measurement and choice (renderer.FrameRenderer._remember)
     measured: dict = field(default_factory=dict)
@@ -645,6 +646,7 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     return TraceContext(scene=scene, geom_accel=geom_accel,
                         lamp_accel=accels["lamp"] if "lamp" in accels else Accel(lamps.tris.verts),
                         lights=lights, geom_ng=geom_ng, lamp_ng=lamp_ng,
+                        emit_accel=Accel(lights.tri_verts[:lights.n_geom]) if lights.n_geom else None,
                         material_params=params, max_bounces=int(max(0, max_bounces)),
                         film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
                         material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),

@@ -5,10 +5,11 @@ strategies by the balance heuristic:
   light candidates: ``light_candidates`` points from the power alias table over surface lights (through
                     light tiles when they pay), pdf p_l = p_select / A (area measure); with the spatial light
                     sampler from the pixel's block tile (light_blocks.py), p_l = q_block(light) / A
-  BSDF candidates:  ``bsdf_candidates`` BSDF-sampled rays; a ray that reaches emitters yields the lamp it
-                    crosses and the emissive surface it stops at (each generated with p_b), a ray that
-                    reaches none is a null candidate (it still counts in M_b, never re-drawn); with the world in
-                    the reservoirs every ray also yields the world's point in its direction
+  BSDF candidates:  ``bsdf_candidates`` BSDF-sampled rays; a ray yields the first emissive surface and the
+                    first lamp along it, occluders ignored (each generated with p_b, so the technique's density
+                    is p_b at every light point, as the MIS weights assume), a ray that meets none is a null
+                    candidate (it still counts in M_b, never re-drawn); with the world in the reservoirs every
+                    ray also yields the world's point in its direction
   world candidates: ``world_candidates`` points of the world (world_points.py: the world on a far sphere, so its
                     samples are area-measure points too) drawn by the world's own distribution, pdf p_e (area)
 Everything is in AREA measure on the lights, so a sample (a point on a light) and its weight W mean the same
@@ -174,14 +175,20 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
     for j in range(max(m_b, 1 if keep_bsdf_ray else 0)):
         ray = sample_rays(surf, rng.random((3, n), dtype=np.float32))
         live, o, d = ray.rows, ray.o, ray.d
-        hits = ray.hits = ctx.geom_accel.intersect(o, d)
-        if j == 0 and keep_bsdf_ray:
+        if j == 0 and keep_bsdf_ray:  # the path's first bounce: its geometry hit
+            ray.hits = ctx.geom_accel.intersect(o, d)
             first_ray = ray
         if j >= m_b or live.size == 0:
             continue
+        # the emitters along the ray whatever occludes them (the first emissive triangle, every lamp the ray
+        # crosses first): the BSDF technique's density of a light point is then p_b wherever the MIS weights use
+        # it. Only emitter hits would give it density 0 behind an occluder, and a sample reused from a pixel that
+        # sees its light occluded to one that sees it would be underweighted (0.8 % dark in spatial reuse with one
+        # light candidate, docs/RESULTS.md). Shading tests visibility.
         candidates = []
-        hp = np.maximum(hits.prim, 0)
-        candidates.append((np.where(hits.prim >= 0, lights.geom_to_light[hp], -1), hits.u, hits.v, False))
+        if ctx.emit_accel is not None:
+            eh = ctx.emit_accel.intersect(o, d)
+            candidates.append((eh.prim, eh.u, eh.v, False))
         if m_e:
             # every ray yields the world's point in its direction, occluded or not: the BSDF technique's density of
             # world points is then p_b everywhere, as the MIS weights assume. (Taking only the rays that escape
@@ -191,7 +198,7 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
             eb1, eb2 = env.exit_coords(o, d)
             candidates.append((np.full(len(live), lights.env_index), eb1, eb2, True))
         if len(lamps.tris):
-            lh = lamp_hits(ctx, o, d, hits.t)
+            lh = lamp_hits(ctx, o, d, np.full(len(live), np.inf, np.float32))
             lamp_ok = lh.prim >= 0
             candidates.append((np.where(lamp_ok, lights.lamp_to_light[np.maximum(lh.prim, 0)], -1), lh.u, lh.v,
                                False))
