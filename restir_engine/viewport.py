@@ -33,6 +33,10 @@ MAX_VIEWPORT_SAMPLES = 1024
 HALF_FLOAT_MAX = 65504.0  # RGBA16F textures turn larger values into inf (black viewport)
 DIVIDERS = (1, 2, 4, 8)   # resolution dividers of a navigation pass
 DEFAULT_BUDGET = 0.15     # seconds a navigation pass may take (the first image after a move)
+# light candidates of a navigation pass at most: the history reprojected from the last view lets fewer suffice
+# (many_lights 1k 10-view pan, 6 seeds: 8 candidates with reuse 0.337 relMSE in 52 ms, 32 after a restart 0.353 in
+# 71 ms; docs/RESULTS.md "Viewport"); the passes that refine a still view use the setting
+NAVIGATION_CANDIDATES = 8
 COST_SMOOTHING = 0.5      # weight of the newest pass in the running cost-per-pixel estimate
 
 # viewport pass: (label, description); the RESTIR_* false colours are documented in docs/USAGE.md
@@ -371,10 +375,15 @@ class ViewportSession:
             self._navigating = navigation
             if not navigation and self._view is not None and self._view[1] != self._key:
                 return  # the view moved while this pass was being set up: render the new view first
+        # a navigation pass that reuses the last view's reservoirs needs fewer candidates (the first pass of a scene
+        # has no history and renders as F12 does)
+        reusing = r.settings.temporal_reuse and r.prev_history is not None and r.prev_history.res is not None
+        r.light_candidate_cap = NAVIGATION_CANDIDATES if navigation and reusing else None
         try:
             done = r.sample_pass(should_stop=should_stop)
         finally:
             self._navigating = False
+            r.light_candidate_cap = None
         seconds = self.clock() - t0
         if not done:
             return

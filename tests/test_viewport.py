@@ -117,17 +117,21 @@ def _final_view_error(core, cam, settings, reference, temporal, steps, seed):
         session.set_scene(core, dataclasses.replace(settings, temporal_reuse=temporal, seed=seed))
         navigate(session, cam, steps)
         image, _ = session.latest()
-        return clipped_rel_mse(image[..., :3], reference), session.stats.pass_seconds
+        used = session.renderer.reuse_stats.get("light_candidates")
+        return clipped_rel_mse(image[..., :3], reference), session.stats.pass_seconds, used
     finally:
         session.halt()
 
 
-def test_temporal_reuse_across_views_lowers_the_error_after_a_move(addon):
+def test_temporal_reuse_across_views_lowers_the_error_after_a_move(addon, monkeypatch):
     """A scripted pan (10 views, one pass each, 160x90) over the harness's many-lights street (1000 emitters,
     direct light, ReSTIR DI): the image right after the last move has a lower error (clipped_rel_mse) with the
-    reservoirs reprojected from the previous views than restarted from scratch. Paired by seed (same path, same
-    random streams otherwise): the mean improvement over 6 seeds must exceed 3 standard errors of the paired
-    differences (numbers printed; docs/RESULTS.md "Viewport" has them at equal time)."""
+    reservoirs reprojected from the previous views than restarted from scratch, at the same 32 light candidates.
+    Paired by seed (same path, same random streams otherwise): the mean improvement over 6 seeds must exceed 3
+    standard errors of the paired differences. The viewport's own navigation passes, which reuse with 8 light
+    candidates (viewport.NAVIGATION_CANDIDATES), must not be worse than the restart by 3 standard errors (numbers
+    printed; docs/RESULTS.md "Viewport" has them at equal time)."""
+    from restir_engine import viewport
     scene = build_many_lights("1k", "small")
     dg = bpy.context.evaluated_depsgraph_get()
     core = export_scene(dg)
@@ -141,14 +145,20 @@ def test_temporal_reuse_across_views_lowers_the_error_after_a_move(addon):
                              ).passes["Combined"][..., :3]
     seeds = (1, 2, 3, 4, 5, 6)
     rows = {}
-    for temporal in (True, False):
-        errs, secs = zip(*[_final_view_error(core, cam, settings, reference, temporal, steps, seed)
-                           for seed in seeds])
-        rows[temporal] = (np.array(errs), float(np.median(secs)))
-        print(f"temporal reuse {temporal}: relMSE {np.round(errs, 3)}, {np.median(secs):.3f} s per pass")
-    diffs = rows[False][0] - rows[True][0]
+    for label, temporal, cap in (("reuse, 32", True, 10 ** 6), ("restart, 32", False, 10 ** 6),
+                                 ("reuse, navigation cap", True, viewport.NAVIGATION_CANDIDATES)):
+        monkeypatch.setattr(viewport, "NAVIGATION_CANDIDATES", cap)
+        errs, secs, used = zip(*[_final_view_error(core, cam, settings, reference, temporal, steps, seed)
+                                 for seed in seeds])
+        rows[label] = np.array(errs)
+        print(f"{label}: relMSE {np.round(errs, 3)}, {np.median(secs):.3f} s per pass, {used[0]} light candidates")
+        assert used[0] == min(cap, settings.light_candidates)
+    diffs = rows["restart, 32"] - rows["reuse, 32"]
     print(f"paired improvement {diffs.mean():.4f} +- {diffs.std(ddof=1) / np.sqrt(len(seeds)):.4f}")
     assert diffs.mean() > 3 * diffs.std(ddof=1) / np.sqrt(len(seeds))
+    worse = rows["reuse, navigation cap"] - rows["restart, 32"]
+    print(f"navigation cap against the restart {worse.mean():.4f} +- {worse.std(ddof=1) / np.sqrt(len(seeds)):.4f}")
+    assert worse.mean() < 3 * worse.std(ddof=1) / np.sqrt(len(seeds))
 
 
 def test_viewport_passes_equal_the_render_passes(addon):

@@ -74,7 +74,7 @@ def choose_world_method(lights, setting: str = "AUTO") -> tuple[str, str]:
     keeps one sample for all its lights, so a world that shares the direct light with lamps or emitters adds the
     choice between them to the noise (scripts/benchmark_world_reservoirs.py: a constant world with three lamps 3x
     the relMSE, an environment image with three lamps even to 2x worse); an environment image that is the only
-    light gains from reuse (1.1-1.5x over light sampling at equal time, 2.3-3.3x over the world light-sampled
+    light gains from reuse (1.1-1.6x over light sampling at equal time, 2.5-3.8x over the world light-sampled
     beside the reservoirs)."""
     env = getattr(lights, "env", None)
     if env is None:

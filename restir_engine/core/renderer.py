@@ -272,6 +272,7 @@ class FrameRenderer:
         self.settings = settings
         self.clock = clock or NullClock()
         self.candidates = None  # di.CandidateSettings when the direct light is resampled
+        self.light_candidate_cap = None  # at most this many light candidates in the next passes (viewport navigation)
         self.method = "PATH"
         self.method_reason = "path tracer"
         self.world_method, self.world_reason = "LIGHT_SAMPLED", "the direct light is not resampled"
@@ -551,6 +552,11 @@ class FrameRenderer:
                 c.first = first
                 first += len(c.hits.rows)
         candidates = self.candidates
+        cap = self.light_candidate_cap
+        if resampled and cap is not None and candidates.light_candidates > cap:
+            candidates = dataclasses.replace(candidates, light_candidates=cap)
+        if resampled:
+            self.reuse_stats["light_candidates"] = candidates.light_candidates
         if resampled and ctx.lights.tri_alias is not None and candidates.tile_settings.wanted(npix, candidates.light_candidates):
             with clock.stage("initial"):
                 r_tiles = rng(st.seed, st.frame, s, STREAM_TILES)
