@@ -478,6 +478,20 @@ def eval_bsdf(p: SurfaceParams, wo: np.ndarray, wi: np.ndarray):
     return eval_view(ViewTerms.of(p, wo), wo, wi)
 
 
+def ggx_normals(alpha: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """GGX microfacet normals (3, k) in the local frame (z = the macro normal) drawn with density D(h) cos θh
+    (solid angle) from uniforms u1, u2 (k,): tan² θh = α² u1 / (1 - u1), φ = 2π u2."""
+    tan2 = alpha * alpha * u1 / np.maximum(1.0 - u1, 1e-7)
+    cos_t = 1.0 / np.sqrt(1.0 + tan2)
+    sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
+    phi = np.float32(2 * np.pi) * u2
+    h = np.empty((3, len(cos_t)), np.float32)
+    h[0] = sin_t * np.cos(phi)
+    h[1] = sin_t * np.sin(phi)
+    h[2] = cos_t
+    return h
+
+
 def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.ndarray, u2: np.ndarray,
                 view: ViewTerms | None = None):
     """Sample wi; returns wi (3, n), f (3, n), pdf (n,) (the mixture pdf, so MIS-ready). ``view``: the surfaces'
@@ -485,16 +499,7 @@ def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.nda
     spec = np.flatnonzero(u_lobe < p.p_spec)
     wi = cosine_hemisphere(u1, u2)
     if spec.size:
-        a = p.alpha[spec]
-        uu1, uu2 = u1[spec], u2[spec]
-        tan2 = a * a * uu1 / np.maximum(1.0 - uu1, 1e-7)
-        cos_t = 1.0 / np.sqrt(1.0 + tan2)
-        sin_t = np.sqrt(np.maximum(0.0, 1.0 - cos_t * cos_t))
-        phi = 2 * np.pi * uu2
-        h = np.empty((3, spec.size), np.float32)
-        h[0] = sin_t * np.cos(phi)
-        h[1] = sin_t * np.sin(phi)
-        h[2] = cos_t
+        h = ggx_normals(p.alpha[spec], u1[spec], u2[spec])
         if view is not None and view.spec_n is not None:  # about the specular normal: rotate h into its frame
             sn = np.take(view.spec_n, spec, axis=1)
             t2, b2 = orthonormal_basis(sn)

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import fresnel_exact
+from .bsdf import fresnel_exact, ggx_normals
 from .microfacet_tables import glass_albedo_at, smith_lambda
 from .sampling import dot, orthonormal_basis
 
@@ -47,15 +47,12 @@ def sample_glass(wo: np.ndarray, n: np.ndarray, ng: np.ndarray, front: np.ndarra
     rough = None if alpha is None else np.flatnonzero(alpha > ROUGH_ALPHA_MIN)
     h = n
     if rough is not None and rough.size:
-        a = alpha[rough]
-        tan2 = a * a * u1[rough] / np.maximum(1.0 - u1[rough], 1e-7)
-        hz = 1.0 / np.sqrt(1.0 + tan2)
-        sin_h = np.sqrt(np.maximum(0.0, 1.0 - hz * hz))
-        phi = np.float32(2 * np.pi) * u2[rough]
+        hl = ggx_normals(alpha[rough], u1[rough], u2[rough])
+        hz = hl[2]
         nr = n[:, rough]
         t, b = orthonormal_basis(nr)
         h = n.copy()
-        h[:, rough] = (sin_h * np.cos(phi)) * t + (sin_h * np.sin(phi)) * b + hz * nr
+        h[:, rough] = hl[0] * t + hl[1] * b + hl[2] * nr
     c = np.clip(dot(wo, h), 0.0, 1.0)
     sin2_t = (1.0 - c * c) / (eta * eta)
     tir = sin2_t >= 1.0

@@ -173,14 +173,9 @@ def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: n
     rows = None if lamp_mask is None else np.flatnonzero(lamp_mask)
     if len(ctx.scene.lamps.tris) and (rows is None or rows.size):  # lamps seen (camera rays: those visible to them)
         far = hits.t if tmax is None else np.minimum(hits.t, tmax)
-        if rows is None:
-            lh = lamp_hits(ctx, o, d, far)
-            sel = np.flatnonzero(lh.prim >= 0)
-            oo, dd = o, d
-        else:
-            oo, dd = cols(o, rows), cols(d, rows)
-            lh = lamp_hits(ctx, oo, dd, far[rows])
-            sel = np.flatnonzero(lh.prim >= 0)
+        oo, dd = (o, d) if rows is None else (cols(o, rows), cols(d, rows))
+        lh = lamp_hits(ctx, oo, dd, far if rows is None else far[rows])
+        sel = np.flatnonzero(lh.prim >= 0)
         if camera:
             sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
         if sel.size:
