@@ -11,8 +11,11 @@ texel is 1.5e-3 rad wide).
 
 Candidates (di.initial_ris): a direction ω_x drawn from the world's own distribution at the receiver (an image by its
 2-D table, a constant world by the cosine about the normal, world.World.sample) gives the point where the ray
-x + t ω_x leaves S, with area pdf p_ω(ω_x) cos θ_l / d²; a BSDF ray that escapes the scene gives the same kind of
-point, with the BSDF's pdf.
+x + t ω_x leaves S, with area pdf p_ω(ω_x) cos θ_l / d²; every BSDF candidate ray gives the point where it leaves S
+(occluded or not, so the BSDF technique's density is its pdf everywhere), with the BSDF's pdf.
+
+Points are kept as float32 sphere coordinates (b1, b2) like sphere lamps' points: directions are resolved to
+about 1e-7 rad, except within 5e-4 rad of straight down (b1 near 1), where they are snapped coarser.
 """
 from __future__ import annotations
 
@@ -22,7 +25,7 @@ from .lights import sphere_coords, sphere_direction
 from .world import World
 
 DISTANCE = 1e4    # R / r
-MAX_RADIUS = 1e9  # m: keeps d⁴ (the diffuse target's denominator, lights target.py) inside float32
+MAX_RADIUS = 1e9  # m: keeps d⁴ (the diffuse target's denominator, target.py) inside float32
 
 
 class WorldSphere:

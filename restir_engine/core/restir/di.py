@@ -53,10 +53,6 @@ class CandidateSettings:
     """Initial resampling: method (DIRECT_METHODS), candidates per strategy, light tiles (settings, and the
     sample pass's light_tiles.LightTiles or None)."""
 
-    def world_resampled(self, lights) -> bool:
-        """Whether the reservoirs hold the world's points (a sampled world is attached to ``lights``)."""
-        return self.world_candidates > 0 and lights.env is not None
-
     method: str = "RESTIR"
     light_candidates: int = 32
     bsdf_candidates: int = 1
@@ -65,6 +61,10 @@ class CandidateSettings:
     world_candidates: int = 1  # > 0: the world's points enter the reservoirs (world_points.py), drawn this many
     #                            times per surface by the world's own distribution; 0: the world is light-sampled
     #                            at the shaded surface instead (pathtracer.world_event)
+
+    def world_resampled(self, lights) -> bool:
+        """Whether the reservoirs hold the world's points (a sampled world is attached to ``lights``)."""
+        return self.world_candidates > 0 and lights.env is not None
 
 
 class LightSpace:
@@ -183,8 +183,8 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
         # the emitters along the ray whatever occludes them (the first emissive triangle, every lamp the ray
         # crosses first): the BSDF technique's density of a light point is then p_b wherever the MIS weights use
         # it. Only emitter hits would give it density 0 behind an occluder, and a sample reused from a pixel that
-        # sees its light occluded to one that sees it would be underweighted (0.8 % dark in spatial reuse with one
-        # light candidate, docs/RESULTS.md). Shading tests visibility.
+        # sees its light occluded to one that sees it would be underweighted (a floor seen through slats under a
+        # large emitter read 6.5 % dark: tests/test_restir_stability.py). Shading tests visibility.
         candidates = []
         if ctx.emit_accel is not None:
             eh = ctx.emit_accel.intersect(o, d)
