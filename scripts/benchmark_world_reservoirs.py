@@ -5,8 +5,9 @@ image), alone ("hdri") and with three small area lamps ("hdri+lamps"), and under
 ("constant+lamps"). Direct light only and 3 bounces (indirect path-traced). Configurations: light sampling
 (NEE), ReSTIR DI with the world light-sampled beside the reservoirs (World Light "Light Sampled"), ReSTIR DI
 with the world in the reservoirs (World Light "Resampled", World Candidates 1). Cases: 1-sample stills, 4-sample
-stills, and the 4th frame of a 4-frame animation (static camera, 1 sample per frame, history carried). Error: relMSE of Combined against Cycles at 1024 samples; seconds:
-render_frame's time; efficiency 1 / (relMSE x seconds), relative to NEE.
+stills, and the 4th frame of a 4-frame animation (static camera, 1 sample per frame, history carried). Error:
+relMSE of Combined against Cycles at 1024 samples; seconds: render_frame's time; efficiency 1 / (relMSE x seconds),
+relative to NEE.
 
     .venv/bin/python scripts/benchmark_world_reservoirs.py   # -> docs/results/world/world_reservoirs.{json,png}
 """
