@@ -215,7 +215,7 @@ class ViewportSession:
         self._key = None             # the key of the view being rendered
         self._divider = 1
         self._frame = 0              # views rendered so far: keys the random streams of each view
-        self._cost = None            # running estimate of seconds per pixel of one pass
+        self._cost = None            # running estimate of seconds per pixel of one sample
         self._interrupt = False      # the running refinement pass must stop
         self._navigating = False     # the running pass is a navigation pass (view changes do not stop it)
         self._closed = False
@@ -379,8 +379,12 @@ class ViewportSession:
         # has no history and renders as F12 does)
         reusing = r.settings.temporal_reuse and r.prev_history is not None and r.prev_history.res is not None
         r.light_candidate_cap = NAVIGATION_CANDIDATES if navigation and reusing else None
+        # full-resolution refinement renders several samples per pass where F12 would (renderer.batch_size); a
+        # navigation pass, and the reduced-resolution steps after it, one: they are meant to show an image soon
+        batch = 1 if navigation or self._divider > 1 else r.batch_size(self.max_samples - r.samples_done)
+        before = r.samples_done
         try:
-            done = r.sample_pass(should_stop=should_stop)
+            done = r.sample_pass(should_stop=should_stop, batch=batch)
         finally:
             self._navigating = False
             r.light_candidate_cap = None
@@ -388,7 +392,7 @@ class ViewportSession:
         if not done:
             return
         _x0, _y0, w, h = r.ctx.scene.camera.window
-        per_pixel = seconds / max(1, w * h)
+        per_pixel = seconds / max(1, w * h * (r.samples_done - before))  # per pixel and sample
         self._cost = per_pixel if self._cost is None else \
             COST_SMOOTHING * per_pixel + (1 - COST_SMOOTHING) * self._cost
         self._publish(seconds, int(navigation))

@@ -138,7 +138,21 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
             may_see_lamp: np.ndarray | None = None) -> PrimaryHits:
     """Camera rays through raster points (x, y) (window pixels + jitter, y up). ``may_hit`` / ``may_see_lamp`` (n,)
     bool: False where the ray is known to meet no geometry / no lamp visible to the camera (projected boxes,
-    camera.box_pixels and camera.emitter_pixels), which is then not traced against it."""
+    camera.box_pixels and camera.emitter_pixels), which is then not traced against it; under a constant world a ray
+    that may meet neither is not generated at all (it sees the world's colour, or nothing on a transparent film)."""
+    if may_hit is not None and ctx.world.image is None:
+        need = may_hit if not len(ctx.scene.lamps.tris) else \
+            np.ones(len(x), bool) if may_see_lamp is None else may_hit | may_see_lamp
+        if not need.all():
+            idx = np.flatnonzero(need)
+            sub = primary(ctx, x[idx], y[idx], may_hit[idx], None if may_see_lamp is None else may_see_lamp[idx])
+            transparent = ctx.film_transparent
+            emitted = np.empty((3, len(x)), np.float32)
+            emitted[:] = 0.0 if transparent else ctx.world.color[:, None]
+            emitted[:, idx] = sub.emitted
+            alpha = np.full(len(x), 0.0 if transparent else 1.0, np.float32)
+            alpha[idx] = sub.alpha
+            return PrimaryHits(emitted, alpha, idx[sub.rows], sub.surf)
     cam = ctx.scene.camera
     o, d, tmax = camera_mod.generate_rays(cam, x, y)
     if may_hit is None or may_hit.all():

@@ -18,6 +18,13 @@ Stages of a sample pass (each timed by a profile.StageClock when one is given):
 Images are (h, w, c) float32 with row 0 at the *bottom* (Blender's pass order), covering the camera window
 (border) only. Pixels are row-major over the window; a chunk is a span of CHUNK_PIXELS pixels and its
 random streams are keyed by (seed, frame, pass, stream, chunk), so images do not depend on scheduling.
+
+Sample batches: a pass that keeps no per-pixel state between its stages' pixels (no reservoirs, no ReSTIR GI, no
+measurement) may render several samples at once: its chunks then hold their pixel span once per sample
+(``_Chunk.batch``), so every array of the pass is that many times longer. Where few pixels see a surface (the
+default cube: 15 % of the image) a chunk otherwise holds a few thousand paths and the pass is bound by NumPy's
+per-call cost, under the GIL, so the two threads gain nothing; ``FrameRenderer.batch_size`` sizes batches to about
+CHUNK_PIXELS surfaces per chunk (measured: scripts/benchmark_default_cube.py).
 """
 from __future__ import annotations
 
@@ -52,6 +59,7 @@ from .target import WIDTH, ShadingTerms
 
 INTEGRATORS = ("PATH", "RESTIR")
 CHUNK_PIXELS = 32768  # pixels per chunk of work (measured: scripts/benchmark_stages.py --tile-sweep)
+MAX_BATCH = 8  # samples one pass renders at most (FrameRenderer.batch_size)
 STOP_POLL_SECONDS = 0.02  # how often a running stage asks should_stop (the viewport's latency to a new view)
 
 
@@ -92,6 +100,7 @@ class RenderSettings:
     data_passes: bool = True  # Depth, Normal and Vector (one more ray per pixel and frame); off when not written
     denoise_data: bool = False  # Denoising Albedo / Normal: first-hit albedo and camera-space normal, per sample
     tile_pixels: int = CHUNK_PIXELS  # pixels per chunk of work (smaller: finer progress and cancellation)
+    sample_batch: int = 0  # samples a pass renders at once where it can (module docstring); 0 = automatic
     coverage_samples: int = 0  # camera rays per pixel for the emission seen directly: 1, 4, 9, 16 ...; 0 = automatic
     indirect_method: str = "PATH"  # with integrator RESTIR: "AUTO" (method_choice), "OFF" (no bounces), "PATH" or
     #                                "RESTIR_GI" (restir/gi.py)
@@ -238,7 +247,8 @@ class _Chunk:
     """One span of window pixels through a sample pass: its primary hits and per-surface results."""
 
     index: int
-    pixels: np.ndarray     # window pixel indices (row-major)
+    pixels: np.ndarray     # window pixel indices (row-major): the chunk's span, ``batch`` times over
+    batch: int = 1         # samples of each pixel (sample s + b at pixels[b * span : (b + 1) * span])
     hits: object = None    # pathtracer.PrimaryHits (rows index ``pixels``)
     first: int = 0         # index of its first surface in the frame's G-buffer
     res: object = None     # di.DIReservoirs of its surfaces after initial resampling
@@ -404,8 +414,9 @@ class FrameRenderer:
         if self.settings.denoise_data:
             self.acc["albedo"], self.acc["dnormal"] = _BUFFERS.zeros((h, w, 3)), _BUFFERS.zeros((h, w, 3))
         self.samples_done = 0
+        self._surfaces_per_chunk = None  # surfaces per chunk and sample in the last pass (batch_size)
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
-        self.gi_skipped = 0  # sample passes that kept path-traced indirect light (GI_MIN_SHARE)
+        self.gi_skipped = 0  # samples whose pass kept path-traced indirect light (GI_MIN_SHARE)
         self.reuse_stats = {}  # the last pass's temporal acceptance and confidence (diagnostics)
         self.used_tiles = False
         self._data = None
@@ -467,23 +478,34 @@ class FrameRenderer:
             stop.advance(len(done))
         return out
 
-    def sample_pass(self, progress=None, should_stop=None) -> bool:
-        """Render the next sample pass (one path per pixel) into the accumulators. Returns False, keeping
-        the accumulators unchanged, when ``should_stop`` asked to stop part-way."""
+    def sample_pass(self, progress=None, should_stop=None, batch: int = 1) -> bool:
+        """Render the next sample pass (one path per pixel; ``batch`` per pixel where the pass can: module docstring)
+        into the accumulators. Returns False, keeping the accumulators unchanged, when ``should_stop`` asked to stop
+        part-way."""
         try:
-            self._sample_pass(progress, should_stop)
+            done = self._sample_pass(progress, should_stop, batch)
         except _Stopped:
             return False
-        self.samples_done += 1
+        self.samples_done += done
         return True
 
-    def _sample_pass(self, progress, should_stop):
+    def batch_size(self, remaining: int) -> int:
+        """Samples the next pass should render at once (at most ``remaining``): the setting, else as many as bring a
+        chunk to about ``tile_pixels`` surfaces, judged by the last pass (1 before any pass), at most MAX_BATCH."""
+        st = self.settings
+        if st.sample_batch > 0:
+            return max(1, min(remaining, int(st.sample_batch)))
+        if self._surfaces_per_chunk is None:
+            return 1
+        return max(1, min(remaining, MAX_BATCH, int(st.tile_pixels // max(self._surfaces_per_chunk, 1.0))))
+
+    def _sample_pass(self, progress, should_stop, batch: int = 1) -> int:
+        """One pass of ``batch`` samples (1 where the pass resamples or measures). Returns the samples rendered."""
         st = self.settings
         s = self.samples_done
         clock = self.clock
         x0, y0, w, h = self.ctx.scene.camera.window
         npix = w * h
-        chunks = [_Chunk(i, np.arange(sl.start, sl.stop)) for i, sl in enumerate(self._spans(npix))]
         if self.gi_auto and s == 0 and self._measure[0] is None:
             with clock.stage("probe"):  # nothing measured yet (a still, a first frame): measure before choosing
                 self._probe()
@@ -499,6 +521,12 @@ class FrameRenderer:
             probe = since >= PROBE_FRAMES
             self._measure = (sums, 1 if probe else since + 1)
             self._remember()
+        if resampled or gi_on or probe:
+            batch = 1
+        batch = max(1, int(batch))
+        spans = self._spans(npix)
+        chunks = [_Chunk(i, np.arange(sl.start, sl.stop) if batch == 1 else
+                         np.tile(np.arange(sl.start, sl.stop), batch), batch) for i, sl in enumerate(spans)]
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
         chunk_stages = 4 + int(resampled) + (int(self.spatial.passes) + 1 if reusing else 0) + \
             (int(self.gi.passes) + 1 if gi_on else 0)
@@ -519,8 +547,11 @@ class FrameRenderer:
         def camera_rays(c: _Chunk):
             r = rng(st.seed, st.frame, s, STREAM_CAMERA, c.index)
             # the pass's position in the pixel: Sobol point s, shifted per pixel (the shift keyed without the pass)
-            shift = rng(st.seed, st.frame, 0, STREAM_PIXEL_OFFSET, c.index).bit_generator.random_raw(len(c.pixels))
-            j = pass_jitter(shift.view(np.uint32).reshape(-1, 2), s)
+            span = len(c.pixels) // c.batch
+            shift = rng(st.seed, st.frame, 0, STREAM_PIXEL_OFFSET, c.index).bit_generator.random_raw(span)
+            shift = shift.view(np.uint32).reshape(-1, 2)
+            j = pass_jitter(shift, s) if c.batch == 1 else \
+                np.concatenate([pass_jitter(shift, s + b) for b in range(c.batch)])
             px = (x0 + c.pixels % w).astype(np.float32)
             py = (y0 + c.pixels // w).astype(np.float32)
             hit_mask = None if may_hit is None else may_hit[c.pixels]
@@ -551,6 +582,7 @@ class FrameRenderer:
             for c in chunks:
                 c.first = first
                 first += len(c.hits.rows)
+            self._surfaces_per_chunk = first / (len(chunks) * batch)
         candidates = self.candidates
         cap = self.light_candidate_cap
         if resampled and cap is not None and candidates.light_candidates > cap:
@@ -628,7 +660,7 @@ class FrameRenderer:
             for c in chunks:
                 c.path_indirect = None
         if self.gi is not None and not gi_on:
-            self.gi_skipped += 1
+            self.gi_skipped += batch
         gb = res = gi_res = gb_gi = gi_history = None
         if reusing or gi_on:
             with clock.stage("gbuffer"):
@@ -679,6 +711,7 @@ class FrameRenderer:
             self._map(shade, chunks, stop)
         with clock.stage("passes"):
             self._accumulate(chunks, resampled, stop)
+        return batch
 
     def _gi_initial(self, surf, first, block: np.ndarray, filled: bool = False):
         """ReSTIR GI's initial reservoirs at surfaces ``surf`` from their first bounces (pathtracer.FirstBounce):
@@ -847,6 +880,8 @@ class FrameRenderer:
         flat = {k: a.reshape(len(a) * a.shape[1], -1) if a.ndim == 3 else a.reshape(-1) for k, a in self.acc.items()}
 
         def add(c: _Chunk):
+            if c.batch > 1:
+                return add_batch(c)
             # the (3, k) results are transposed into contiguous (k, 3) copies first: adding a transposed view
             # to (k, 3) rows runs NumPy's inner loop over 3 elements (measured 60 ms per 640x360 frame)
             span = slice(int(c.pixels[0]), int(c.pixels[-1]) + 1)  # a chunk is a contiguous pixel range
@@ -869,6 +904,25 @@ class FrameRenderer:
                 albedo = denoising_albedo(surf)
                 flat["albedo"][pix] += np.ascontiguousarray((albedo if chain is None else albedo * chain).T)
                 flat["dnormal"][pix] += np.ascontiguousarray((world_to_cam @ surf.ns).T)
+
+        def add_batch(c: _Chunk):
+            """A chunk of ``batch`` samples per pixel (no reservoirs or glass chains: those passes do not batch):
+            each result summed over the samples of its pixel."""
+            n = len(c.pixels) // c.batch
+            span = slice(int(c.pixels[0]), int(c.pixels[0]) + n)
+            flat["emit"][span] += c.hits.emitted.reshape(3, c.batch, n).sum(axis=1).T
+            flat["alpha"][span] += c.hits.alpha.reshape(c.batch, n).sum(axis=0)
+            for key, value in (("direct", c.direct), ("indirect", c.indirect)):
+                if value is not None:
+                    dense = np.zeros((len(c.pixels), 3), np.float32)
+                    dense[c.hits.rows] = value.T
+                    flat[key][span] += dense.reshape(c.batch, n, 3).sum(axis=0)
+            if "albedo" in flat and len(c.hits.rows):
+                surf = c.hits.surf
+                for key, value in (("albedo", denoising_albedo(surf)), ("dnormal", world_to_cam @ surf.ns)):
+                    dense = np.zeros((len(c.pixels), 3), np.float32)
+                    dense[c.hits.rows] = value.T
+                    flat[key][span] += dense.reshape(c.batch, n, 3).sum(axis=0)
 
         world_to_cam = np.ascontiguousarray(self.ctx.scene.camera.cam_to_world[:3, :3].T, dtype=np.float32)
         self._map(add, chunks, stop)
@@ -958,12 +1012,16 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     t0 = time.perf_counter()
     fr = FrameRenderer(scene, settings, history, clock)
     cancelled = False
-    for s in range(settings.samples):
+    while fr.samples_done < settings.samples:
+        s = fr.samples_done
+        batch = fr.batch_size(settings.samples - s)
         report = None
         if progress:
-            def report(f, s=s):
-                progress((s + f) / settings.samples, f"Sample {s + 1}/{settings.samples}")
-        if not fr.sample_pass(report, should_stop):
+            def report(f, s=s, b=batch):
+                label = f"Sample {s + 1}/{settings.samples}" if b == 1 else \
+                    f"Samples {s + 1}-{s + b}/{settings.samples}"
+                progress((s + f * b) / settings.samples, label)
+        if not fr.sample_pass(report, should_stop, batch):
             cancelled = True
             break
     if fr.samples_done == 0:

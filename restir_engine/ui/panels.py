@@ -158,7 +158,7 @@ class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
             box.label(text=last["indirect_reason"])
         elif last and last.get("gi_skipped_passes"):
             layout.label(text=f"Last render: path-traced indirect light in {last['gi_skipped_passes']} of "
-                              f"{last.get('samples', '?')} passes (almost no bounce light to cache)", icon="INFO")
+                              f"{last.get('samples', '?')} samples (almost no bounce light to cache)", icon="INFO")
         if s.direct_method in ("RESTIR", "AUTO"):
             layout.label(text="Temporal reuse and bias correction: as set for direct light")
         else:  # the shared settings are not drawn above for these direct methods
