@@ -57,6 +57,16 @@ def with_data_passes(settings: RenderSettings, view_layer) -> RenderSettings:
                    denoise_data=bool(view_layer.restir.use_pass_denoising_data))
 
 
+def _set_rect(render_pass, pixels: np.ndarray) -> None:
+    """Copy (w·h, channels) float32 pixels into a render pass through the buffer protocol (``foreach_set``):
+    assigning ``rect`` converts element by element (measured 36-44 ms for a 320x180 Combined pass, 0.07 ms this
+    way)."""
+    try:
+        render_pass.rect.foreach_set(pixels.ravel())
+    except (AttributeError, TypeError):  # a bpy without foreach_set on the pass array
+        render_pass.rect = pixels
+
+
 def scene_problems(core_scene, light_count: int) -> list[str]:
     """Messages for scenes that render but not as the user probably expects."""
     problems = []
@@ -300,5 +310,5 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             rp = layer.passes.find_by_name(name, "")
             if rp is None or core_name not in images:
                 continue
-            rp.rect = np.ascontiguousarray(images[core_name], dtype=np.float32).reshape(w * h, len(chans))
+            _set_rect(rp, np.ascontiguousarray(images[core_name], dtype=np.float32).reshape(w * h, len(chans)))
         self.end_result(result)
