@@ -44,6 +44,14 @@ def plane_under_world(albedo=0.5, world=1.0, width=32) -> Scene:
                  world_radiance=np.full(3, world, np.float32))
 
 
+def small_plane_under_world(width=32) -> Scene:
+    """A diffuse square (albedo 0.5) seen from above, covering the middle quarter of the view, under a constant
+    world of radiance 1: the other pixels see the world."""
+    mats = MaterialTable.build([{"base_color": (0.5,) * 3, "f0": 0.0}])
+    return Scene(tris(quad((0, 0, 0), (0.5, 0, 0), (0, 0.5, 0)), 0), mats, Lamps.empty(), top_down_camera(width, width),
+                 world_radiance=np.full(3, 1.0, np.float32))
+
+
 def floor_with_emitter(albedo=0.5, le=4.0, height=1.0, half=0.5, width=32, two_sided=True) -> Scene:
     """A diffuse floor under an emissive square (facing down) of half size ``half`` at ``height``."""
     mats = MaterialTable.build([{"base_color": (albedo,) * 3, "f0": 0.0},

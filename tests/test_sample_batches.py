@@ -7,18 +7,9 @@ tests/test_regression_images.py).
 """
 import numpy as np
 from regression import block_stats
-from scenes_core import quad, regression_room, top_down_camera, tris
+from scenes_core import regression_room, small_plane_under_world
 
 from restir_engine.core.renderer import FrameRenderer, RenderSettings, render_frame
-from restir_engine.core.scene import Lamps, MaterialTable, Scene
-
-
-def small_plane_under_world(width=32) -> Scene:
-    """A diffuse square (albedo 0.5) seen from above, covering the middle quarter of the view, under a constant
-    world of radiance 1: the other pixels see the world."""
-    mats = MaterialTable.build([{"base_color": (0.5,) * 3, "f0": 0.0}])
-    return Scene(tris(quad((0, 0, 0), (0.5, 0, 0), (0, 0.5, 0)), 0), mats, Lamps.empty(), top_down_camera(width, width),
-                 world_radiance=np.full(3, 1.0, np.float32))
 
 
 def test_batches_count_and_place_every_sample():

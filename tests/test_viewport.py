@@ -268,3 +268,30 @@ def test_stop_during_a_pass_returns_promptly(addon):
     print(f"stopped in {elapsed:.3f} s")
     assert elapsed < 1.0 and not session.running
     assert not [t for t in threading.enumerate() if t.name == "viewport-worker"]
+
+
+def test_still_view_refines_in_sample_batches_as_f12(addon, monkeypatch):
+    """A still view of a scene where few pixels see a surface, path traced: the full-resolution refinement renders
+    several samples per pass (renderer.batch_size) and accumulates the same image as F12 with as many samples."""
+    from scenes_core import small_plane_under_world
+    core = small_plane_under_world(48)
+    settings = RenderSettings(samples=1, max_bounces=1, data_passes=False, tile_pixels=4096)
+    batches = []
+    original = FrameRenderer.sample_pass
+
+    def counted(self, progress=None, should_stop=None, batch=1):
+        batches.append(batch)
+        return original(self, progress, should_stop, batch)
+
+    monkeypatch.setattr(FrameRenderer, "sample_pass", counted)
+    session = ViewportSession(lambda: None, budget=0.0, max_samples=8)
+    try:
+        session.set_scene(core, settings)
+        session.set_view(core.camera, "still")
+        wait_for(lambda: session.stats.samples >= 8)
+        got = pass_image(session.renderer, "COMBINED")[0]
+    finally:
+        session.halt()
+    assert batches[0] == 1 and max(batches) > 1 and len(batches) < 8, batches
+    ref = render_frame(dataclasses.replace(core, motion=None), dataclasses.replace(settings, samples=8, frame=1))
+    assert np.allclose(got, ref.passes["Combined"], atol=1e-5)
