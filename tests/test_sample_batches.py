@@ -5,6 +5,8 @@ The batched image must be the same estimator as one sample per pass: the samples
 agree with unbatched renders within noise (Welch z-scores of block means over independent seeds, as
 tests/test_regression_images.py).
 """
+import dataclasses
+
 import numpy as np
 from regression import block_stats
 from scenes_core import regression_room, small_plane_under_world
@@ -33,6 +35,10 @@ def test_batches_count_and_place_every_sample():
     assert np.allclose(emission[12:20, 12:20], 0.0)
     lit = res.passes["Direct"][12:20, 12:20, 0]  # albedo 0.5 under a unit world, unoccluded: exactly 0.5 in mean
     assert abs(lit.mean() - 0.5) < 0.02
+    # the denoising data are summed the same way: inside the square every sample's albedo is 0.5
+    res = render_frame(scene, dataclasses.replace(st, denoise_data=True))
+    assert np.allclose(res.passes["Denoising Albedo"][12:20, 12:20], 0.5, atol=1e-5)
+    assert np.allclose(res.passes["Denoising Albedo"][:4], 0.0)
 
 
 def test_batched_passes_render_the_same_image():
