@@ -9,8 +9,10 @@ tests/test_cycles_accuracy.py: |ours - Cycles| < 5 SE + 0.5 % of Cycles (two-sid
 the SE bound; the margin is 4x tighter than the 2 % the materials issue asks for).
 
 Power: the cells that isolate a lobe (diffuse, the layered diffuse of a white dielectric, the dielectric specular
-of a black one, rough metals, a Glossy BSDF, rough dielectrics of IOR 1.2 and 2.0) must each fail the same test
-when our mean is scaled by 1.03: a 3 % error in any of those lobes cannot pass.
+of a black one, rough metals, a Glossy BSDF, rough dielectrics of IOR 1.2 and 2.0) must each have a bound tighter
+than a 3 % error: |1.03 x - x| > 5 SE + 0.5 % at the cell's mean x (relative SE below about 0.5 %), so a 3 % error
+in any of those lobes fails at least half the time, and almost surely where the SE is well inside that. (The check
+once scaled the *measured* mean by 1.03, which made it fail by chance where that mean fell 2-3 SE below Cycles'.)
 Before the Cycles layering (diffuse weighted by 1 - Schlick(f0, cos θ_view)) the floor's rough dielectrics read
 38 % dark in the far cells and spheres were off by up to 8 % (docs/RESULTS.md "Principled BSDF").
 """
@@ -72,8 +74,10 @@ def assert_cells_match(ours, ref, names, power=()):
     report = [f"{n}: ours/cycles {a / b:.4f} (rel SE {s / b:.4f})" for n, a, b, s in zip(names, ma, mb, se)]
     assert ok.all(), "\n".join(r for r, good in zip(report, ok) if not good)
     for i in power:
+        # the test's resolution at this cell, whatever side of Cycles its mean fell on: a 3 % error lies outside the
+        # bound (the bound of the means scaled by 1.03, at their expected difference)
         se3 = np.sqrt(1.03 ** 2 * ours[:, i].var(ddof=1) / len(ours) + ref[:, i].var(ddof=1) / len(ref))
-        assert not agree(1.03 * ma[i], mb[i], se3), f"cannot see a 3 % error in {report[i]}"
+        assert 0.03 * abs(mb[i]) > Z_MAX * se3 + MARGIN * abs(mb[i]), f"cannot see a 3 % error in {report[i]}"
 
 
 def grid_names():
