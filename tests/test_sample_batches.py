@@ -76,4 +76,9 @@ def test_auto_batches_only_where_few_pixels_see_a_surface():
     assert 1 < fr.batch_size(7) <= 7
     fr = FrameRenderer(room, RenderSettings(samples=8, integrator="RESTIR", direct_method="RESTIR", max_bounces=0,
                                             data_passes=False, sample_batch=4))
+    assert fr.batch_size(8) == 1  # asked for 4, but this pass resamples: render_frame's progress counts 1
     assert fr.sample_pass(batch=4) and fr.samples_done == 1
+    sparse = FrameRenderer(small_plane_under_world(), RenderSettings(
+        samples=8, integrator="RESTIR", direct_method="RESTIR", max_bounces=1, data_passes=False, tile_pixels=256))
+    sparse.sample_pass()
+    assert sparse.batch_size(7) == 1  # few surfaces per chunk, but reservoirs keep per-pixel state

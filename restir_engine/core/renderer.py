@@ -493,16 +493,34 @@ class FrameRenderer:
         """Samples the next pass should render at once (at most ``remaining``): the setting, else as many as bring a
         chunk to about ``tile_pixels`` surfaces, judged by the last pass (1 before any pass), at most MAX_BATCH."""
         st = self.settings
+        if not self._can_batch():
+            return 1
         if st.sample_batch > 0:
             return max(1, min(remaining, int(st.sample_batch)))
         if self._surfaces_per_chunk is None:
             return 1
         return max(1, min(remaining, MAX_BATCH, int(st.tile_pixels // max(self._surfaces_per_chunk, 1.0))))
 
+    def _can_batch(self) -> bool:
+        """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
+        ReSTIR GI) and measures nothing for Auto indirect (no probe; the first pass without a measurement probes)."""
+        if self.candidates is not None:
+            return False
+        if self.gi is None:
+            return True
+        if not self.gi_auto or self.indirect_method == "RESTIR_GI":
+            return False
+        if self.samples_done == 0:
+            sums, since = self._measure
+            return sums is not None and since < PROBE_FRAMES
+        return True
+
     def _sample_pass(self, progress, should_stop, batch: int = 1) -> int:
         """One pass of ``batch`` samples (1 where the pass resamples or measures). Returns the samples rendered."""
         st = self.settings
         s = self.samples_done
+        if not self._can_batch():
+            batch = 1
         clock = self.clock
         x0, y0, w, h = self.ctx.scene.camera.window
         npix = w * h
@@ -521,8 +539,6 @@ class FrameRenderer:
             probe = since >= PROBE_FRAMES
             self._measure = (sums, 1 if probe else since + 1)
             self._remember()
-        if resampled or gi_on or probe:
-            batch = 1
         batch = max(1, int(batch))
         spans = self._spans(npix)
         chunks = [_Chunk(i, np.arange(sl.start, sl.stop) if batch == 1 else
@@ -912,17 +928,17 @@ class FrameRenderer:
             span = slice(int(c.pixels[0]), int(c.pixels[0]) + n)
             flat["emit"][span] += c.hits.emitted.reshape(3, c.batch, n).sum(axis=1).T
             flat["alpha"][span] += c.hits.alpha.reshape(c.batch, n).sum(axis=0)
+            def add_rows(key, value):  # (3, hits) values of the hit rows, summed into their pixels
+                dense = np.zeros((len(c.pixels), 3), np.float32)
+                dense[c.hits.rows] = value.T
+                flat[key][span] += dense.reshape(c.batch, n, 3).sum(axis=0)
+
             for key, value in (("direct", c.direct), ("indirect", c.indirect)):
                 if value is not None:
-                    dense = np.zeros((len(c.pixels), 3), np.float32)
-                    dense[c.hits.rows] = value.T
-                    flat[key][span] += dense.reshape(c.batch, n, 3).sum(axis=0)
+                    add_rows(key, value)
             if "albedo" in flat and len(c.hits.rows):
-                surf = c.hits.surf
-                for key, value in (("albedo", denoising_albedo(surf)), ("dnormal", world_to_cam @ surf.ns)):
-                    dense = np.zeros((len(c.pixels), 3), np.float32)
-                    dense[c.hits.rows] = value.T
-                    flat[key][span] += dense.reshape(c.batch, n, 3).sum(axis=0)
+                add_rows("albedo", denoising_albedo(c.hits.surf))
+                add_rows("dnormal", world_to_cam @ c.hits.surf.ns)
 
         world_to_cam = np.ascontiguousarray(self.ctx.scene.camera.cam_to_world[:3, :3].T, dtype=np.float32)
         self._map(add, chunks, stop)
