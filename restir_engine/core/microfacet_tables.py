@@ -217,7 +217,12 @@ def rows_at(rows: np.ndarray, index: np.ndarray, mu: np.ndarray) -> np.ndarray:
     n = N_MU
     y = np.clip((mu - np.float32(MUS[0])) * np.float32((n - 1) / (1.0 - MUS[0])), 0, n - 1)
     y0 = np.minimum(y.astype(np.intp), n - 2)
-    fy = y - y0
+    fy = y - y0.astype(np.float32)  # float32 (an integer array would promote it, and every term after, to float64)
     k = index * n + y0
     flat = rows.reshape(-1)
-    return flat[k] * (1 - fy) + flat[k + 1] * fy
+    lo = flat[k]
+    out = flat[k + 1]
+    out -= lo
+    out *= fy
+    out += lo
+    return out
