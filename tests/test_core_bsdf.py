@@ -195,3 +195,33 @@ def test_mix_picks_components_in_proportion_to_their_weights():
     g = np.random.default_rng(4)
     h = hash_uniform(np.arange(n), g.random(n, dtype=np.float32), g.random(n, dtype=np.float32))
     assert abs(h.mean() - 0.5) < 5 * np.sqrt(1 / 12 / n) and ((h >= 0) & (h < 1)).all()
+
+
+def test_lobe_flags_only_skip_work():
+    """SurfaceParams records which optional lobes some entry may have (metal, dielectric, F82 tint, Oren–Nayar, a
+    coloured dielectric layer) so per-hit blocks need not scan their rows. The flags are a superset kept through
+    take/assign, and the view terms with every flag set (the general path) equal the ones with the scanned flags."""
+    rng = np.random.default_rng(3)
+    m = 5
+    table = SurfaceParams.from_material(rng.uniform(0.1, 0.9, (m, 3)), np.array([0, 0, 0.3, 1, 0.0]),
+                                        np.array([0.2, 0.5, 0.7, 0.3, 1.0]), np.full(m, 0.04))
+    assert table.lobes == {"metal", "diel"}
+    tinted = SurfaceParams.from_material(np.full((1, 3), 0.5), [0.0], [0.5], [0.04], spec_tint=[[1.0, 0.5, 0.2]],
+                                         diffuse_roughness=[0.5])
+    assert tinted.lobes == {"diel", "coloured_layer", "rough_diffuse"}
+    n = 4000
+    mat = rng.integers(0, m, n)
+    p = table.take(mat)
+    assert p.lobes == table.lobes and p.take(slice(0, 10)).lobes == table.lobes
+    wo = rng.normal(size=(3, n)).astype(np.float32)
+    wo[2] = np.abs(wo[2]) + 0.05
+    wo /= np.linalg.norm(wo, axis=0)
+    wi = rng.normal(size=(3, n)).astype(np.float32)
+    wi /= np.linalg.norm(wi, axis=0)
+    general = SurfaceParams(p.block, frozenset({"metal", "diel", "tint", "rough_diffuse", "coloured_layer"}))
+    f_fast, pdf_fast = bsdf.eval_bsdf(p, wo, wi)
+    f_gen, pdf_gen = bsdf.eval_bsdf(general, wo, wi)
+    np.testing.assert_allclose(f_fast, f_gen, rtol=2e-6, atol=1e-7)
+    np.testing.assert_allclose(pdf_fast, pdf_gen, rtol=2e-6, atol=1e-7)
+    p.assign(np.arange(3), tinted.take(np.zeros(3, np.intp)))
+    assert p.lobes == {"metal", "diel", "coloured_layer", "rough_diffuse"}

@@ -80,10 +80,25 @@ class SurfaceParams:
       on_a, on_b, on_ems (3)  the diffuse lobe's energy-preserving Oren–Nayar (Cycles 4.3+; Lambert: 1/π, 0, 0):
                      f_d = diffuse · layer · (a + b t + Ems (1 - E(cos θo)) (1 - E(cos θi))), see :func:`oren_nayar_E`."""
 
-    __slots__ = ("block",)
+    __slots__ = ("block", "lobes")
 
-    def __init__(self, block: np.ndarray):
+    def __init__(self, block: np.ndarray, lobes: frozenset | None = None):
         self.block = block
+        # which optional lobes some entry may have ("metal", "diel", "tint": a metal's F82 tint, "rough_diffuse":
+        # Oren–Nayar): a superset, kept through take/assign so that a per-hit block needs no scan of its rows
+        self.lobes = lobes if lobes is not None else self._scan()  # coloured_layer: f0t or msd not grey somewhere
+
+    def _scan(self) -> frozenset:
+        b = self.block
+        f0t, msd = b[PARAM_ROWS["diel_f0"]], b[PARAM_ROWS["msd"]]
+        coloured = (f0t != f0t[0]) | (msd != msd[0])
+        found = (("metal", b[PARAM_ROWS["metal"]]), ("diel", b[PARAM_ROWS["diel"]]), ("tint", b[PARAM_ROWS["d_m"]]),
+                 ("rough_diffuse", b[PARAM_ROWS["on_b"]]), ("coloured_layer", coloured))
+        return frozenset(name for name, rows in found if rows.any())
+
+    def has(self, lobe: str) -> bool:
+        """Whether some entry may have ``lobe`` (False: none has it)."""
+        return lobe in self.lobes
 
     def __getattr__(self, name):
         try:
@@ -97,14 +112,15 @@ class SurfaceParams:
     def take(self, idx) -> "SurfaceParams":
         """Parameters of entries ``idx`` (index array or slice)."""
         if isinstance(idx, slice):
-            return SurfaceParams(self.block[:, idx])
+            return SurfaceParams(self.block[:, idx], self.lobes)
         # mode "wrap" skips the bounds check: 30-40 % faster for the per-hit gather from the material table (the
         # indices are material or hit indices, in range by construction); the result is C-ordered, rows contiguous
-        return SurfaceParams(np.take(self.block, idx, axis=1, mode="wrap"))
+        return SurfaceParams(np.take(self.block, idx, axis=1, mode="wrap"), self.lobes)
 
     def assign(self, idx, other: "SurfaceParams") -> None:
         """self[idx] = other (every row)."""
         self.block[:, idx] = other.block
+        self.lobes = self.lobes | other.lobes
 
     def scale(self, factor: np.ndarray) -> None:
         """Scale every lobe by ``factor`` (n,) in place (Fresnel and layering terms are ratios: unchanged)."""
@@ -177,6 +193,7 @@ class SurfaceParams:
         b[PARAM_ROWS["on_b"]] = on_b
         b[PARAM_ROWS["on_ems"]] = (albedo * albedo * (e_avg_on / np.maximum(1 - e_avg_on, 1e-12)) / np.pi
                                    / (1 - albedo * (1 - e_avg_on))) * (on_b > 0)
+        out.lobes = out._scan()
         return out
 
     @staticmethod
@@ -248,8 +265,8 @@ class ViewTerms:
         alpha = p.alpha
         lam_o = smith_lambda(alpha, co)
         kd = p.diffuse * INV_PI
-        has_metal = bool(p.metal.any())
-        has_diel = bool(p.diel.any())
+        has_metal = p.has("metal")
+        has_diel = p.has("diel")
         if not (has_metal or has_diel):
             return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha * alpha, lam_o, co, p.spec_on,
                              p.p_spec, False)._oren_nayar(p, co)
@@ -262,23 +279,28 @@ class ViewTerms:
             cm += 1.0
             spec_a = cm * p.a_m
             spec_b = cm * p.b_m
-            if p.d_m.any():
+            if p.has("tint"):
                 spec_d = cm * p.d_m
         if has_diel:
             cd = p.fd * miss
             cd += 1.0
             spec_c = cd * p.c_d
-            ad = cd * p.a_d
-            spec_a = ad if spec_a is None else spec_a + ad
+            if spec_a is None:
+                spec_a = cd * p.a_d
+            else:
+                cd *= p.a_d
+                spec_a += cd
             eta2m1 = p.eta2m1
             s = view_layer(p, wo) if layer is None else layer
-            f0t = p.diel_f0
-            la = (1.0 - f0t) * s
-            la += f0t
-            dark = one_e * p.msd
+            f0t, msd = p.diel_f0, p.msd
+            if not p.has("coloured_layer"):             # f0t and msd grey: one channel serves
+                f0t, msd = f0t[0], msd[0]
+            la = f0t * (1.0 - s)                        # mix(f0t, 1, S)
+            la += s
+            dark = one_e * msd
             np.subtract(1.0, dark, out=dark)
             la *= dark                                  # the dielectric layer's albedo toward the viewer
-            w = la.max(axis=0)
+            w = la.max(axis=0) if la.ndim == 2 else la
             np.subtract(1.0, w, out=w)
             np.clip(w, 0.0, 1.0, out=w)                 # 1 where there is no dielectric layer (f0t = 0, S = 0)
             kd *= w
@@ -288,9 +310,9 @@ class ViewTerms:
     def _oren_nayar(self, p: SurfaceParams, co: np.ndarray) -> "ViewTerms":
         """Attach the Oren–Nayar terms where some surface has a diffuse roughness: f_d = kd π (a + b t + ms (1 - E_i))
         (kd stays the Lambert lobe, which the ReSTIR targets and the GI diffuse split use as its approximation)."""
-        on_b = p.on_b
-        if not on_b.any():
+        if not p.has("rough_diffuse"):
             return self
+        on_b = p.on_b
         self.on_a, self.on_b = p.on_a * np.float32(np.pi), on_b * np.float32(np.pi)
         self.on_ms = p.on_ems * (1.0 - oren_nayar_E(p.on_a, on_b, np.maximum(co, 0))) * np.float32(np.pi)
         return self
@@ -319,10 +341,10 @@ def denoising_albedo(surf) -> np.ndarray:
     e = surf.albedo
     one_e = 1.0 - e
     out = v.kd * np.float32(np.pi)
-    if p.metal.any():
+    if p.has("metal"):
         c = np.clip(1.0 - surf.wo_l[2], 0.0, 1.0)
         out = out + (p.a_m + p.b_m * (c * c * c * c * c)) * (e + p.fm * one_e)
-    if p.diel.any():
+    if p.has("diel"):
         out = out + (p.a_d + p.c_d * (1.0 - p.f0r) * surf.layer) * (e + p.fd * one_e)
     return np.clip(out, 0.0, 1.0).astype(np.float32)
 
