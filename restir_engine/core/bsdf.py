@@ -265,8 +265,9 @@ class ViewTerms:
         alpha = p.alpha
         lam_o = smith_lambda(alpha, co)
         kd = p.diffuse * INV_PI
-        has_metal = p.has("metal")
-        has_diel = p.has("diel")
+        # per block: a chunk may hold none of a lobe the scene has (a flag absent skips the scan)
+        has_metal = p.has("metal") and bool(p.metal.any())
+        has_diel = p.has("diel") and bool(p.diel.any())
         if not (has_metal or has_diel):
             return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha * alpha, lam_o, co, p.spec_on,
                              p.p_spec, False)._oren_nayar(p, co)
@@ -279,7 +280,7 @@ class ViewTerms:
             cm += 1.0
             spec_a = cm * p.a_m
             spec_b = cm * p.b_m
-            if p.has("tint"):
+            if p.has("tint") and p.d_m.any():
                 spec_d = cm * p.d_m
         if has_diel:
             cd = p.fd * miss
@@ -310,9 +311,9 @@ class ViewTerms:
     def _oren_nayar(self, p: SurfaceParams, co: np.ndarray) -> "ViewTerms":
         """Attach the Oren–Nayar terms where some surface has a diffuse roughness: f_d = kd π (a + b t + ms (1 - E_i))
         (kd stays the Lambert lobe, which the ReSTIR targets and the GI diffuse split use as its approximation)."""
-        if not p.has("rough_diffuse"):
-            return self
         on_b = p.on_b
+        if not (p.has("rough_diffuse") and on_b.any()):
+            return self
         self.on_a, self.on_b = p.on_a * np.float32(np.pi), on_b * np.float32(np.pi)
         self.on_ms = p.on_ems * (1.0 - oren_nayar_E(p.on_a, on_b, np.maximum(co, 0))) * np.float32(np.pi)
         return self
