@@ -394,21 +394,32 @@ class LightTable:
 
     def _cone_sample(self, light, p, u2, u3):
         """Sphere coordinates (b1, b2) of the points where directions drawn uniformly in the cone subtended by
-        spheres ``light`` from p (3, k) first meet them (uniform area points for p inside a sphere)."""
-        pc, dc, r = self._from_points(light, p)
-        x = r * r / np.maximum(dc * dc, 1e-300)
+        spheres ``light`` from p (3, k) first meet them (uniform area points for p inside a sphere).
+
+        float32 without cancellation: with a the unit axis toward the centre (distance d), the direction
+        w = cos θ a + sin θ e (e ⊥ a) meets the sphere at s = d cos θ - q, q = sqrt(r² - d² sin² θ), where the unit
+        normal is (s w - d a)/r = -(d sin² θ + q cos θ)/r · a + (s sin θ / r) · e: both parts are sums of
+        non-negative terms (the direct difference s w - d a loses d/r of its digits)."""
+        f32 = np.float32
+        pc = np.take(self.rows_v0, light, axis=1) - p
+        dc = np.sqrt(dot(pc, pc))
+        r = self.sphere_r[light].astype(np.float32)
+        x = (r * r) / np.maximum(dc * dc, f32(1e-30))
         inside = x >= 1.0
-        one_minus = u2.astype(np.float64) * one_minus_cos_cone(np.where(inside, 0.0, x))
+        x = np.where(inside, f32(0.0), x)
+        one_minus = u2 * (x / (1.0 + np.sqrt(np.maximum(f32(0.0), 1.0 - x))))  # u · (1 - cos θmax)
         cos_t = 1.0 - one_minus
-        sin_t = np.sqrt(np.maximum(0.0, one_minus * (2.0 - one_minus)))
-        phi = 2.0 * np.pi * u3.astype(np.float64)
-        axis = pc / np.maximum(dc, 1e-300)
+        sin2 = one_minus * (2.0 - one_minus)
+        sin_t = np.sqrt(sin2)
+        q = np.sqrt(np.maximum(f32(0.0), r * r - dc * dc * sin2))
+        inv_r = 1.0 / np.maximum(r, f32(1e-30))
+        n_axis = -(dc * sin2 + q * cos_t) * inv_r
+        n_perp = (dc * cos_t - q) * sin_t * inv_r
+        axis = pc / np.maximum(dc, f32(1e-30))
         t, b = orthonormal_basis(axis)
-        w = t * (sin_t * np.cos(phi)) + b * (sin_t * np.sin(phi)) + axis * cos_t
-        # the near crossing of p + s w: s = dc cos θ - sqrt(r² - dc² sin² θ)
-        s = dc * cos_t - np.sqrt(np.maximum(0.0, r * r - (dc * sin_t) ** 2))
-        n = (s * w - pc) / r
-        n /= np.maximum(np.sqrt(np.einsum("ij,ij->j", n, n)), 1e-300)
+        phi = f32(2.0 * np.pi) * u3
+        n = axis * n_axis + (t * np.cos(phi) + b * np.sin(phi)) * n_perp
+        n /= np.maximum(np.sqrt(dot(n, n)), f32(1e-30))
         b1, b2 = sphere_coords(n)
         if inside.any():
             b1[inside], b2[inside] = u2[inside], u3[inside]
