@@ -84,9 +84,10 @@ class SurfaceParams:
 
     def __init__(self, block: np.ndarray, lobes: frozenset | None = None):
         self.block = block
-        # which optional lobes some entry may have ("metal", "diel", "tint": a metal's F82 tint, "rough_diffuse":
-        # Oren–Nayar): a superset, kept through take/assign so that a per-hit block needs no scan of its rows
-        self.lobes = lobes if lobes is not None else self._scan()  # coloured_layer: f0t or msd not grey somewhere
+        # the optional lobes some entry may have: "metal", "diel", "tint" (a metal's F82 tint), "rough_diffuse"
+        # (Oren–Nayar), "coloured_layer" (a dielectric f0t or msd that is not grey). A superset, kept through
+        # take/assign, so per-hit blocks skip what no material has without scanning their rows
+        self.lobes = lobes if lobes is not None else self._scan()
 
     def _scan(self) -> frozenset:
         b = self.block
