@@ -215,7 +215,7 @@ class ViewportSession:
         self._key = None             # the key of the view being rendered
         self._divider = 1
         self._frame = 0              # views rendered so far: keys the random streams of each view
-        self._cost = None            # running estimate of seconds per pixel of one sample
+        self._cost = None            # running estimate of seconds per pixel of a one-sample pass
         self._interrupt = False      # the running refinement pass must stop
         self._navigating = False     # the running pass is a navigation pass (view changes do not stop it)
         self._closed = False
@@ -392,9 +392,12 @@ class ViewportSession:
         if not done:
             return
         _x0, _y0, w, h = r.ctx.scene.camera.window
-        per_pixel = seconds / max(1, w * h * (r.samples_done - before))  # per pixel and sample
-        self._cost = per_pixel if self._cost is None else \
-            COST_SMOOTHING * per_pixel + (1 - COST_SMOOTHING) * self._cost
+        if r.samples_done - before == 1:
+            # the estimate sizes navigation passes, which render one sample: a batched refinement pass costs less per
+            # sample (fuller chunks) and would make the next navigation pass overrun its budget
+            per_pixel = seconds / max(1, w * h)
+            self._cost = per_pixel if self._cost is None else \
+                COST_SMOOTHING * per_pixel + (1 - COST_SMOOTHING) * self._cost
         self._publish(seconds, int(navigation))
 
     def _publish(self, seconds: float | None = None, navigation: int = 0) -> None:

@@ -276,11 +276,12 @@ def test_still_view_refines_in_sample_batches_as_f12(addon, monkeypatch):
     from scenes_core import small_plane_under_world
     core = small_plane_under_world(48)
     settings = RenderSettings(samples=1, max_bounces=1, data_passes=False, tile_pixels=4096)
-    batches = []
+    batches, costs = [], []
     original = FrameRenderer.sample_pass
 
     def counted(self, progress=None, should_stop=None, batch=1):
         batches.append(batch)
+        costs.append(session._cost)
         return original(self, progress, should_stop, batch)
 
     monkeypatch.setattr(FrameRenderer, "sample_pass", counted)
@@ -290,8 +291,12 @@ def test_still_view_refines_in_sample_batches_as_f12(addon, monkeypatch):
         session.set_view(core.camera, "still")
         wait_for(lambda: session.stats.samples >= 8)
         got = pass_image(session.renderer, "COMBINED")[0]
+        costs.append(session._cost)  # after the last pass (its estimate is updated before the image is published)
     finally:
         session.halt()
     assert batches[0] == 1 and max(batches) > 1 and len(batches) < 8, batches
+    # the navigation cost estimate (seconds per pixel of a one-sample pass) learns from one-sample passes only
+    assert costs[1] is not None
+    assert all(costs[k] == costs[k - 1] for k in range(2, len(costs)) if batches[k - 1] > 1), (batches, costs)
     ref = render_frame(dataclasses.replace(core, motion=None), dataclasses.replace(settings, samples=8, frame=1))
     assert np.allclose(got, ref.passes["Combined"], atol=1e-5)
