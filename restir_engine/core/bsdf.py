@@ -159,7 +159,7 @@ class SurfaceParams:
         fss_d = diel_f0 + (1 - diel_f0) * s_ss
         diel_w = np.where(diel, 1 - met, 0.0)
         metal = (met > 0) & ((metal_f0.max(axis=0) > 0) | (f90 > 0))
-        out = SurfaceParams(np.zeros((PARAM_WIDTH, m), np.float32))
+        out = SurfaceParams(np.zeros((PARAM_WIDTH, m), np.float32), frozenset())  # its lobes: scanned once filled
         b = out.block
         b[PARAM_ROWS["diffuse"]] = base * (1 - met)
         b[PARAM_ROWS["a_m"]] = met * metal_f0

@@ -51,8 +51,9 @@ def sphere_coords(unit: np.ndarray):
 
 
 def one_minus_cos_cone(r2_over_d2: np.ndarray) -> np.ndarray:
-    """1 - cos θ_max of the cone a sphere subtends, from (r/d)² < 1, without cancellation (float64)."""
-    x = np.asarray(r2_over_d2, np.float64)
+    """1 - cos θ_max of the cone a sphere subtends, from (r/d)² < 1, without cancellation (in the input's float
+    precision)."""
+    x = np.asarray(r2_over_d2)
     return x / (1.0 + np.sqrt(np.maximum(0.0, 1.0 - x)))
 
 
@@ -407,7 +408,7 @@ class LightTable:
         x = (r * r) / np.maximum(dc * dc, f32(1e-30))
         inside = x >= 1.0
         x = np.where(inside, f32(0.0), x)
-        one_minus = u2 * (x / (1.0 + np.sqrt(np.maximum(f32(0.0), 1.0 - x))))  # u · (1 - cos θmax)
+        one_minus = u2 * one_minus_cos_cone(x)  # u · (1 - cos θmax), float32
         cos_t = 1.0 - one_minus
         sin2 = one_minus * (2.0 - one_minus)
         sin_t = np.sqrt(sin2)

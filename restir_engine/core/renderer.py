@@ -504,16 +504,19 @@ class FrameRenderer:
     def _can_batch(self) -> bool:
         """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
         ReSTIR GI) and measures nothing for Auto indirect (no probe; the first pass without a measurement probes)."""
-        if self.candidates is not None:
+        if self.candidates is not None or self._gi_runs():
             return False
-        if self.gi is None:
+        if self.gi is None or self.samples_done > 0:
             return True
-        if not self.gi_auto or self.indirect_method == "RESTIR_GI":
-            return False
-        if self.samples_done == 0:
-            sums, since = self._measure
-            return sums is not None and since < PROBE_FRAMES
-        return True
+        return self._measure[0] is not None and not self._periodic_probe_due()
+
+    def _gi_runs(self) -> bool:
+        """ReSTIR GI runs in the next pass (AUTO: while its last measurement says so)."""
+        return self.gi is not None and (not self.gi_auto or self.indirect_method == "RESTIR_GI")
+
+    def _periodic_probe_due(self) -> bool:
+        """AUTO path-tracing: the first pass of this frame measures in some chunks (every PROBE_FRAMES-th frame)."""
+        return self._measure[1] >= PROBE_FRAMES
 
     def _sample_pass(self, progress, should_stop, batch: int = 1) -> int:
         """One pass of ``batch`` samples (1 where the pass resamples or measures). Returns the samples rendered."""
@@ -532,11 +535,11 @@ class FrameRenderer:
         # ReSTIR GI runs in this pass (AUTO: while its last measurement says so); AUTO measures in every pass that
         # runs GI, and while it path-traces, in a quarter of the chunks of the first pass of every PROBE_FRAMES-th
         # frame of this content (``probe``: the first bounces' extra work costs about 12 % of such a frame)
-        gi_on = self.gi is not None and (not self.gi_auto or self.indirect_method == "RESTIR_GI")
+        gi_on = self._gi_runs()
         probe = False
         if self.gi_auto and not gi_on and s == 0:
             sums, since = self._measure
-            probe = since >= PROBE_FRAMES
+            probe = self._periodic_probe_due()
             self._measure = (sums, 1 if probe else since + 1)
             self._remember()
         batch = max(1, int(batch))
