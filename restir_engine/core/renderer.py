@@ -191,6 +191,7 @@ MEASURE_DECAY = 0.8  # AUTO indirect: weight of the earlier passes' measurements
 PROBE_EVERY = 4  # AUTO indirect while path tracing: one chunk in this many measures (in a frame's first pass)
 PROBE_FRAMES = 8  # ... in every this many frames (or views) of the same scene content
 PROBE_PIXELS = 32  # a frame without a measurement first probes one pixel in this many (FrameRenderer._probe),
+PROBE_MAX = 2048  # ... at most this many (measured: 1800 separate the harness scenes' choices on every seed)
 PROBE_BOUNCES = 2  # with paths of at most this many bounces (the split is decided at the first two vertices)
 GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's: 6 px at 640x360 (measured on interior_gi:
 #                          relMSE 0.23 at 5 px, 0.29 at 8, 0.71 at 16 with 4 passes, 1 spp)
@@ -744,12 +745,14 @@ class FrameRenderer:
 
     def _probe(self) -> None:
         """AUTO indirect without a measurement: camera paths of up to PROBE_BOUNCES bounces through one pixel in
-        PROBE_PIXELS (their own random stream, so the frame's passes are independent of it and the image is unbiased
-        and deterministic) measure what the GI reservoirs would carry, and the frame's first pass follows that."""
+        PROBE_PIXELS, at most PROBE_MAX of them (their own random stream, so the frame's passes are independent of
+        it and the image is unbiased and deterministic), measure what the GI reservoirs would carry, and the
+        frame's first pass follows that. (Tried: the probe's paths as those pixels' samples of the pass, which
+        biases them by selection, and the probe run beside the pass's camera rays, which took longer.)"""
         st, ctx = self.settings, self.ctx
         x0, y0, w, h = ctx.scene.camera.window
         r = rng(st.seed, st.frame, 0, STREAM_PROBE)
-        pix = r.integers(0, w * h, max(1, (w * h) // PROBE_PIXELS))
+        pix = r.integers(0, w * h, max(1, min((w * h) // PROBE_PIXELS, PROBE_MAX)))
         jit = r.random((2, len(pix)), dtype=np.float32)
         hits = pathtracer.primary(ctx, (x0 + pix % w).astype(np.float32) + jit[0],
                                   (y0 + pix // w).astype(np.float32) + jit[1],
