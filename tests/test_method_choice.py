@@ -101,7 +101,7 @@ def test_auto_indirect_follows_what_the_reservoirs_can_carry():
 
 
 def test_auto_indirect_choice_carries_to_the_next_frame():
-    """A frame without a measurement probes a sixteenth of its pixels (their own random stream) before its first
+    """A frame without a measurement probes one pixel in 32 (their own random stream) before its first
     pass; the measurement is kept with the scene's context for the next frame: frame 1 of the mirror room chooses
     light sampling for its direct light and path tracing from its first pass on, without a probe. Only frame f + 1
     uses frame f's measurement, so rendering a frame again gives the same image."""
