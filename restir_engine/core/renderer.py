@@ -191,8 +191,8 @@ MEASURE_DECAY = 0.8  # AUTO indirect: weight of the earlier passes' measurements
 PROBE_EVERY = 4  # AUTO indirect while path tracing: one chunk in this many measures (in a frame's first pass)
 PROBE_FRAMES = 8  # ... in every this many frames (or views) of the same scene content
 PROBE_PIXELS = 32  # a frame without a measurement first probes one pixel in this many (FrameRenderer._probe),
-PROBE_MAX = 2048  # ... at most this many (measured: 1800 separate the harness scenes' choices on every seed)
 PROBE_BOUNCES = 2  # with paths of at most this many bounces (the split is decided at the first two vertices)
+PROBE_MAX = 2048  # ... and at most this many paths (measured: 1800 separate the harness scenes' choices on every seed)
 GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's: 6 px at 640x360 (measured on interior_gi:
 #                          relMSE 0.23 at 5 px, 0.29 at 8, 0.71 at 16 with 4 passes, 1 spp)
 MANY_COVERAGE = 16
