@@ -45,6 +45,15 @@ def luminance_rows(rgb: np.ndarray) -> np.ndarray:
     return np.float32(0.2126) * rgb[0] + np.float32(0.7152) * rgb[1] + np.float32(0.0722) * rgb[2]
 
 
+def smith_view(alpha2: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """√(c² (1 - α²) + α²) (n,): c (1 + 2 Λ(c)) of the GGX Smith Λ at cos θ = c > 0 (float32)."""
+    v = c * c
+    v *= 1.0 - alpha2
+    v += alpha2
+    np.sqrt(v, out=v)
+    return v
+
+
 def fss_dielectric(eta: np.ndarray) -> np.ndarray:
     """Cycles' fit of the cosine-weighted average of the exact dielectric Fresnel (η ≥ 1)."""
     return (eta - 1.0) / (4.08567 + 1.00071 * eta)
@@ -228,7 +237,8 @@ class ViewTerms:
     c = 1 - ωo·h and F the exact dielectric Fresnel of η (eta2m1 = η² - 1): spec_a (3, n); spec_b only where some
     surface has a metal lobe, spec_c, eta2m1, f0r only where some has a dielectric lobe, spec_d only where some
     metal has a Specular Tint (else None);
-    alpha, alpha2, lam_o = Λ(ωo), co = cos θo, spec_on, p_spec (n,)."""
+    alpha, alpha2 = α², co = cos θo, vo = √(cos² θo (1 - α²) + α²) (the view's half of the height-correlated
+    Smith term: G2/(4 cos θo cos θi) = 1/(2 (vo cos θi + vi cos θo)); Λ(ωo) = (vo/cos θo - 1)/2), p_spec (n,)."""
 
     kd: np.ndarray
     spec_a: np.ndarray
@@ -238,9 +248,8 @@ class ViewTerms:
     eta2m1: np.ndarray | None
     alpha: np.ndarray
     alpha2: np.ndarray
-    lam_o: np.ndarray
+    vo: np.ndarray
     co: np.ndarray
-    spec_on: np.ndarray
     p_spec: np.ndarray
     glossy: bool = True  # False: no surface has a specular lobe (Diffuse BSDFs only): Lambert alone
     f0r: np.ndarray | None = None  # (n,) untinted dielectric f0 (with spec_c)
@@ -252,11 +261,20 @@ class ViewTerms:
     spec_n: np.ndarray | None = None   # (3, n) the specular lobes' normal in the local frame (surface.py), or None
     co_s: np.ndarray | None = None     # (n,) cos θo about spec_n
 
+    @property
+    def lam_o(self) -> np.ndarray:
+        """Smith Λ(ωo) (n,) about the specular lobes' normal."""
+        co = self.co if self.co_s is None else self.co_s
+        lam = self.vo / np.maximum(co, np.float32(1e-12))
+        lam -= 1.0
+        lam *= 0.5
+        return lam
+
     def with_spec_normal(self, spec_n: np.ndarray, wo: np.ndarray) -> None:
-        """Give the specular lobes their own normal ``spec_n`` (local, unit (3, n)): their cos θo and Λ(ωo)."""
+        """Give the specular lobes their own normal ``spec_n`` (local, unit (3, n)): their cos θo and vo."""
         self.spec_n = spec_n
         self.co_s = np.clip(dot(wo, spec_n), np.float32(1e-4), 1.0).astype(np.float32)
-        self.lam_o = smith_lambda(self.alpha, self.co_s)
+        self.vo = smith_view(self.alpha2, self.co_s)
 
     @staticmethod
     def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None,
@@ -264,14 +282,15 @@ class ViewTerms:
         """``albedo``, ``layer``: :func:`view_albedo`, :func:`view_layer` if known."""
         co = wo[2]
         alpha = p.alpha
-        lam_o = smith_lambda(alpha, co)
+        alpha2 = alpha * alpha
+        vo = smith_view(alpha2, co)
         kd = p.diffuse * INV_PI
         # per block: a chunk may hold none of a lobe the scene has (a flag absent skips the scan)
         has_metal = p.has("metal") and bool(p.metal.any())
         has_diel = p.has("diel") and bool(p.diel.any())
         if not (has_metal or has_diel):
-            return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha * alpha, lam_o, co, p.spec_on,
-                             p.p_spec, False)._oren_nayar(p, co)
+            return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha2, vo, co, p.p_spec,
+                             False)._oren_nayar(p, co)
         e = view_albedo(p, wo) if albedo is None else albedo
         one_e = 1.0 - e
         miss = one_e / e
@@ -306,8 +325,8 @@ class ViewTerms:
             np.subtract(1.0, w, out=w)
             np.clip(w, 0.0, 1.0, out=w)                 # 1 where there is no dielectric layer (f0t = 0, S = 0)
             kd *= w
-        return ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha * alpha, lam_o, co, p.spec_on,
-                         p.p_spec, True, p.f0r if has_diel else None)._oren_nayar(p, co)
+        return ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha2, vo, co, p.p_spec, True,
+                         p.f0r if has_diel else None)._oren_nayar(p, co)
 
     def _oren_nayar(self, p: SurfaceParams, co: np.ndarray) -> "ViewTerms":
         """Attach the Oren–Nayar terms where some surface has a diffuse roughness: f_d = kd π (a + b t + ms (1 - E_i))
@@ -364,13 +383,13 @@ def fresnel_exact(c, eta2m1):
     it can."""
     g = c * c
     g += eta2m1
-    np.sqrt(g, out=g)
+    np.sqrt(g, out=g)                               # g ≥ c > 0
     gpc = g + c
-    gmc = g - c
-    a = gmc / np.maximum(gpc, np.float32(1e-12))
+    gmc = np.subtract(g, c, out=g)
+    a = gmc / gpc
     b = c * gpc
     b -= 1.0
-    den = c * gmc
+    den = np.multiply(c, gmc, out=gpc)
     den += 1.0
     b /= den
     b *= b
@@ -407,8 +426,8 @@ def half_vector_terms(wdw: np.ndarray, co, ci, alpha2):
 
 def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     """f (3, n) and pdf (n,) (solid angle) of unit directions wi (3, n) at surfaces with view terms ``v``. The half
-    vector h = (wo + wi)/|wo + wi| enters only through cos θ_h = (cos θ_o + cos θ_i)/|wo + wi| and
-    wo·h = (1 + wo·wi)/|wo + wi|, with |wo + wi|² = 2 + 2 wo·wi."""
+    vector h = (wo + wi)/|wo + wi| enters only through |wo + wi|² = t = 2 + 2 wo·wi: cos θ_h = (cos θ_o +
+    cos θ_i)/√t and wo·h = √t/2, so the specular pdf D cos θ_h/(4 wo·h) is D (cos θ_o + cos θ_i)/(2t)."""
     co = v.co
     ci = wi[2]
     valid = (co > 0) & (ci > 0)
@@ -432,26 +451,45 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         co = v.co_s
         ci = dot(wi, v.spec_n)
         valid_s = valid & (ci > 0)
-    cos_h, odh, d = half_vector_terms(dot(wo, wi), co, ci, v.alpha2)
-    s = 1.0 + v.lam_o + smith_lambda(v.alpha, ci)
-    den4 = 4.0 * co * ci
-    np.maximum(den4, np.float32(1e-12), out=den4)
-    s *= den4
-    np.divide(d, s, out=s)
-    s *= v.spec_on                                   # D G2 / (4 cos θo cos θi)
+    a2 = v.alpha2
+    t = dot(wo, wi)
+    t *= 2.0
+    t += 2.0
+    np.maximum(t, np.float32(1e-12), out=t)         # |wo + wi|²
+    q = co + ci
+    c2 = q * q
+    c2 /= t
+    np.minimum(c2, 1.0, out=c2)                     # cos² θh
+    c2 *= a2 - 1.0
+    c2 += 1.0
+    c2 *= c2
+    c2 *= np.float32(2.0 * np.pi)
+    dh = np.divide(a2, c2, out=c2)                  # D/2
+    # height-correlated Smith: G2/(4 cos θo cos θi) = 1/(2 (vo cos θi + vi cos θo))
+    vi = ci * ci
+    vi *= 1.0 - a2
+    vi += a2
+    np.sqrt(vi, out=vi)
+    vi *= co
+    vo_ci = v.vo * ci
+    vi += vo_ci
+    np.maximum(vi, np.float32(1e-12), out=vi)
+    s = np.divide(dh, vi, out=vi)                   # D G2 / (4 cos θo cos θi)
     if v.spec_n is not None:
         s *= valid_s
     f = v.spec_a * s
     f += kd
+    odh = np.sqrt(t)
+    odh *= 0.5
+    np.minimum(odh, 1.0, out=odh)                   # ωo·h
     if v.spec_b is not None or v.spec_d is not None:
         c = 1.0 - odh
-        np.clip(c, 0.0, 1.0, out=c)
         c5 = c * c
         c5 *= c5
         c5 *= c
         c5 *= s
         if v.spec_b is not None:
-            f += c5 * v.spec_b
+            f += np.multiply(c5, v.spec_b, out=np.empty_like(f))
         if v.spec_d is not None:
             c5 *= odh * c
             f -= c5 * v.spec_d
@@ -463,11 +501,15 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         fr *= s
         f += fr * v.spec_c
     f *= valid
-    pdf_s = d * cos_h / (4.0 * odh)
+    q /= t
+    q *= dh                                         # the specular pdf D cos θh/(4 ωo·h)
     if v.spec_n is not None:
         ci = wi[2]
-        pdf_s *= valid_s
-    pdf = (1 - v.p_spec) * np.maximum(ci, 0) * INV_PI + v.p_spec * pdf_s
+        q *= valid_s
+    pdf = np.maximum(ci, np.float32(0.0))
+    pdf *= (1.0 - v.p_spec) * INV_PI
+    q *= v.p_spec
+    pdf += q
     pdf *= valid
     return f.astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
 
@@ -491,7 +533,7 @@ def diffuse_f(v: ViewTerms, wi: np.ndarray, rows=None) -> np.ndarray:
     co = v.co if rows is None else v.co[rows]
     valid = ((wi[2] > 0) & (co > 0)).astype(np.float32)
     if v.bump_n is not None:
-        sub = v if rows is None else ViewTerms(None, None, None, None, None, None, None, None, None, None, None, None,
+        sub = v if rows is None else ViewTerms(None, None, None, None, None, None, None, None, None, None, None,
                                                bump_n=np.take(v.bump_n, rows, axis=1), bump_a2=v.bump_a2[rows])
         ok, g = bump_factor(sub, wi)
         valid *= ok * g
