@@ -3,7 +3,8 @@ materials only) and the many_lights street, and the share of the CPU time spent 
 
 Runs the same frames as scripts/benchmark_stages.py (640x360, 1 sample per frame, steady frames of a sequence,
 fastest kept). The material share is measured with per-thread CPU clocks (time.thread_time) around the material
-code — building per-hit parameters (SurfaceParams.take/of_table, Mix picks), the view terms (ViewTerms.of),
+code — building per-hit parameters (SurfaceParams.take/of_table/gather and the row gathers on first use, Mix
+picks), the view terms (ViewTerms.of), the diffuse part and the denoising albedo,
 evaluating and sampling the BSDF (eval_view, sample_bsdf) and the exact-Fresnel part of the ReSTIR target — as a
 fraction of the process CPU time of the frame. Run it from another checkout to measure a "before" (what exists
 of those functions there is wrapped); ``--frames-only`` skips the clocks (their overhead is ~1 %).
@@ -70,6 +71,11 @@ def instrument() -> None:
     from restir_engine.core.restir import di, gi
     sp = bsdf.SurfaceParams
     sp.take = _timed(sp.take)
+    for name in ("gather", "grey", "__getattr__"):  # row gathers done on first use (newer checkouts)
+        if hasattr(sp, name):
+            setattr(sp, name, _timed(getattr(sp, name)))
+    if isinstance(getattr(sp, "block", None), property):
+        sp.block = property(_timed(sp.block.fget))
     for name in ("of_table", "from_material"):
         if hasattr(sp, name):
             setattr(sp, name, staticmethod(_timed(getattr(sp, name))))
@@ -78,7 +84,9 @@ def instrument() -> None:
         for name in ("eval_view", "sample_bsdf"):
             if hasattr(mod, name):
                 setattr(mod, name, _timed(getattr(mod, name)))
-    for mod, name in ((surface, "pick_components"), (target, "fresnel_exact")):
+    from restir_engine.core import renderer
+    for mod, name in ((surface, "pick_components"), (target, "fresnel_exact"), (renderer, "denoising_albedo"),
+                      (pathtracer, "diffuse_f"), (gi, "diffuse_f")):
         if hasattr(mod, name):
             setattr(mod, name, _timed(getattr(mod, name)))
 

@@ -225,3 +225,44 @@ def test_lobe_flags_only_skip_work():
     np.testing.assert_allclose(pdf_fast, pdf_gen, rtol=2e-6, atol=1e-7)
     p.assign(np.arange(3), tinted.take(np.zeros(3, np.intp)))
     assert p.lobes == {"metal", "diel", "coloured_layer", "rough_diffuse"}
+
+
+def test_rows_gathered_on_first_use_equal_the_block():
+    """SurfaceParams.gather (a material table's per-hit view) gathers each row when first read and composes indices
+    on take; every row, grey channel and the BSDF evaluated from it equal the eagerly gathered block. Few metals
+    among grey dielectrics are evaluated on their own columns (ViewTerms.metal_rows), here with an F82 tint too:
+    f and pdf equal the general path's, and spec_full() the general spec_a/spec_b."""
+    rng = np.random.default_rng(5)
+    m = 4
+    table = SurfaceParams.from_material(rng.uniform(0.1, 0.9, (m, 3)), np.array([0, 1.0, 0, 0.6]),
+                                        np.array([0.3, 0.4, 0.8, 0.5]), np.full(m, 0.04),
+                                        spec_tint=[[1, 1, 1], [1.0, 0.6, 0.3], [1, 1, 1], [1, 1, 1]])
+    assert table.lobes == {"metal", "diel", "tint"}
+    n = 5000
+    mat = rng.choice(m, n, p=[0.5, 0.1, 0.3, 0.1])
+    lazy, eager = table.gather(mat), table.take(mat)
+    assert len(lazy) == n and lazy.lobes == table.lobes
+    for name in bsdf.PARAM_ROWS:
+        np.testing.assert_array_equal(getattr(lazy, name), getattr(eager, name))
+    np.testing.assert_array_equal(lazy.grey("fd"), eager.fd[0])
+    sub = np.arange(0, n, 7)
+    np.testing.assert_array_equal(lazy.take(sub).block, eager.block[:, sub])
+    np.testing.assert_array_equal(table.gather(mat).block, eager.block)
+    wo = rng.normal(size=(3, n)).astype(np.float32)
+    wo[2] = np.abs(wo[2]) + 0.05
+    wo /= np.linalg.norm(wo, axis=0)
+    wi = rng.normal(size=(3, n)).astype(np.float32)
+    wi[2] = np.abs(wi[2])
+    wi /= np.linalg.norm(wi, axis=0)
+    v = bsdf.ViewTerms.of(table.gather(mat), wo)
+    assert v.metal_rows is not None and v.metal_d is not None  # the metal-columns path ran
+    general = SurfaceParams(eager.block, frozenset({"metal", "diel", "tint", "coloured_layer"}))
+    vg = bsdf.ViewTerms.of(general, wo)
+    assert vg.metal_rows is None
+    f, pdf = bsdf.eval_view(v, wo, wi)
+    f_g, pdf_g = bsdf.eval_view(vg, wo, wi)
+    np.testing.assert_allclose(pdf, pdf_g, rtol=2e-6, atol=1e-7)
+    np.testing.assert_allclose(f, f_g, rtol=1e-5, atol=1e-6)
+    a, b = v.spec_full()
+    np.testing.assert_allclose(a, vg.spec_a, rtol=1e-6, atol=1e-7)
+    np.testing.assert_allclose(b, vg.spec_b, rtol=1e-6, atol=1e-7)

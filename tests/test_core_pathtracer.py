@@ -258,7 +258,7 @@ def test_per_hit_shading_stays_float32():
     assert surf.params.block.dtype == np.float32
     view = surf.view
     for name, value in vars(view).items():
-        if isinstance(value, np.ndarray):
+        if isinstance(value, np.ndarray) and name != "metal_rows":  # (metal_rows: surface indices)
             assert value.dtype == np.float32, name
     u = rng(1, 0, 0, 0).random((3, len(surf)), dtype=np.float32)
     wi, f, pdf = bsdf.sample_bsdf(surf.params, surf.wo_l, u[0], u[1], u[2], view=view)

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import microfacet_tables as tables
-from .microfacet_tables import ALPHA_MIN, smith_lambda
+from .microfacet_tables import ALPHA_MIN
 from .sampling import cosine_hemisphere, dot, orthonormal_basis
 
 INV_PI = np.float32(1.0 / np.pi)
@@ -89,10 +89,11 @@ class SurfaceParams:
       on_a, on_b, on_ems (3)  the diffuse lobe's energy-preserving Oren–Nayar (Cycles 4.3+; Lambert: 1/π, 0, 0):
                      f_d = diffuse · layer · (a + b t + Ems (1 - E(cos θo)) (1 - E(cos θi))), see :func:`oren_nayar_E`."""
 
-    __slots__ = ("block", "lobes")
+    __slots__ = ("_block", "lobes", "_table", "_idx", "_rows")
 
     def __init__(self, block: np.ndarray, lobes: frozenset | None = None):
-        self.block = block
+        self._block = block
+        self._table = self._idx = self._rows = None
         # the optional lobes some entry may have: "metal", "diel", "tint" (a metal's F82 tint), "rough_diffuse"
         # (Oren–Nayar), "coloured_layer" (a dielectric f0t or msd that is not grey). A superset, kept through
         # take/assign, so per-hit blocks skip what no material has without scanning their rows
@@ -101,34 +102,77 @@ class SurfaceParams:
     def _scan(self) -> frozenset:
         b = self.block
         f0t, msd = b[PARAM_ROWS["diel_f0"]], b[PARAM_ROWS["msd"]]
-        coloured = (f0t != f0t[0]) | (msd != msd[0])
+        # (a pure metal's tinted f0t is weighed by nothing: its dielectric lobe and diffuse weight are 0)
+        coloured = ((f0t != f0t[0]) | (msd != msd[0])) & (b[PARAM_ROWS["diel"]] > 0)
         found = (("metal", b[PARAM_ROWS["metal"]]), ("diel", b[PARAM_ROWS["diel"]]), ("tint", b[PARAM_ROWS["d_m"]]),
                  ("rough_diffuse", b[PARAM_ROWS["on_b"]]), ("coloured_layer", coloured))
         return frozenset(name for name, rows in found if rows.any())
+
+    def gather(self, idx: np.ndarray) -> "SurfaceParams":
+        """Parameters of entries ``idx`` (an index array into this table), each named row gathered on first use:
+        a chunk of hits reads only the rows of the lobes it has (and one channel of a grey row, :meth:`grey`)."""
+        out = SurfaceParams.__new__(SurfaceParams)
+        out._block = None
+        out._table, out._idx, out._rows = self.block, idx, {}
+        out.lobes = self.lobes
+        return out
+
+    @property
+    def block(self) -> np.ndarray:
+        """All rows (PARAM_WIDTH, n) (gathered now if they were not)."""
+        if self._block is None:
+            self._block = np.take(self._table, self._idx, axis=1, mode="wrap")
+            self._table = self._idx = self._rows = None
+        return self._block
 
     def has(self, lobe: str) -> bool:
         """Whether some entry may have ``lobe`` (False: none has it)."""
         return lobe in self.lobes
 
     def __getattr__(self, name):
-        try:
-            return object.__getattribute__(self, "block")[PARAM_ROWS[name]]
-        except KeyError:
-            raise AttributeError(name) from None
+        rows = PARAM_ROWS.get(name)
+        if rows is None:
+            raise AttributeError(name)
+        if self._block is not None:
+            return self._block[rows]
+        got = self._rows.get(name)
+        if got is None:  # mode "wrap" skips the bounds check (the indices are in range by construction)
+            got = self._rows[name] = np.take(self._table[rows], self._idx, axis=-1, mode="wrap")
+        return got
+
+    def grey(self, name: str) -> np.ndarray:
+        """The first channel (n,) of RGB row ``name`` (all of it where the row is grey)."""
+        rows = PARAM_ROWS[name]
+        if self._block is not None:
+            return self._block[rows.start]
+        got = self._rows.get(name)
+        if got is not None:
+            return got[0]
+        key = name + "/0"
+        got = self._rows.get(key)
+        if got is None:
+            got = self._rows[key] = np.take(self._table[rows.start], self._idx, mode="wrap")
+        return got
 
     def __len__(self) -> int:
-        return self.block.shape[1]
+        return self._block.shape[1] if self._block is not None else len(self._idx)
 
     def take(self, idx) -> "SurfaceParams":
         """Parameters of entries ``idx`` (index array or slice)."""
+        if self._block is None:  # still a view of the table: compose the indices
+            out = SurfaceParams.__new__(SurfaceParams)
+            out._block = None
+            out._table, out._idx, out._rows = self._table, self._idx[idx], {}
+            out.lobes = self.lobes
+            return out
         if isinstance(idx, slice):
-            return SurfaceParams(self.block[:, idx], self.lobes)
-        # mode "wrap" skips the bounds check: 30-40 % faster for the per-hit gather from the material table (the
-        # indices are material or hit indices, in range by construction); the result is C-ordered, rows contiguous
-        return SurfaceParams(np.take(self.block, idx, axis=1, mode="wrap"), self.lobes)
+            return SurfaceParams(self._block[:, idx], self.lobes)
+        # mode "wrap" skips the bounds check: 30-40 % faster (the indices are in range by construction); the
+        # result is C-ordered, rows contiguous
+        return SurfaceParams(np.take(self._block, idx, axis=1, mode="wrap"), self.lobes)
 
     def assign(self, idx, other: "SurfaceParams") -> None:
-        """self[idx] = other (every row)."""
+        """self[idx] = other (every row; gathers all rows of both)."""
         self.block[:, idx] = other.block
         self.lobes = self.lobes | other.lobes
 
@@ -260,6 +304,25 @@ class ViewTerms:
     on_ms: np.ndarray | None = None
     spec_n: np.ndarray | None = None   # (3, n) the specular lobes' normal in the local frame (surface.py), or None
     co_s: np.ndarray | None = None     # (n,) cos θo about spec_n
+    # metals on their own columns (a chunk whose other lobes are grey and where at most half the surfaces are
+    # metal): spec_a and spec_b hold no metal part; metal_a, metal_b, metal_d (3, k) are the metal lobe's
+    # spec_a, spec_b, spec_d terms of surfaces metal_rows (k,)
+    metal_rows: np.ndarray | None = None
+    metal_a: np.ndarray | None = None
+    metal_b: np.ndarray | None = None
+    metal_d: np.ndarray | None = None
+
+    def spec_full(self):
+        """spec_a ((3, n) or grey (n,)) and spec_b ((3, n) or None) of every surface, metal columns included."""
+        if self.metal_rows is None:
+            return self.spec_a, self.spec_b
+        r, n = self.metal_rows, len(self.co)
+        a = np.empty((3, n), np.float32)
+        a[:] = self.spec_a
+        a[:, r] += self.metal_a
+        b = np.zeros((3, n), np.float32)
+        b[:, r] = self.metal_b
+        return a, b
 
     @property
     def lam_o(self) -> np.ndarray:
@@ -286,7 +349,8 @@ class ViewTerms:
         vo = smith_view(alpha2, co)
         kd = p.diffuse * INV_PI
         # per block: a chunk may hold none of a lobe the scene has (a flag absent skips the scan)
-        has_metal = p.has("metal") and bool(p.metal.any())
+        is_metal = p.metal > 0 if p.has("metal") else None
+        has_metal = is_metal is not None and bool(is_metal.any())
         has_diel = p.has("diel") and bool(p.diel.any())
         if not (has_metal or has_diel):
             return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha2, vo, co, p.p_spec,
@@ -295,27 +359,32 @@ class ViewTerms:
         one_e = 1.0 - e
         miss = one_e / e
         spec_a = spec_b = spec_c = spec_d = eta2m1 = None
+        mrows = metal = None
         if has_metal:
-            cm = p.fm * miss
+            if not p.has("coloured_layer"):  # the other lobes grey: metals on their own columns when few
+                mrows = np.flatnonzero(is_metal)
+                if 2 * mrows.size > len(co):
+                    mrows = None
+            pm, mm = (p, miss) if mrows is None else (p.take(mrows), miss[mrows])
+            cm = pm.fm * mm
             cm += 1.0
-            spec_a = cm * p.a_m
-            spec_b = cm * p.b_m
-            if p.has("tint") and p.d_m.any():
-                spec_d = cm * p.d_m
+            metal = [cm * pm.a_m, cm * pm.b_m, None]
+            if p.has("tint") and pm.d_m.any():
+                metal[2] = cm * pm.d_m
+            if mrows is None:
+                spec_a, spec_b, spec_d = metal
         if has_diel:
-            cd = p.fd * miss
+            # without a tinted dielectric its rows are grey: one channel serves (spec_c (n,), and spec_a too
+            # where no metal adds to it)
+            row = p.grey if not p.has("coloured_layer") else p.__getattr__
+            cd = row("fd") * miss
             cd += 1.0
-            spec_c = cd * p.c_d
-            if spec_a is None:
-                spec_a = cd * p.a_d
-            else:
-                cd *= p.a_d
-                spec_a += cd
+            spec_c = cd * row("c_d")
+            cd *= row("a_d")
+            spec_a = cd if spec_a is None else np.add(spec_a, cd, out=spec_a)
             eta2m1 = p.eta2m1
             s = view_layer(p, wo) if layer is None else layer
-            f0t, msd = p.diel_f0, p.msd
-            if not p.has("coloured_layer"):             # f0t and msd grey: one channel serves
-                f0t, msd = f0t[0], msd[0]
+            f0t, msd = row("diel_f0"), row("msd")
             la = f0t * (1.0 - s)                        # mix(f0t, 1, S)
             la += s
             dark = one_e * msd
@@ -325,8 +394,14 @@ class ViewTerms:
             np.subtract(1.0, w, out=w)
             np.clip(w, 0.0, 1.0, out=w)                 # 1 where there is no dielectric layer (f0t = 0, S = 0)
             kd *= w
-        return ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha2, vo, co, p.p_spec, True,
-                         p.f0r if has_diel else None)._oren_nayar(p, co)
+        if mrows is not None and spec_a is None:
+            spec_a = np.zeros(len(co), np.float32)
+        v = ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha2, vo, co, p.p_spec, True,
+                      p.f0r if has_diel else None)
+        if mrows is not None:
+            v.metal_rows = mrows
+            v.metal_a, v.metal_b, v.metal_d = metal
+        return v._oren_nayar(p, co)
 
     def _oren_nayar(self, p: SurfaceParams, co: np.ndarray) -> "ViewTerms":
         """Attach the Oren–Nayar terms where some surface has a diffuse roughness: f_d = kd π (a + b t + ms (1 - E_i))
@@ -477,8 +552,7 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     s = np.divide(dh, vi, out=vi)                   # D G2 / (4 cos θo cos θi)
     if v.spec_n is not None:
         s *= valid_s
-    f = v.spec_a * s
-    f += kd
+    spec = v.spec_a * s                             # (n,) where every lobe is grey, else (3, n)
     odh = np.sqrt(t)
     odh *= 0.5
     np.minimum(odh, 1.0, out=odh)                   # ωo·h
@@ -489,18 +563,43 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         c5 *= c
         c5 *= s
         if v.spec_b is not None:
-            f += np.multiply(c5, v.spec_b, out=np.empty_like(f))
+            spec += np.multiply(c5, v.spec_b, out=np.empty_like(spec))
         if v.spec_d is not None:
             c5 *= odh * c
-            f -= c5 * v.spec_d
-            np.maximum(f, 0.0, out=f)                # the F82-tint clamp
+            spec -= c5 * v.spec_d
+            np.maximum(spec, 0.0, out=spec)          # the F82-tint clamp
     if v.spec_c is not None:
         fr = fresnel_exact(odh, v.eta2m1)
         fr -= v.f0r
         np.maximum(fr, 0.0, out=fr)
         fr *= s
-        f += fr * v.spec_c
-    f *= valid
+        fr = np.multiply(fr, v.spec_c, out=fr) if v.spec_c.ndim == 1 else fr * v.spec_c
+        spec = np.add(spec, fr, out=spec) if spec.ndim >= fr.ndim else spec + fr
+    if spec.ndim == 1:
+        spec *= valid
+        f = kd * valid
+        f += spec
+    else:
+        spec += kd
+        spec *= valid
+        f = spec
+    if v.metal_rows is not None:  # the metal lobe on its own columns
+        r = v.metal_rows
+        sk, ok = s[r], odh[r]
+        c = 1.0 - ok
+        c5 = c * c
+        c5 *= c5
+        c5 *= c
+        c5 *= sk
+        m = v.metal_a * sk
+        m += c5 * v.metal_b
+        if v.metal_d is not None:
+            c5 *= ok * c
+            m -= c5 * v.metal_d
+            np.maximum(m, 0.0, out=m)                # the F82-tint clamp
+        m *= valid[r]
+        n = f.shape[1]
+        np.add.at(f.reshape(-1), (r + np.arange(0, 3 * n, n)[:, None]).ravel(), m.ravel())  # f[:, r] += m
     q /= t
     q *= dh                                         # the specular pdf D cos θh/(4 ωo·h)
     if v.spec_n is not None:

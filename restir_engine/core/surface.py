@@ -75,7 +75,7 @@ class Surface:
         self.ns = ns * s_ns
         self.wo = -d
         self.bsdf_mat = mat  # the material whose BSDF the hit uses
-        self.params = ctx.material_params.take(mat)
+        self.params = ctx.material_params.gather(mat)
         if geom.uvs is not None:
             textured = np.flatnonzero(mats.base_tex[mat] >= 0)
             if textured.size:  # re-derive the parameters where a texture drives the base colour

@@ -68,11 +68,12 @@ class ShadingTerms:
         v = view_terms(surf)
         packed[LAYOUT["co"]] = v.co
         packed[LAYOUT["kd"]] = v.kd * LUM[:, None]
-        packed[LAYOUT["a"]] = v.spec_a * LUM[:, None]
-        if v.spec_b is None:
+        spec_a, spec_b = v.spec_full()
+        packed[LAYOUT["a"]] = spec_a * LUM[:, None]
+        if spec_b is None:
             packed[LAYOUT["b"]] = 0.0
         else:
-            packed[LAYOUT["b"]] = v.spec_b * LUM[:, None]
+            packed[LAYOUT["b"]] = spec_b * LUM[:, None]
         if v.spec_c is None:
             packed[LAYOUT["c"]] = 0.0
             packed[LAYOUT["eta2m1"]] = 0.0
