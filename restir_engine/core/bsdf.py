@@ -75,8 +75,9 @@ WEIGHT_ROWS = (slice(0, 12), slice(15, 21))
 
 
 class SurfaceParams:
-    """Per-hit (or per-material) BSDF parameters as one (37, n) float32 block of named rows (:data:`PARAM_ROWS`),
-    so a gather by material or by hit is one ``np.take``. The lobes' weights are folded into their Fresnel terms:
+    """Per-hit (or per-material) BSDF parameters as named rows (:data:`PARAM_ROWS`) of one (PARAM_WIDTH, n) float32
+    block: a material table, a per-hit block (one ``np.take``), or a table's per-hit view (:meth:`gather`) whose rows
+    are gathered when first read. The lobes' weights are folded into their Fresnel terms:
       diffuse (3) base (1 - metallic)
       a_m, b_m, d_m (3) metal: metallic · F0, metallic · (1 - F0) · f90, metallic · b  (F_m = F0 + (f90 - F0) c⁵
                      - b ωo·h c⁶ with c = 1 - ωo·h; f90 = 1 for Principled metals, F0 for the Glossy BSDF)
@@ -458,9 +459,10 @@ def fresnel_exact(c, eta2m1):
     it can."""
     g = c * c
     g += eta2m1
-    np.sqrt(g, out=g)                               # g ≥ c > 0
+    np.sqrt(g, out=g)
     gpc = g + c
     gmc = np.subtract(g, c, out=g)
+    np.maximum(gpc, np.float32(1e-12), out=gpc)     # c = 0 where glass sends its TIR rows here with η² - 1 = 0
     a = gmc / gpc
     b = c * gpc
     b -= 1.0
