@@ -4,7 +4,7 @@ materials only) and the many_lights street, and the share of the CPU time spent 
 Runs the same frames as scripts/benchmark_stages.py (640x360, 1 sample per frame, steady frames of a sequence,
 fastest kept). The material share is measured with per-thread CPU clocks (time.thread_time) around the material
 code — building per-hit parameters (SurfaceParams.take/of_table/gather and the row gathers on first use, Mix
-picks), the view terms (ViewTerms.of), the diffuse part and the denoising albedo,
+picks), the GGX albedo and layer lookups, the view terms (ViewTerms.of), the diffuse part and the denoising albedo,
 evaluating and sampling the BSDF (eval_view, sample_bsdf) and the exact-Fresnel part of the ReSTIR target — as a
 fraction of the process CPU time of the frame. Run it from another checkout to measure a "before" (what exists
 of those functions there is wrapped); ``--frames-only`` skips the clocks (their overhead is ~1 %).
@@ -76,6 +76,11 @@ def instrument() -> None:
             setattr(sp, name, _timed(getattr(sp, name)))
     if isinstance(getattr(sp, "block", None), property):
         sp.block = property(_timed(sp.block.fget))
+    # the GGX albedo and layer lookups per hit (Surface._table_at; older checkouts: rows_at in Surface.__init__)
+    if hasattr(surface.Surface, "_table_at"):
+        surface.Surface._table_at = _timed(surface.Surface._table_at)
+    elif hasattr(surface, "rows_at"):
+        surface.rows_at = _timed(surface.rows_at)
     for name in ("of_table", "from_material"):
         if hasattr(sp, name):
             setattr(sp, name, staticmethod(_timed(getattr(sp, name))))

@@ -297,6 +297,8 @@ class ViewTerms:
     co: np.ndarray
     p_spec: np.ndarray
     glossy: bool = True  # False: no surface has a specular lobe (Diffuse BSDFs only): Lambert alone
+    om_a2: np.ndarray | None = None    # (n,) 1 - α² (glossy)
+    pd: np.ndarray | None = None       # (n,) (1 - p_spec)/π: the diffuse sample's pdf over cos θi (glossy)
     f0r: np.ndarray | None = None  # (n,) untinted dielectric f0 (with spec_c)
     bump_n: np.ndarray | None = None   # (3, n) normal-mapped surfaces: the unmapped normal in the local frame
     bump_a2: np.ndarray | None = None  # (n,) and its bump-shadowing roughness (:func:`bump_factor`)
@@ -343,7 +345,8 @@ class ViewTerms:
     @staticmethod
     def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None,
            layer: np.ndarray | None = None) -> "ViewTerms":
-        """``albedo``, ``layer``: :func:`view_albedo`, :func:`view_layer` if known."""
+        """``albedo``, ``layer``: :func:`view_albedo`, :func:`view_layer` (n,) if known, or functions returning
+        them (called only where a lobe needs them: a chunk of Diffuse BSDFs looks up neither)."""
         co = wo[2]
         alpha = p.alpha
         alpha2 = alpha * alpha
@@ -356,7 +359,7 @@ class ViewTerms:
         if not (has_metal or has_diel):
             return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha2, vo, co, p.p_spec,
                              False)._oren_nayar(p, co)
-        e = view_albedo(p, wo) if albedo is None else albedo
+        e = view_albedo(p, wo) if albedo is None else albedo() if callable(albedo) else albedo
         one_e = 1.0 - e
         miss = one_e / e
         spec_a = spec_b = spec_c = spec_d = eta2m1 = None
@@ -384,7 +387,7 @@ class ViewTerms:
             cd *= row("a_d")
             spec_a = cd if spec_a is None else np.add(spec_a, cd, out=spec_a)
             eta2m1 = p.eta2m1
-            s = view_layer(p, wo) if layer is None else layer
+            s = view_layer(p, wo) if layer is None else layer() if callable(layer) else layer
             f0t, msd = row("diel_f0"), row("msd")
             la = f0t * (1.0 - s)                        # mix(f0t, 1, S)
             la += s
@@ -392,13 +395,16 @@ class ViewTerms:
             np.subtract(1.0, dark, out=dark)
             la *= dark                                  # the dielectric layer's albedo toward the viewer
             w = la.max(axis=0) if la.ndim == 2 else la
-            np.subtract(1.0, w, out=w)
-            np.clip(w, 0.0, 1.0, out=w)                 # 1 where there is no dielectric layer (f0t = 0, S = 0)
+            np.subtract(1.0, w, out=w)                  # ≤ 1: 1 where there is no dielectric layer (f0t = 0, S = 0)
+            np.maximum(w, 0.0, out=w)
             kd *= w
         if mrows is not None and spec_a is None:
             spec_a = np.zeros(len(co), np.float32)
-        v = ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha2, vo, co, p.p_spec, True,
-                      p.f0r if has_diel else None)
+        p_spec = p.p_spec
+        pd = 1.0 - p_spec
+        pd *= INV_PI
+        v = ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha2, vo, co, p_spec, True,
+                      1.0 - alpha2, pd, p.f0r if has_diel else None)
         if mrows is not None:
             v.metal_rows = mrows
             v.metal_a, v.metal_b, v.metal_d = metal
@@ -523,11 +529,12 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     if not v.glossy:
         pdf = np.maximum(ci, np.float32(0.0)) * INV_PI * valid
         return (kd * valid).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
+    valid = valid.astype(np.float32)                # (masks multiply as float32: a bool operand is cast per element)
     valid_s = valid
     if v.spec_n is not None:  # the specular lobes about their own normal
         co = v.co_s
         ci = dot(wi, v.spec_n)
-        valid_s = valid & (ci > 0)
+        valid_s = valid * (ci > 0)
     a2 = v.alpha2
     t = dot(wo, wi)
     t *= 2.0
@@ -537,14 +544,14 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     c2 = q * q
     c2 /= t
     np.minimum(c2, 1.0, out=c2)                     # cos² θh
-    c2 *= a2 - 1.0
-    c2 += 1.0
+    c2 *= v.om_a2
+    np.subtract(1.0, c2, out=c2)                    # 1 + cos² θh (α² - 1)
     c2 *= c2
     c2 *= np.float32(2.0 * np.pi)
     dh = np.divide(a2, c2, out=c2)                  # D/2
     # height-correlated Smith: G2/(4 cos θo cos θi) = 1/(2 (vo cos θi + vi cos θo))
     vi = ci * ci
-    vi *= 1.0 - a2
+    vi *= v.om_a2
     vi += a2
     np.sqrt(vi, out=vi)
     vi *= co
@@ -608,7 +615,7 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         ci = wi[2]
         q *= valid_s
     pdf = np.maximum(ci, np.float32(0.0))
-    pdf *= (1.0 - v.p_spec) * INV_PI
+    pdf *= v.pd
     q *= v.p_spec
     pdf += q
     pdf *= valid
@@ -675,8 +682,6 @@ def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.nda
             h = h[0] * t2 + h[1] * b2 + h[2] * sn
         o = np.take(wo, spec, axis=1)
         wi[:, spec] = 2.0 * dot(o, h) * h - o
+    # eval_view is 0 (f and pdf) below the surface, and its pdf positive wherever f may be
     f, pdf = eval_view(ViewTerms.of(p, wo) if view is None else view, wo, wi)
-    ok = (pdf > 0) & (wi[2] > 0)
-    f *= ok
-    pdf *= ok
     return wi, f, pdf

@@ -212,17 +212,33 @@ def layer_rows(alpha, f0) -> np.ndarray:
     return (lo * (1 - fi) + hi * fi).astype(np.float32)
 
 
-def rows_at(rows: np.ndarray, index: np.ndarray, mu: np.ndarray) -> np.ndarray:
-    """Linear interpolation in μ of row ``index`` (n,) of (m, N_MU) ``rows`` at ``mu`` (n,)."""
+def mu_index(index: np.ndarray, mu: np.ndarray):
+    """Where hits of rows ``index`` (n,) at ``mu`` (n,) fall in (m, N_MU) per-material rows: flat indices of the
+    lower neighbours (n,) and the fractions (n,) float32, for :func:`lerp_rows` (shared by every table)."""
     n = N_MU
-    y = np.clip((mu - np.float32(MUS[0])) * np.float32((n - 1) / (1.0 - MUS[0])), 0, n - 1)
-    y0 = np.minimum(y.astype(np.intp), n - 2)
+    y = mu - np.float32(MUS[0])
+    y *= np.float32((n - 1) / (1.0 - MUS[0]))
+    np.maximum(y, 0.0, out=y)
+    np.minimum(y, n - 1, out=y)
+    y0 = y.astype(np.intp)
+    np.minimum(y0, n - 2, out=y0)
     fy = y - y0.astype(np.float32)  # float32 (an integer array would promote it, and every term after, to float64)
-    k = index * n + y0
+    k = index * n
+    k += y0
+    return k, fy
+
+
+def lerp_rows(rows: np.ndarray, k: np.ndarray, fy: np.ndarray) -> np.ndarray:
+    """Linear interpolation in μ of (m, N_MU) ``rows`` at :func:`mu_index`'s ``k``, ``fy``."""
     flat = rows.reshape(-1)
-    lo = flat[k]
-    out = flat[k + 1]
+    lo = np.take(flat, k)
+    out = np.take(flat, k + 1)
     out -= lo
     out *= fy
     out += lo
     return out
+
+
+def rows_at(rows: np.ndarray, index: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """Linear interpolation in μ of row ``index`` (n,) of (m, N_MU) ``rows`` at ``mu`` (n,)."""
+    return lerp_rows(rows, *mu_index(index, mu))

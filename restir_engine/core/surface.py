@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from .bsdf import SurfaceParams, ViewTerms
-from .microfacet_tables import rows_at
+from .microfacet_tables import lerp_rows, mu_index
 from .glass import GLASS_SALT
 from .mix import hash_uniform, pick_components
 from .sampling import barycentric, cols, dot, norm, orthonormal_basis
@@ -151,20 +151,40 @@ class Surface:
                 self.spec_n[1, rows] = dot(n2, cols(self.bt, rows))
                 self.spec_n[2, rows] = dot(n2, cols(self.ns, rows))
                 mu = dot(wo_l, self.spec_n)
-        # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal), once
-        # per hit (α and η are constant per material: one interpolation in μo)
-        self.albedo = rows_at(ctx.material_albedo, mat, mu)
-        self.layer = rows_at(ctx.material_layer, mat, mu)
+        # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal): looked
+        # up once per hit when first used (α and η are constant per material: one interpolation in μo)
+        self._mu, self._tables = mu, (ctx.material_albedo, ctx.material_layer)
+        self._at = self._albedo = self._layer = None
 
     def __len__(self) -> int:
         return len(self.prim)
+
+    def _table_at(self, which: int) -> np.ndarray:
+        """Table ``which`` (0: GGX albedo E, 1: the layer's Fresnel factor S) at the hits' μo (n,)."""
+        if self._at is None:
+            self._at = mu_index(self.bsdf_mat, self._mu)
+        return lerp_rows(self._tables[which], *self._at)
+
+    @property
+    def albedo(self) -> np.ndarray:
+        """The specular lobes' GGX single-scattering albedo E(α, μo) (n,) (looked up on first use)."""
+        if self._albedo is None:
+            self._albedo = self._table_at(0)
+        return self._albedo
+
+    @property
+    def layer(self) -> np.ndarray:
+        """The dielectric layer's Fresnel interpolation factor S(α, μo, η) (n,) (looked up on first use)."""
+        if self._layer is None:
+            self._layer = self._table_at(1)
+        return self._layer
 
     @property
     def view(self) -> ViewTerms:
         """The BSDF's view-dependent factors (bsdf.ViewTerms), computed on first use."""
         v = getattr(self, "_view", None)
         if v is None:
-            v = self._view = ViewTerms.of(self.params, self.wo_l, self.albedo, self.layer)
+            v = self._view = ViewTerms.of(self.params, self.wo_l, lambda: self.albedo, lambda: self.layer)
             v.bump_n, v.bump_a2 = self.bump_n, self.bump_a2
             if self.spec_n is not None:
                 v.with_spec_normal(self.spec_n, self.wo_l)
@@ -173,8 +193,12 @@ class Surface:
     def take(self, idx) -> "Surface":
         """The surfaces ``idx`` (an index array or a slice) as a new Surface."""
         out = Surface.__new__(Surface)
-        for name in ("prim", "b1", "b2", "mat", "bsdf_mat", "albedo", "layer"):
+        for name in ("prim", "b1", "b2", "mat", "bsdf_mat", "_mu"):
             setattr(out, name, getattr(self, name)[idx])
+        out._tables = self._tables
+        out._at = None if self._at is None else (self._at[0][idx], self._at[1][idx])
+        out._albedo = None if self._albedo is None else self._albedo[idx]
+        out._layer = None if self._layer is None else self._layer[idx]
         for name in ("glass", "glass_front", "glass_ior", "glass_alpha", "glass_ms"):
             a = getattr(self, name)
             setattr(out, name, None if a is None else a[idx])
