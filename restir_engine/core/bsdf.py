@@ -94,11 +94,11 @@ class SurfaceParams:
       on_a, on_b, on_ems (3)  the diffuse lobe's energy-preserving Oren–Nayar (Cycles 4.3+; Lambert: 1/π, 0, 0):
                      f_d = diffuse · layer · (a + b t + Ems (1 - E(cos θo)) (1 - E(cos θi))), see :func:`oren_nayar_E`."""
 
-    __slots__ = ("_block", "lobes", "_table", "_idx", "_rows", "_fresnel")
+    __slots__ = ("_block", "lobes", "_table", "_idx", "_rows", "_fresnel", "_mu_rows")
 
     def __init__(self, block: np.ndarray, lobes: frozenset | None = None):
         self._block = block
-        self._table = self._idx = self._rows = self._fresnel = None
+        self._table = self._idx = self._rows = self._fresnel = self._mu_rows = None
         # the optional lobes some entry may have: "metal", "diel", "tint" (a metal's F82 tint), "rough_diffuse"
         # (Oren–Nayar), "coloured_layer" (a dielectric f0t or msd that is not grey). A superset, kept through
         # take/assign, so per-hit blocks skip what no material has without scanning their rows
@@ -121,7 +121,37 @@ class SurfaceParams:
         out._table, out._idx, out._rows = self.block, idx, {}
         out.lobes = self.lobes
         out._fresnel = self.fresnel_rows() if self.has("diel") else None
+        out._mu_rows = self.mu_rows() if self.has("diel") and not self.has("coloured_layer") else None
         return out
+
+    def mu_rows(self) -> dict:
+        """This table's view terms as functions of μo, per entry (m, N_MU) at the GGX tables' μ nodes, for a grey
+        dielectric layer (Specular Tint white): "E" the GGX albedo, "W" the diffuse lobe's layering weight
+        max(1 - mix(f0t, 1, S)(1 - (1 - E) msd), 0), "A" and "C" the dielectric's spec_a and spec_c
+        (a_d, c_d times 1 + fd (1 - E)/E); each as (values, steps to the next node), flat float32 (computed
+        once; :func:`lerp_at` reads them at a hit's μo)."""
+        if self._mu_rows is None:
+            e = tables.albedo_rows(self.alpha).astype(np.float64)
+            s = tables.layer_rows(self.alpha, self.f0r).astype(np.float64)
+            b = self.block.astype(np.float64)
+
+            def grey(name):
+                return b[PARAM_ROWS[name].start][:, None]
+            cd = grey("fd") * ((1.0 - e) / e) + 1.0
+            la = (grey("diel_f0") * (1.0 - s) + s) * (1.0 - (1.0 - e) * grey("msd"))
+
+            def flat(x):
+                x = x.astype(np.float32)
+                step = np.zeros_like(x)
+                step[:, :-1] = np.diff(x, axis=1)
+                return x.ravel(), step.ravel()
+            self._mu_rows = {"E": flat(e), "W": flat(np.maximum(1.0 - la, 0.0)), "A": flat(cd * grey("a_d")),
+                             "C": flat(cd * grey("c_d"))}
+        return self._mu_rows
+
+    def view_mu_rows(self) -> dict | None:
+        """For a table's per-hit view without a coloured dielectric layer: the table's :meth:`mu_rows` (else None)."""
+        return self._mu_rows if self._block is None else None
 
     def fresnel_rows(self):
         """This table's dielectric Fresnel per entry as two flat (m FRESNEL_N,) float32 arrays: max(F(c) - f0r, 0)
@@ -148,7 +178,7 @@ class SurfaceParams:
         """All rows (PARAM_WIDTH, n) (gathered now if they were not)."""
         if self._block is None:
             self._block = np.take(self._table, self._idx, axis=1, mode="wrap")
-            self._table = self._idx = self._rows = self._fresnel = None
+            self._table = self._idx = self._rows = self._fresnel = self._mu_rows = None
         return self._block
 
     def has(self, lobe: str) -> bool:
@@ -189,6 +219,7 @@ class SurfaceParams:
             out = SurfaceParams.__new__(SurfaceParams)
             out._block = None
             out._table, out._idx, out._rows, out._fresnel = self._table, self._idx[idx], {}, self._fresnel
+            out._mu_rows = self._mu_rows
             out.lobes = self.lobes
             return out
         if isinstance(idx, slice):
@@ -370,9 +401,11 @@ class ViewTerms:
 
     @staticmethod
     def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None,
-           layer: np.ndarray | None = None) -> "ViewTerms":
+           layer: np.ndarray | None = None, mu_at=None) -> "ViewTerms":
         """``albedo``, ``layer``: :func:`view_albedo`, :func:`view_layer` (n,) if known, or functions returning
-        them (called only where a lobe needs them: a chunk of Diffuse BSDFs looks up neither)."""
+        them (called only where a lobe needs them: a chunk of Diffuse BSDFs looks up neither). ``mu_at``: where
+        the surfaces' μo falls in per-material μ rows (:func:`microfacet_tables.mu_index`), with which a table's
+        per-hit view under a grey dielectric layer reads its view terms from :meth:`SurfaceParams.mu_rows`."""
         co = wo[2]
         alpha = p.alpha
         alpha2 = alpha * alpha
@@ -385,17 +418,27 @@ class ViewTerms:
         if not (has_metal or has_diel):
             return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha2, vo, co, p.p_spec,
                              False)._oren_nayar(p, co)
-        e = view_albedo(p, wo) if albedo is None else albedo() if callable(albedo) else albedo
-        one_e = 1.0 - e
-        miss = one_e / e
-        spec_a = spec_b = spec_c = spec_d = eta2m1 = None
+        fast = p.view_mu_rows() if mu_at is not None else None
+        one_e = miss = None
+        if fast is None:
+            e = view_albedo(p, wo) if albedo is None else albedo() if callable(albedo) else albedo
+            one_e = 1.0 - e
+            miss = one_e / e
+        spec_a = spec_b = spec_c = spec_d = eta2m1 = f0r = None
         mrows = metal = None
         if has_metal:
             if not p.has("coloured_layer"):  # the other lobes grey: metals on their own columns when few
                 mrows = np.flatnonzero(is_metal)
                 if 2 * mrows.size > len(co):
                     mrows = None
-            pm, mm = (p, miss) if mrows is None else (p.take(mrows), miss[mrows])
+            pm = p if mrows is None else p.take(mrows)
+            if fast is None:
+                mm = miss if mrows is None else miss[mrows]
+            else:
+                k, fy = mu_at if mrows is None else (mu_at[0][mrows], mu_at[1][mrows])
+                mm = lerp_at(fast["E"], k, fy)
+                np.divide(1.0, mm, out=mm)
+                mm -= 1.0                               # (1 - E)/E
             cm = pm.fm * mm
             cm += 1.0
             metal = [cm * pm.a_m, cm * pm.b_m, None]
@@ -403,7 +446,13 @@ class ViewTerms:
                 metal[2] = cm * pm.d_m
             if mrows is None:
                 spec_a, spec_b, spec_d = metal
-        if has_diel:
+        if has_diel and fast is not None:               # grey layer, a table's view: per-material rows in μo
+            k, fy = mu_at
+            kd *= lerp_at(fast["W"], k, fy)
+            cd = lerp_at(fast["A"], k, fy)
+            spec_a = cd if spec_a is None else np.add(spec_a, cd, out=spec_a)
+            spec_c = lerp_at(fast["C"], k, fy)
+        elif has_diel:
             # without a tinted dielectric its rows are grey: one channel serves (spec_c (n,), and spec_a too
             # where no metal adds to it)
             row = p.grey if not p.has("coloured_layer") else p.__getattr__
@@ -412,7 +461,7 @@ class ViewTerms:
             spec_c = cd * row("c_d")
             cd *= row("a_d")
             spec_a = cd if spec_a is None else np.add(spec_a, cd, out=spec_a)
-            eta2m1 = p.eta2m1
+            eta2m1, f0r = p.eta2m1, p.f0r
             s = view_layer(p, wo) if layer is None else layer() if callable(layer) else layer
             f0t, msd = row("diel_f0"), row("msd")
             la = f0t * (1.0 - s)                        # mix(f0t, 1, S)
@@ -430,9 +479,11 @@ class ViewTerms:
         pd = 1.0 - p_spec
         pd *= INV_PI
         v = ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha2, vo, co, p_spec, True,
-                      1.0 - alpha2, pd, p.f0r if has_diel else None)
+                      1.0 - alpha2, pd, f0r)
         if has_diel:
             v.fresnel = p.fresnel_index()
+            if v.fresnel is None and eta2m1 is None:  # (a table's view always has its Fresnel rows)
+                v.eta2m1, v.f0r = p.eta2m1, p.f0r
         if mrows is not None:
             v.metal_rows = mrows
             v.metal_a, v.metal_b, v.metal_d = metal
@@ -509,6 +560,14 @@ def fresnel_exact(c, eta2m1):
     a *= b
     a *= 0.5
     return a
+
+
+def lerp_at(rows, k: np.ndarray, fy: np.ndarray) -> np.ndarray:
+    """Per-material rows (values, steps) (:meth:`SurfaceParams.mu_rows`) at flat node ``k`` + fraction ``fy`` (n,)."""
+    out = np.take(rows[1], k, mode="wrap")
+    out *= fy
+    out += np.take(rows[0], k, mode="wrap")
+    return out
 
 
 def fresnel_lookup(rows, first: np.ndarray, c: np.ndarray) -> np.ndarray:

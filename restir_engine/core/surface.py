@@ -159,11 +159,16 @@ class Surface:
     def __len__(self) -> int:
         return len(self.prim)
 
-    def _table_at(self, which: int) -> np.ndarray:
-        """Table ``which`` (0: GGX albedo E, 1: the layer's Fresnel factor S) at the hits' μo (n,)."""
+    def _mu_at(self):
+        """Where the hits' μo (about the specular normal) falls in per-material μ rows: (flat node (n,), fraction
+        (n,)) (:func:`microfacet_tables.mu_index`, once)."""
         if self._at is None:
             self._at = mu_index(self.bsdf_mat, self._mu)
-        return lerp_rows(self._tables[which], *self._at)
+        return self._at
+
+    def _table_at(self, which: int) -> np.ndarray:
+        """Table ``which`` (0: GGX albedo E, 1: the layer's Fresnel factor S) at the hits' μo (n,)."""
+        return lerp_rows(self._tables[which], *self._mu_at())
 
     @property
     def albedo(self) -> np.ndarray:
@@ -184,7 +189,8 @@ class Surface:
         """The BSDF's view-dependent factors (bsdf.ViewTerms), computed on first use."""
         v = getattr(self, "_view", None)
         if v is None:
-            v = self._view = ViewTerms.of(self.params, self.wo_l, lambda: self.albedo, lambda: self.layer)
+            v = self._view = ViewTerms.of(self.params, self.wo_l, lambda: self.albedo, lambda: self.layer,
+                                          self._mu_at())
             v.bump_n, v.bump_a2 = self.bump_n, self.bump_a2
             if self.spec_n is not None:
                 v.with_spec_normal(self.spec_n, self.wo_l)
