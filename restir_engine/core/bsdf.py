@@ -70,10 +70,6 @@ PARAM_ROWS = {"diffuse": slice(0, 3), "a_m": slice(3, 6), "b_m": slice(6, 9), "d
               "msd": slice(24, 27), "diel_f0": slice(27, 30), "alpha": 30, "eta2m1": 31, "f0r": 32, "p_spec": 33,
               "spec_on": 34, "metal": 35, "diel": 36, "on_a": 37, "on_b": 38, "on_ems": slice(39, 42)}
 PARAM_WIDTH = 42
-#: Entries of the per-material dielectric Fresnel tables over cos θ in [0, 1] (:meth:`SurfaceParams.fresnel_rows`):
-#: linear interpolation of 512 entries is within 1e-4 of the exact Fresnel for η ≥ 1.05 (the largest error is in the
-#: first interval, at grazing angles, where F is about 1; tests/test_core_bsdf.py)
-FRESNEL_N = 512
 #: The rows that scale with a lobe's weight (Mix/Add components: core/mix.py)
 WEIGHT_ROWS = (slice(0, 12), slice(15, 21))
 
@@ -94,11 +90,11 @@ class SurfaceParams:
       on_a, on_b, on_ems (3)  the diffuse lobe's energy-preserving Oren–Nayar (Cycles 4.3+; Lambert: 1/π, 0, 0):
                      f_d = diffuse · layer · (a + b t + Ems (1 - E(cos θo)) (1 - E(cos θi))), see :func:`oren_nayar_E`."""
 
-    __slots__ = ("_block", "lobes", "_table", "_idx", "_rows", "_fresnel", "_mu_rows")
+    __slots__ = ("_block", "lobes", "_table", "_idx", "_rows", "_mu_rows")
 
     def __init__(self, block: np.ndarray, lobes: frozenset | None = None):
         self._block = block
-        self._table = self._idx = self._rows = self._fresnel = self._mu_rows = None
+        self._table = self._idx = self._rows = self._mu_rows = None
         # the optional lobes some entry may have: "metal", "diel", "tint" (a metal's F82 tint), "rough_diffuse"
         # (Oren–Nayar), "coloured_layer" (a dielectric f0t or msd that is not grey). A superset, kept through
         # take/assign, so per-hit blocks skip what no material has without scanning their rows
@@ -120,7 +116,6 @@ class SurfaceParams:
         out._block = None
         out._table, out._idx, out._rows = self.block, idx, {}
         out.lobes = self.lobes
-        out._fresnel = self.fresnel_rows() if self.has("diel") else None
         out._mu_rows = self.mu_rows() if self.has("diel") and not self.has("coloured_layer") else None
         return out
 
@@ -153,32 +148,12 @@ class SurfaceParams:
         """For a table's per-hit view without a coloured dielectric layer: the table's :meth:`mu_rows` (else None)."""
         return self._mu_rows if self._block is None else None
 
-    def fresnel_rows(self):
-        """This table's dielectric Fresnel per entry as two flat (m FRESNEL_N,) float32 arrays: max(F(c) - f0r, 0)
-        at c = j/(FRESNEL_N - 1) (F exact for the entry's η) and the step to entry j + 1 (computed once)."""
-        if self._fresnel is None:
-            m = len(self)
-            c = np.broadcast_to(np.linspace(0.0, 1.0, FRESNEL_N), (m, FRESNEL_N)).copy()
-            f = fresnel_exact(c, self.eta2m1.astype(np.float64)[:, None])
-            f = np.maximum(f - self.f0r.astype(np.float64)[:, None], 0.0)
-            step = np.zeros_like(f)
-            step[:, :-1] = np.diff(f, axis=1)
-            self._fresnel = (f.astype(np.float32).ravel(), step.astype(np.float32).ravel())
-        return self._fresnel
-
-    def fresnel_index(self):
-        """For a table's per-hit view: (the table's :meth:`fresnel_rows`, each hit's first entry in them (n,));
-        None for a block of its own (its rows may differ from the table's: :func:`fresnel_exact` serves)."""
-        if self._block is not None or self._fresnel is None:
-            return None
-        return self._fresnel, self._idx * FRESNEL_N
-
     @property
     def block(self) -> np.ndarray:
         """All rows (PARAM_WIDTH, n) (gathered now if they were not)."""
         if self._block is None:
             self._block = np.take(self._table, self._idx, axis=1, mode="wrap")
-            self._table = self._idx = self._rows = self._fresnel = self._mu_rows = None
+            self._table = self._idx = self._rows = self._mu_rows = None
         return self._block
 
     def has(self, lobe: str) -> bool:
@@ -218,8 +193,7 @@ class SurfaceParams:
         if self._block is None:  # still a view of the table: compose the indices
             out = SurfaceParams.__new__(SurfaceParams)
             out._block = None
-            out._table, out._idx, out._rows, out._fresnel = self._table, self._idx[idx], {}, self._fresnel
-            out._mu_rows = self._mu_rows
+            out._table, out._idx, out._rows, out._mu_rows = self._table, self._idx[idx], {}, self._mu_rows
             out.lobes = self.lobes
             return out
         if isinstance(idx, slice):
@@ -358,7 +332,6 @@ class ViewTerms:
     f0r: np.ndarray | None = None  # (n,) untinted dielectric f0 (with spec_c)
     bump_n: np.ndarray | None = None   # (3, n) normal-mapped surfaces: the unmapped normal in the local frame
     bump_a2: np.ndarray | None = None  # (n,) and its bump-shadowing roughness (:func:`bump_factor`)
-    fresnel: tuple | None = None       # (SurfaceParams.fresnel_rows, first entry per surface (n,)), or None: exact
     on_a: np.ndarray | None = None     # (n,) Oren–Nayar where some surface has a diffuse roughness (else None):
     on_b: np.ndarray | None = None     # a, b and the multiple-scattering colour Ems (1 - E(cos θo)) (3, n)
     on_ms: np.ndarray | None = None
@@ -424,7 +397,8 @@ class ViewTerms:
             e = view_albedo(p, wo) if albedo is None else albedo() if callable(albedo) else albedo
             one_e = 1.0 - e
             miss = one_e / e
-        spec_a = spec_b = spec_c = spec_d = eta2m1 = f0r = None
+        spec_a = spec_b = spec_c = spec_d = None
+        eta2m1, f0r = (p.eta2m1, p.f0r) if has_diel else (None, None)
         mrows = metal = None
         if has_metal:
             if not p.has("coloured_layer"):  # the other lobes grey: metals on their own columns when few
@@ -461,7 +435,6 @@ class ViewTerms:
             spec_c = cd * row("c_d")
             cd *= row("a_d")
             spec_a = cd if spec_a is None else np.add(spec_a, cd, out=spec_a)
-            eta2m1, f0r = p.eta2m1, p.f0r
             s = view_layer(p, wo) if layer is None else layer() if callable(layer) else layer
             f0t, msd = row("diel_f0"), row("msd")
             la = f0t * (1.0 - s)                        # mix(f0t, 1, S)
@@ -480,10 +453,6 @@ class ViewTerms:
         pd *= INV_PI
         v = ViewTerms(kd, spec_a, spec_b, spec_c, spec_d, eta2m1, alpha, alpha2, vo, co, p_spec, True,
                       1.0 - alpha2, pd, f0r)
-        if has_diel:
-            v.fresnel = p.fresnel_index()
-            if v.fresnel is None and eta2m1 is None:  # (a table's view always has its Fresnel rows)
-                v.eta2m1, v.f0r = p.eta2m1, p.f0r
         if mrows is not None:
             v.metal_rows = mrows
             v.metal_a, v.metal_b, v.metal_d = metal
@@ -567,20 +536,6 @@ def lerp_at(rows, k: np.ndarray, fy: np.ndarray) -> np.ndarray:
     out = np.take(rows[1], k, mode="wrap")
     out *= fy
     out += np.take(rows[0], k, mode="wrap")
-    return out
-
-
-def fresnel_lookup(rows, first: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """max(F(c) - f0r, 0) (n,) of each surface's material at cos θ = c (n,) in [0, 1], interpolated in its
-    :meth:`SurfaceParams.fresnel_rows` ``rows`` from entry ``first`` (n,)."""
-    y = c * np.float32(FRESNEL_N - 1)
-    i = y.astype(np.intp)
-    np.minimum(i, FRESNEL_N - 2, out=i)
-    y -= i.astype(np.float32)
-    i += first
-    out = np.take(rows[1], i, mode="wrap")
-    out *= y
-    out += np.take(rows[0], i, mode="wrap")
     return out
 
 
@@ -679,12 +634,9 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
             spec -= c5 * v.spec_d
             np.maximum(spec, 0.0, out=spec)          # the F82-tint clamp
     if v.spec_c is not None:
-        if v.fresnel is not None:
-            fr = fresnel_lookup(*v.fresnel, odh)
-        else:
-            fr = fresnel_exact(odh, v.eta2m1)
-            fr -= v.f0r
-            np.maximum(fr, 0.0, out=fr)
+        fr = fresnel_exact(odh, v.eta2m1)
+        fr -= v.f0r
+        np.maximum(fr, 0.0, out=fr)
         fr *= s
         fr = np.multiply(fr, v.spec_c, out=fr) if v.spec_c.ndim == 1 else fr * v.spec_c
         spec = np.add(spec, fr, out=spec) if spec.ndim >= fr.ndim else spec + fr

@@ -80,8 +80,8 @@ class ShadingTerms:
             packed[LAYOUT["f0r"]] = 0.0
         else:
             packed[LAYOUT["c"]] = v.spec_c * LUM[:, None]
-            packed[LAYOUT["eta2m1"]] = prm.eta2m1 if v.eta2m1 is None else v.eta2m1
-            packed[LAYOUT["f0r"]] = prm.f0r if v.f0r is None else v.f0r
+            packed[LAYOUT["eta2m1"]] = v.eta2m1
+            packed[LAYOUT["f0r"]] = v.f0r
         packed[LAYOUT["lam_o"]] = v.lam_o
         packed[LAYOUT["spec_on"]] = prm.spec_on
         packed[LAYOUT["p_spec"]] = prm.p_spec
