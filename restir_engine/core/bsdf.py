@@ -121,8 +121,8 @@ class SurfaceParams:
 
     def mu_rows(self) -> dict:
         """This table's view terms as functions of μo, per entry (m, N_MU) at the GGX tables' μ nodes, for a grey
-        dielectric layer (Specular Tint white): "E" the GGX albedo, "W" the diffuse lobe's layering weight
-        max(1 - mix(f0t, 1, S)(1 - (1 - E) msd), 0), "A" and "C" the dielectric's spec_a and spec_c
+        dielectric layer (Specular Tint white): "E" the GGX albedo, "W" the diffuse lobe's layering weight over π
+        max(1 - mix(f0t, 1, S)(1 - (1 - E) msd), 0)/π, "A" and "C" the dielectric's spec_a and spec_c
         (a_d, c_d times 1 + fd (1 - E)/E); each as (values, steps to the next node), flat float32 (computed
         once; :func:`lerp_at` reads them at a hit's μo)."""
         if self._mu_rows is None:
@@ -140,7 +140,7 @@ class SurfaceParams:
                 step = np.zeros_like(x)
                 step[:, :-1] = np.diff(x, axis=1)
                 return x.ravel(), step.ravel()
-            self._mu_rows = {"E": flat(e), "W": flat(np.maximum(1.0 - la, 0.0)), "A": flat(cd * grey("a_d")),
+            self._mu_rows = {"E": flat(e), "W": flat(np.maximum(1.0 - la, 0.0) / np.pi), "A": flat(cd * grey("a_d")),
                              "C": flat(cd * grey("c_d"))}
         return self._mu_rows
 
@@ -383,15 +383,16 @@ class ViewTerms:
         alpha = p.alpha
         alpha2 = alpha * alpha
         vo = smith_view(alpha2, co)
-        kd = p.diffuse * INV_PI
         # per block: a chunk may hold none of a lobe the scene has (a flag absent skips the scan)
         is_metal = p.metal > 0 if p.has("metal") else None
         has_metal = is_metal is not None and bool(is_metal.any())
         has_diel = p.has("diel") and bool(p.diel.any())
         if not (has_metal or has_diel):
+            kd = p.diffuse * INV_PI
             return ViewTerms(kd, np.zeros_like(kd), None, None, None, None, alpha, alpha2, vo, co, p.p_spec,
                              False)._oren_nayar(p, co)
-        fast = p.view_mu_rows() if mu_at is not None else None
+        fast = p.view_mu_rows() if mu_at is not None and has_diel else None
+        kd = p.diffuse * lerp_at(fast["W"], *mu_at) if fast is not None else p.diffuse * INV_PI
         one_e = miss = None
         if fast is None:
             e = view_albedo(p, wo) if albedo is None else albedo() if callable(albedo) else albedo
@@ -422,7 +423,6 @@ class ViewTerms:
                 spec_a, spec_b, spec_d = metal
         if has_diel and fast is not None:               # grey layer, a table's view: per-material rows in μo
             k, fy = mu_at
-            kd *= lerp_at(fast["W"], k, fy)
             cd = lerp_at(fast["A"], k, fy)
             spec_a = cd if spec_a is None else np.add(spec_a, cd, out=spec_a)
             spec_c = lerp_at(fast["C"], k, fy)
