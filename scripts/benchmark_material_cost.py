@@ -2,16 +2,17 @@
 materials only) and the many_lights street, and the share of the CPU time spent evaluating materials.
 
 Runs the same frames as scripts/benchmark_stages.py (640x360, 1 sample per frame, steady frames of a sequence,
-fastest kept). The material share is measured with per-thread CPU clocks (time.thread_time) around the material
+fastest kept; the material share of that frame and the median over the steady frames are reported). The
+material share is measured with per-thread CPU clocks (time.thread_time) around the material
 code — building per-hit parameters (SurfaceParams.take/of_table/gather and the row gathers on first use, Mix
 picks), the GGX albedo and layer lookups, the view terms (ViewTerms.of), the diffuse part and the denoising albedo,
 evaluating and sampling the BSDF (eval_view, sample_bsdf) and the exact-Fresnel part of the ReSTIR target — as a
 fraction of the process CPU time of the frame. Run it from another checkout to measure a "before" (what exists
 of those functions there is wrapped); ``--frames-only`` skips the clocks (their overhead is ~1 %).
 
-Writes docs/results/materials/cost.json (or cost_before.json with --label before) and, when both exist,
-cost.png. Usage:
-  python scripts/benchmark_material_cost.py [--frames 5] [--label after|before] [--frames-only] [--out DIR]
+Writes docs/results/materials/cost.json (cost_before.json / cost_start.json with --label before / start) and
+cost.png with every series that exists. Usage:
+  python scripts/benchmark_material_cost.py [--frames 5] [--label after|start|before] [--frames-only] [--out DIR]
 """
 from __future__ import annotations
 
@@ -107,30 +108,55 @@ def run(name, scene_name, kw, frames):
         wall, cpu = time.perf_counter() - t, time.process_time() - c0
         hist = r.history
         rows.append({"frame_s": wall, "cpu_s": cpu, "material_cpu_s": _spent[0]})
-    best = min(rows[1:] or rows, key=lambda r: r["frame_s"])
+    steady = rows[1:] or rows
+    best = min(steady, key=lambda r: r["frame_s"])
+    shares = sorted(r["material_cpu_s"] / max(r["cpu_s"], 1e-9) for r in steady)
     out = {"name": name, "frame_s": best["frame_s"], "frames_s": [r["frame_s"] for r in rows],
-           "material_share": best["material_cpu_s"] / max(best["cpu_s"], 1e-9)}
-    print(f"{name:<24} frame {out['frame_s']:6.3f}s  material share {100 * out['material_share']:4.1f}%", flush=True)
+           "material_share": best["material_cpu_s"] / max(best["cpu_s"], 1e-9),
+           "material_shares": [r["material_cpu_s"] / max(r["cpu_s"], 1e-9) for r in rows],
+           "material_share_median": shares[len(shares) // 2] if len(shares) % 2 else
+           0.5 * (shares[len(shares) // 2 - 1] + shares[len(shares) // 2])}
+    print(f"{name:<24} frame {out['frame_s']:6.3f}s  material share {100 * out['material_share']:4.1f}% "
+          f"(steady frames: median {100 * out['material_share_median']:4.1f}%, "
+          f"{100 * shares[0]:4.1f}-{100 * shares[-1]:4.1f}%)", flush=True)
     return out
 
 
-def chart(after, before, path):
+SERIES = (("before", "cost_before.json", "before (Lambert + GGX approximation)"),
+          ("start", "cost_start.json", "Principled as Cycles, per-hit gather (2026-11-26)"),
+          ("after", "cost.json", "Principled as Cycles, lobes as present (now)"))
+
+
+def chart(out_dir, path):
+    """Frame time per run of every series measured (bars), labelled with the material share (median of frames)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
-    names = [r["name"] for r in after["runs"]]
-    b = {r["name"]: r["frame_s"] for r in before["runs"]}
+    series = []
+    for _key, fname, label in SERIES:
+        f = os.path.join(out_dir, fname)
+        if os.path.exists(f):
+            with open(f) as fh:
+                series.append((label, json.load(fh)))
+    names = [r["name"] for r in series[-1][1]["runs"]]
     x = np.arange(len(names))
-    fig, ax = plt.subplots(figsize=(8, 3.6))
-    ax.bar(x - 0.2, [b.get(n, np.nan) for n in names], 0.4, label="before (Lambert + GGX approximation)")
-    ax.bar(x + 0.2, [r["frame_s"] for r in after["runs"]], 0.4, label="after (Principled as Cycles)")
-    for i, r in enumerate(after["runs"]):
-        ax.text(i + 0.2, r["frame_s"], f"{100 * r['material_share']:.0f}%", ha="center", va="bottom", fontsize=8)
+    width = 0.8 / len(series)
+    fig, ax = plt.subplots(figsize=(9, 3.8))
+    for j, (label, data) in enumerate(series):
+        runs = {r["name"]: r for r in data["runs"]}
+        xs = x - 0.4 + width * (j + 0.5)
+        ax.bar(xs, [runs[n]["frame_s"] if n in runs else np.nan for n in names], width, label=label)
+        for xi, n in zip(xs, names):
+            if n in runs:
+                r = runs[n]
+                share = r.get("material_share_median", r["material_share"])
+                ax.text(xi, r["frame_s"], f"{100 * share:.0f}%", ha="center", va="bottom", fontsize=7)
+    ax.axhline(0, color="k", lw=0.5)
     ax.set_xticks(x, names, fontsize=8)
     ax.set_ylabel("seconds per frame (640x360, 1 spp)")
-    ax.set_title("Frame time before/after; labels: CPU share of material evaluation")
-    ax.legend(fontsize=8)
+    ax.set_title("Frame time; labels: CPU share of material evaluation (target: at most 15 %)")
+    ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
@@ -138,7 +164,8 @@ def chart(after, before, path):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--frames", type=int, default=5)
-    ap.add_argument("--label", default="after", choices=("after", "before"))
+    ap.add_argument("--label", default="after", choices=[k for k, _f, _l in SERIES],
+                    help="which series this run is: after (this checkout), before / start (an older checkout)")
     ap.add_argument("--frames-only", action="store_true", help="frame times only, no material clocks")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "results", "materials"))
     args = ap.parse_args()
@@ -148,15 +175,10 @@ def main():
     runs = [run(n, s, kw, args.frames) for n, s, kw in RUNS]
     os.makedirs(args.out, exist_ok=True)
     data = {"label": args.label, "runs": runs, "cores": os.cpu_count(), "date": time.strftime("%Y-%m-%d")}
-    path = os.path.join(args.out, "cost.json" if args.label == "after" else "cost_before.json")
+    path = os.path.join(args.out, {k: f for k, f, _l in SERIES}[args.label])
     with open(path, "w") as f:
         json.dump(data, f, indent=1)
-    other = os.path.join(args.out, "cost_before.json" if args.label == "after" else "cost.json")
-    if os.path.exists(other):
-        with open(other) as f:
-            o = json.load(f)
-        chart(data if args.label == "after" else o, o if args.label == "after" else data,
-              os.path.join(args.out, "cost.png"))
+    chart(args.out, os.path.join(args.out, "cost.png"))
     print("wrote", path)
 
 
