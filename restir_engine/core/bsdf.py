@@ -636,17 +636,7 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     odh *= 0.5
     np.minimum(odh, 1.0, out=odh)                   # ωo·h
     if v.spec_b is not None or v.spec_d is not None:
-        c = 1.0 - odh
-        c5 = c * c
-        c5 *= c5
-        c5 *= c
-        c5 *= s
-        if v.spec_b is not None:
-            spec += np.multiply(c5, v.spec_b, out=np.empty_like(spec))
-        if v.spec_d is not None:
-            c5 *= odh * c
-            spec -= c5 * v.spec_d
-            np.maximum(spec, 0.0, out=spec)          # the F82-tint clamp
+        _add_metal_fresnel(spec, s, odh, v.spec_b, v.spec_d)
     if v.spec_c is not None:
         fr = fresnel_exact(odh, v.eta2m1)
         fr -= v.f0r
@@ -664,18 +654,9 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         f = spec
     if v.metal_rows is not None:  # the metal lobe on its own columns
         r = v.metal_rows
-        sk, ok = s[r], odh[r]
-        c = 1.0 - ok
-        c5 = c * c
-        c5 *= c5
-        c5 *= c
-        c5 *= sk
+        sk = s[r]
         m = v.metal_a * sk
-        m += c5 * v.metal_b
-        if v.metal_d is not None:
-            c5 *= ok * c
-            m -= c5 * v.metal_d
-            np.maximum(m, 0.0, out=m)                # the F82-tint clamp
+        _add_metal_fresnel(m, sk, odh[r], v.metal_b, v.metal_d)
         m *= valid[r]
         n = f.shape[1]
         np.add.at(f.reshape(-1), (r + np.arange(0, 3 * n, n)[:, None]).ravel(), m.ravel())  # f[:, r] += m
@@ -690,6 +671,22 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     pdf += q
     pdf *= valid
     return f.astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
+
+
+def _add_metal_fresnel(spec: np.ndarray, s: np.ndarray, odh: np.ndarray, b, d) -> None:
+    """spec (3, k) += s · (c⁵ b - ωo·h c⁶ d) in place, c = 1 - ωo·h (the angular part of the metal's F82-tint
+    Fresnel; b or d None: absent), clamped at 0 where d is given (the F82-tint clamp)."""
+    c = 1.0 - odh
+    c5 = c * c
+    c5 *= c5
+    c5 *= c
+    c5 *= s
+    if b is not None:
+        spec += c5 * b
+    if d is not None:
+        c5 *= odh * c
+        spec -= c5 * d
+        np.maximum(spec, 0.0, out=spec)
 
 
 def bump_factor(v: ViewTerms, wi: np.ndarray):

@@ -195,7 +195,7 @@ def _trilinear(t: np.ndarray, alpha, mu, z) -> np.ndarray:
 
 def albedo_rows(alpha) -> np.ndarray:
     """E interpolated at fixed α (m,) -> (m, N_MU) rows over μ (a material's α is constant, so a hit's E is one
-    linear interpolation in μ: :func:`rows_at`)."""
+    linear interpolation in μ: :func:`mu_index`, :func:`lerp_rows`)."""
     t = tables()["E"]
     i, fi = _axis(alpha, ALPHAS)
     return (t[i] * (1 - fi[:, None]) + t[i + 1] * fi[:, None]).astype(np.float32)
@@ -237,8 +237,3 @@ def lerp_rows(rows: np.ndarray, k: np.ndarray, fy: np.ndarray) -> np.ndarray:
     out *= fy
     out += lo
     return out
-
-
-def rows_at(rows: np.ndarray, index: np.ndarray, mu: np.ndarray) -> np.ndarray:
-    """Linear interpolation in μ of row ``index`` (n,) of (m, N_MU) ``rows`` at ``mu`` (n,)."""
-    return lerp_rows(rows, *mu_index(index, mu))
