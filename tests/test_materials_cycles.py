@@ -3,7 +3,8 @@
 Scenes (tests/bpy_scenes.py): a 6 x 4 grid of spheres (SPHERE_GRID: Principled dielectrics at roughness 0.1-1,
 IOR 1.2/1.5/2.0, Specular IOR Level 0/0.5/1, Specular Tint; metals at roughness 0.1-1 and a tinted metal; Glossy
 BSDFs; a Diffuse BSDF; a half-metal; a white and a black dielectric) lit by an area light or an emissive quad, and
-a floor of four materials seen at grazing angles by a low camera. Each side renders REPS independent seeds; per
+a floor of four materials seen at grazing angles by a low camera. Each side renders 16 independent seeds (Cycles'
+from the stored reference, tests/cycles_reference.py); per
 sphere (its pixels only) or per floor cell the means are compared with Welch z-scores, with the bound of
 tests/test_cycles_accuracy.py: |ours - Cycles| < 5 SE + 0.5 % of Cycles (two-sided p ≈ 2e-5 per cell at
 the SE bound; the margin is 4x tighter than the 2 % the materials issue asks for).
@@ -18,17 +19,16 @@ Before the Cycles layering (diffuse weighted by 1 - Schlick(f0, cos θ_view)) th
 """
 import numpy as np
 import pytest
-from bpy_scenes import (SPHERE_GRID, alpha_scene, configure_cycles, configure_restir, grazing_floor, material_spheres,
-                        render_passes)
+from bpy_scenes import SPHERE_GRID, alpha_scene, grazing_floor, material_spheres
+from cycles_compare import cycles_reference, ours_cells
+from stats import assert_cells_match, cell_means, image_cells
 
-REPS = 16
-Z_MAX = 5.0
-MARGIN = 0.005
 ROWS, COLS = len(SPHERE_GRID), len(SPHERE_GRID[0])
 SIZE = (144, 96)
 # (row, col) of the cells that isolate one lobe each (see the module docstring)
 LOBE_CELLS = {"diffuse": (3, 2), "layered diffuse": (3, 4), "dielectric specular": (3, 5), "metal 0.5": (1, 2),
               "metal 1.0": (1, 4), "glossy": (3, 1), "IOR 1.2": (2, 1), "IOR 2.0": (2, 3)}
+TRANSPARENT = 32  # Cycles' transparent bounces: cut-outs pass up to 32 transparent points in ours
 
 
 def sphere_masks(size=SIZE):
@@ -42,51 +42,15 @@ def sphere_masks(size=SIZE):
                      for i in range(rows) for j in range(COLS)])
 
 
-def cell_means(images, masks):
-    """(k, cells) means of the channel-averaged images (k, h, w, c) (row 0 at the bottom) over each mask."""
-    flat = images.mean(axis=3)[:, ::-1]
-    return np.stack([flat[:, m].mean(axis=1) for m in masks], axis=1)
+def by_masks(masks):
+    return lambda images: cell_means(images, masks)
 
 
-def render_reps(build, engine, bounces, samples, **settings):
-    scene = build()
-    out = []
-    for seed in range(REPS):
-        if engine == "RESTIR":
-            configure_restir(scene, samples, bounces, seed, **settings)
-        else:
-            configure_cycles(scene, samples, bounces, seed)
-            scene.cycles.transparent_max_bounces = 32  # cut-outs: ours pass up to 32 transparent points
-        out.append(render_passes(scene)["Combined"][..., :3])
-    return np.array(out)
-
-
-def agree(mean_ours, mean_ref, se):
-    return np.abs(mean_ours - mean_ref) <= Z_MAX * se + MARGIN * np.abs(mean_ref)
-
-
-def assert_cells_match(ours, ref, names, power=()):
-    """Every cell within the bound; every cell in ``power`` (indices) able to see a 3 % error."""
-    assert np.isfinite(ours).all()
-    ma, mb = ours.mean(axis=0), ref.mean(axis=0)
-    se = np.sqrt(ours.var(axis=0, ddof=1) / len(ours) + ref.var(axis=0, ddof=1) / len(ref))
-    ok = agree(ma, mb, se)
-    report = [f"{n}: ours/cycles {a / b:.4f} (rel SE {s / b:.4f})" for n, a, b, s in zip(names, ma, mb, se)]
-    assert ok.all(), "\n".join(r for r, good in zip(report, ok) if not good)
-    for i in power:
-        # the test's resolution at this cell, whatever side of Cycles its mean fell on: a 3 % error lies outside the
-        # bound (the bound of the means scaled by 1.03, at their expected difference). The spread per repetition is
-        # the robust one (1.4826 MAD): a rare firefly in one repetition (a caustic path through rough glass: a
-        # robust z of 18 in one of 48 repetitions x 16 cells, measured) inflates the sample variance, and with it
-        # the agreement bound above, without changing how finely the bulk of the estimator resolves the cell;
-        # for light-tailed cells the two spreads agree (within about 10 % on the rough-glass cells)
-        se3 = np.sqrt(1.03 ** 2 * robust_var(ours[:, i]) / len(ours) + robust_var(ref[:, i]) / len(ref))
-        assert 0.03 * abs(mb[i]) > Z_MAX * se3 + MARGIN * abs(mb[i]), f"cannot see a 3 % error in {report[i]}"
-
-
-def robust_var(x):
-    """The variance of normal data with the spread of ``x`` (1.4826 x its median absolute deviation, squared)."""
-    return (1.4826 * np.median(np.abs(x - np.median(x)))) ** 2
+def both(case, build, bounces, ours_samples, cycles_samples, reduce, **settings):
+    """((REPS, cells) ours, (REPS, cells) Cycles' stored reference ``case``) of ``build()``."""
+    ours = ours_cells(build, bounces, ours_samples, reduce, **settings)
+    ref = cycles_reference(case, build, bounces, cycles_samples, reduce, transparent_max_bounces=TRANSPARENT)
+    return ours, ref
 
 
 def grid_names():
@@ -98,19 +62,17 @@ POWER = [r * COLS + c for r, c in LOBE_CELLS.values()]
 
 @pytest.mark.parametrize("light,bounces", [("AREA", 0), ("QUAD", 0), ("AREA", 3)])
 def test_material_grid_path_tracer_matches_cycles(addon, light, bounces):
-    masks = sphere_masks()
-    ours = render_reps(lambda: material_spheres(light, SIZE), "RESTIR", bounces, 32, integrator="PATH")
-    ref = render_reps(lambda: material_spheres(light, SIZE), "CYCLES", bounces, 64)
-    assert_cells_match(cell_means(ours, masks), cell_means(ref, masks), grid_names(), POWER)
+    ours, ref = both(f"spheres_{light.lower()}_b{bounces}", lambda: material_spheres(light, SIZE), bounces, 32, 64,
+                     by_masks(sphere_masks()), integrator="PATH")
+    assert_cells_match(ours, ref, grid_names(), POWER)
 
 
 def test_material_grid_restir_di_matches_cycles(addon):
     """ReSTIR DI's target and shading use the same material model: unbiased mode converges to Cycles per sphere."""
-    masks = sphere_masks()
-    ours = render_reps(lambda: material_spheres("AREA", SIZE), "RESTIR", 0, 16, integrator="RESTIR",
-                       direct_method="RESTIR", bias_correction="UNBIASED", temporal_reuse=True, spatial_neighbors=5)
-    ref = render_reps(lambda: material_spheres("AREA", SIZE), "CYCLES", 0, 64)
-    assert_cells_match(cell_means(ours, masks), cell_means(ref, masks), grid_names(), POWER)
+    ours, ref = both("spheres_area_b0", lambda: material_spheres("AREA", SIZE), 0, 16, 64, by_masks(sphere_masks()),
+                     integrator="RESTIR", direct_method="RESTIR", bias_correction="UNBIASED", temporal_reuse=True,
+                     spatial_neighbors=5)
+    assert_cells_match(ours, ref, grid_names(), POWER)
 
 
 def test_grazing_floor_matches_cycles(addon):
@@ -118,9 +80,8 @@ def test_grazing_floor_matches_cycles(addon):
     cells before the fix): 4 x 4 image cells, the sky cells (black in Cycles) left out; the three rows of floor
     cells below the horizon row must each be able to see a 3 % error."""
     size = (96, 64)
-    ours = render_reps(lambda: grazing_floor(size), "RESTIR", 0, 64, integrator="PATH")
-    ref = render_reps(lambda: grazing_floor(size), "CYCLES", 0, 64)
-    a, b = cell_means(ours, image_cells(size)), cell_means(ref, image_cells(size))
+    a, b = both("grazing_floor", lambda: grazing_floor(size), 0, 64, 64, by_masks(image_cells(size)),
+                integrator="PATH")
     lit = np.flatnonzero(b.mean(axis=0) > 0.02)
     assert set(range(4, 16)) <= set(lit)
     assert_cells_match(a[:, lit], b[:, lit], [f"cell {k}" for k in lit],
@@ -134,36 +95,23 @@ def test_mix_and_add_shaders_match_cycles(addon):
     from bpy_scenes import MIX_GRID
     size = (144, 24)
     masks = sphere_masks(size)[:len(MIX_GRID[0])]
-    ours = render_reps(lambda: material_spheres("AREA", size, MIX_GRID), "RESTIR", 0, 64, integrator="PATH")
-    ref = render_reps(lambda: material_spheres("AREA", size, MIX_GRID), "CYCLES", 0, 256)
+    ours, ref = both("mix_add", lambda: material_spheres("AREA", size, MIX_GRID), 0, 64, 256, by_masks(masks),
+                     integrator="PATH")
     names = [str(spec[:2]) for spec in MIX_GRID[0]]
-    assert_cells_match(cell_means(ours, masks), cell_means(ref, masks), names, power=[1, 2, 3, 5])
+    assert_cells_match(ours, ref, names, power=[1, 2, 3, 5])
 
 
-def image_cells(size, n=4):
-    """(n*n, h, w) bool masks of an n x n grid of image cells, row 0 at the top."""
-    w, h = size
-    cells = np.zeros((n * n, h, w), bool)
-    for i in range(n):
-        for j in range(n):
-            cells[i * n + j, i * h // n:(i + 1) * h // n, j * w // n:(j + 1) * w // n] = True
-    return cells
-
-
-def path_vs_cycles_cells(build, bounces, size=(96, 64)):
+def path_vs_cycles_cells(case, build, bounces, size=(96, 64)):
     """Per-seed means of the 4 x 4 image cells of ``build(size)`` rendered by our path tracer (64 samples) and by
-    Cycles (128): ((REPS, 16), (REPS, 16))."""
-    cells = image_cells(size)
-    ours = render_reps(lambda: build(size), "RESTIR", bounces, 64, integrator="PATH")
-    ref = render_reps(lambda: build(size), "CYCLES", bounces, 128)
-    return cell_means(ours, cells), cell_means(ref, cells)
+    Cycles (128, the stored reference ``case``): ((REPS, 16), (REPS, 16))."""
+    return both(case, lambda: build(size), bounces, 64, 128, by_masks(image_cells(size)), integrator="PATH")
 
 
 def test_alpha_cutouts_match_cycles(addon):
     """Principled Alpha 0.4 and a Mix(Transparent, Diffuse) whose factor is a checker image (Closest
     interpolation), seen by the camera in front of a wall and casting shadows: camera, shadow and (with the wall
     behind) every ray passes the transparent points as Cycles' transparency does, per 4 x 4 image cell."""
-    assert_cells_match(*path_vs_cycles_cells(alpha_scene, 0), [f"cell {k}" for k in range(16)], power=range(16))
+    assert_cells_match(*path_vs_cycles_cells("alpha_cutouts", alpha_scene, 0), [f"cell {k}" for k in range(16)], power=range(16))
 
 
 @pytest.mark.parametrize("kind,bounces", [("IMAGE", 0), ("CONSTANT", 0), ("IMAGE", 3)])
@@ -174,7 +122,8 @@ def test_world_light_matches_cycles(addon, kind, bounces):
     where ours reads ~1.2 % low (z ≈ 3 in 24 seeds; Cycles bends a smooth normal at silhouettes where we bend the
     view vector, docs/CONVENTIONS.md), inside the bound but too close to it for that power."""
     from bpy_scenes import world_scene
-    cells = path_vs_cycles_cells(lambda size: world_scene(kind, size, rotation_z=0.8), bounces)
+    cells = path_vs_cycles_cells(f"world_{kind.lower()}_b{bounces}", lambda size: world_scene(kind, size, rotation_z=0.8),
+                                 bounces)
     assert_cells_match(*cells, [f"cell {k}" for k in range(16)], power=[4, 5, 6] + list(range(8, 16)))
 
 
@@ -184,12 +133,9 @@ def test_world_in_reservoirs_matches_cycles(addon):
     image cell against Cycles, the same cells able to see a 3 % error."""
     from bpy_scenes import world_scene
     size = (96, 64)
-    cells = image_cells(size)
-    ours = render_reps(lambda: world_scene("IMAGE", size, rotation_z=0.8), "RESTIR", 0, 32, direct_method="RESTIR",
-                       world_method="RESAMPLED")
-    ref = render_reps(lambda: world_scene("IMAGE", size, rotation_z=0.8), "CYCLES", 0, 128)
-    assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
-                       power=[4, 5, 6] + list(range(8, 16)))
+    ours, ref = both("world_image_b0", lambda: world_scene("IMAGE", size, rotation_z=0.8), 0, 32, 128,
+                     by_masks(image_cells(size)), direct_method="RESTIR", world_method="RESAMPLED")
+    assert_cells_match(ours, ref, [f"cell {k}" for k in range(16)], power=[4, 5, 6] + list(range(8, 16)))
 
 
 def test_normal_maps_match_cycles(addon):
@@ -200,7 +146,7 @@ def test_normal_maps_match_cycles(addon):
     read 2-9 % bright; on a normal-mapped sphere, which this test leaves out, one cell still reads 0.65 % high,
     docs/RESULTS.md.)"""
     from bpy_scenes import normal_map_scene
-    assert_cells_match(*path_vs_cycles_cells(normal_map_scene, 0), [f"cell {k}" for k in range(16)],
+    assert_cells_match(*path_vs_cycles_cells("normal_maps", normal_map_scene, 0), [f"cell {k}" for k in range(16)],
                        power=range(16))
 
 
@@ -210,7 +156,7 @@ def test_bump_maps_match_cycles(addon):
     height over a tenth of a pixel's footprint (Filter Width 0.1), we exactly along the UVs; a central difference
     one texel apart instead (2.5 % weaker slopes at 16 texels per ridge) read up to 2 % off in 5 cells."""
     from bpy_scenes import bump_scene
-    assert_cells_match(*path_vs_cycles_cells(bump_scene, 0), [f"cell {k}" for k in range(16)], power=range(16))
+    assert_cells_match(*path_vs_cycles_cells("bump_maps", bump_scene, 0), [f"cell {k}" for k in range(16)], power=range(16))
 
 
 @pytest.mark.parametrize("integrator,window", [("PATH", False), ("RESTIR", False), ("RESTIR", True)])
@@ -227,11 +173,10 @@ def test_smooth_glass_matches_cycles(addon, integrator, window):
     its square root, as Cycles' Principled does, the tinted sphere's cells read 4 % dark.)"""
     from bpy_scenes import glass_scene
     size = (96, 64)
-    cells = image_cells(size)
     kw = {"integrator": "PATH"} if integrator == "PATH" else {}
-    ours = render_reps(lambda: glass_scene(size, window=window), "RESTIR", 4, 64, **kw)
-    ref = render_reps(lambda: glass_scene(size, window=window), "CYCLES", 4, 128)
-    assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
+    ours, ref = both("glass_smooth_window" if window else "glass_smooth", lambda: glass_scene(size, window=window), 4,
+                     64, 128, by_masks(image_cells(size)), **kw)
+    assert_cells_match(ours, ref, [f"cell {k}" for k in range(16)],
                        power=[k for k in range(16) if k not in (8, 9, 10, 11)])
 
 
@@ -245,14 +190,13 @@ def test_rough_glass_matches_cycles(addon, integrator):
     (entering, IOR 1.45-1.5, from grazing to normal incidence)."""
     from bpy_scenes import glass_scene
     size = (96, 64)
-    cells = image_cells(size)
     kw = {"integrator": "PATH"} if integrator == "PATH" else {}
     rough = (0.3, 0.2, 0.5)
     # twice the smooth test's samples: at 64 / 128 spp the Glass BSDF sphere's cell had rel SE 0.4 %, where
     # 5 SE + 0.5 % no longer sees a 3 % error (Python 3.13 run); 0.23 % at these samples
-    ours = render_reps(lambda: glass_scene(size, roughness=rough), "RESTIR", 4, 128, **kw)
-    ref = render_reps(lambda: glass_scene(size, roughness=rough), "CYCLES", 4, 256)
-    assert_cells_match(cell_means(ours, cells), cell_means(ref, cells), [f"cell {k}" for k in range(16)],
+    ours, ref = both("glass_rough", lambda: glass_scene(size, roughness=rough), 4, 128, 256,
+                     by_masks(image_cells(size)), **kw)
+    assert_cells_match(ours, ref, [f"cell {k}" for k in range(16)],
                        power=[k for k in range(16) if k not in (8, 9, 10, 11)])
 
 
@@ -262,7 +206,7 @@ def test_rough_diffuse_matches_cycles(addon):
     from bpy_scenes import ROUGH_DIFFUSE_GRID
     size = (144, 24)
     masks = sphere_masks(size)[:len(ROUGH_DIFFUSE_GRID[0])]
-    ours = render_reps(lambda: material_spheres("AREA", size, ROUGH_DIFFUSE_GRID), "RESTIR", 0, 32, integrator="PATH")
-    ref = render_reps(lambda: material_spheres("AREA", size, ROUGH_DIFFUSE_GRID), "CYCLES", 0, 64)
+    ours, ref = both("rough_diffuse", lambda: material_spheres("AREA", size, ROUGH_DIFFUSE_GRID), 0, 32, 64,
+                     by_masks(masks), integrator="PATH")
     names = [f"{k} roughness {r} {e}" for k, _c, r, e in ROUGH_DIFFUSE_GRID[0]]
-    assert_cells_match(cell_means(ours, masks), cell_means(ref, masks), names, power=range(6))
+    assert_cells_match(ours, ref, names, power=range(6))
