@@ -4,8 +4,8 @@ from __future__ import annotations
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from .core.boiling import THRESHOLD as BOILING_THRESHOLD
-from .core.light_tiles import TileSettings
+from .core.restir.boiling import THRESHOLD as BOILING_THRESHOLD
+from .core.lights.tiles import TileSettings
 from .core.restir.di import CandidateSettings
 from .core.restir.gi import GISettings
 from .core.restir.reuse import SpatialSettings, TemporalSettings

@@ -34,9 +34,9 @@ from harness.metrics import rel_mse  # noqa: E402
 from harness.report import efficiency_bars, save_bar_figure  # noqa: E402
 from harness.reference import reference_image, reference_lit  # noqa: E402
 from harness.scenes import ensure_blend  # noqa: E402
-from restir_engine.core import pathtracer  # noqa: E402
-from restir_engine.core.context_cache import context_for  # noqa: E402
-from restir_engine.core.method_choice import choose_direct_method  # noqa: E402
+from restir_engine.core.integrators import pathtracer# noqa: E402
+from restir_engine.core.integrators.context_cache import context_for  # noqa: E402
+from restir_engine.core.integrators.method_choice import choose_direct_method  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 

@@ -20,8 +20,9 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
-from restir_engine.core import camera as camera_mod  # noqa: E402
-from restir_engine.core.accel import Accel, thread_count  # noqa: E402
+from restir_engine.core.geometry import camera as camera_mod# noqa: E402
+from restir_engine.core.geometry.accel import Accel  # noqa: E402
+from restir_engine.core.parallel.pool import thread_count  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 
@@ -78,7 +79,7 @@ def bench_rays(scene, repeat):
     n = o.shape[1]  # rays are (3, n) rows
     tmin_wrap, _, _ = best_of(lambda: accel.intersect(o, d, tmax), repeat)
     # direct embreex: one single-threaded call on one wrapper-sized chunk, scaled to rays/s
-    from restir_engine.core.accel import CHUNK_RAYS
+    from restir_engine.core.geometry.accel import CHUNK_RAYS
     oc, dc = np.ascontiguousarray(o[:, :CHUNK_RAYS].T), np.ascontiguousarray(d[:, :CHUNK_RAYS].T)
     tmin_direct, _, _ = best_of(lambda: accel._scene.run(oc, dc, output=1), repeat)
     direct_rps = len(oc) / tmin_direct

@@ -24,7 +24,7 @@ import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
 from bpy_scenes import configure_cycles, glass_scene, render_passes  # noqa: E402
-from restir_engine.core import pathtracer  # noqa: E402
+from restir_engine.core.integrators import pathtracer# noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.engine import settings_from_scene  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402

@@ -68,7 +68,10 @@ def _timed(fn):
 
 def instrument() -> None:
     """Wrap the material code wherever it was imported (what exists of it: an older checkout has less)."""
-    from restir_engine.core import bsdf, pathtracer, surface, target
+    from restir_engine.core.materials import bsdf
+    from restir_engine.core.integrators import pathtracer
+    from restir_engine.core.materials import surface
+    from restir_engine.core.restir import target
     from restir_engine.core.restir import di, gi
     sp = bsdf.SurfaceParams
     sp.take = _timed(sp.take)

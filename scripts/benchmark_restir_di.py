@@ -28,7 +28,7 @@ import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
 from harness.scenes import ensure_blend  # noqa: E402
-from restir_engine.core.light_tiles import TileSettings  # noqa: E402
+from restir_engine.core.lights.tiles import TileSettings  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 

@@ -33,7 +33,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 from harness.scenes import ensure_blend  # noqa: E402
-from restir_engine.core.accel import thread_count  # noqa: E402
+from restir_engine.core.parallel.pool import thread_count  # noqa: E402
 from restir_engine.core.profile import StageClock, embree_seconds  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402

@@ -1,4 +1,4 @@
-"""Equal-time gain of sampling the world as a light (core/world.py) over collecting it by BSDF rays alone.
+"""Equal-time gain of sampling the world as a light (core/lights/world.py) over collecting it by BSDF rays alone.
 
 Scene: tests/bpy_scenes.world_scene (three spheres on a floor, no lamps) under an environment image with a small
 sun (the sky of the tests) and under a constant colour, 160x90, direct light only and 3 bounces. Reference: Cycles
@@ -23,7 +23,8 @@ import bpy  # noqa: E402
 import restir_engine  # noqa: E402
 from bpy_scenes import configure_cycles, render_passes, world_scene  # noqa: E402
 from harness.metrics import interpolate_loglog, rel_mse  # noqa: E402
-from restir_engine.core import context_cache, pathtracer  # noqa: E402
+from restir_engine.core.integrators import context_cache# noqa: E402
+from restir_engine.core.integrators import pathtracer# noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 

@@ -1,4 +1,4 @@
-"""The world inside ReSTIR DI's reservoirs (core/world_points.py) against the world light-sampled at the shaded point.
+"""The world inside ReSTIR DI's reservoirs (core/lights/world_points.py) against the world light-sampled at the shaded point.
 
 Scenes: tests/bpy_scenes.world_scene (three spheres on a floor) under the sky with a small sun (an environment
 image), alone ("hdri") and with three small area lamps ("hdri+lamps"), and under a constant colour with the lamps

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from restir_engine.core.microfacet_tables import TABLE_FILE, compute_tables  # noqa: E402
+from restir_engine.core.materials.microfacet_tables import TABLE_FILE, compute_tables  # noqa: E402
 
 os.makedirs(os.path.dirname(TABLE_FILE), exist_ok=True)
 np.savez_compressed(TABLE_FILE, **compute_tables())

@@ -1,7 +1,7 @@
 """The boiling filter (biased mode only): outliers against their 16x16 block are emptied, nothing else."""
 import numpy as np
 
-from restir_engine.core.boiling import boiling_filter
+from restir_engine.core.restir.boiling import boiling_filter
 from restir_engine.core.renderer import RenderSettings, render_frame
 from restir_engine.core.restir.di import DIReservoirs
 from scenes_core import add_emitters, concat, floor_with_emitter, quad, tris

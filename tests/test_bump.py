@@ -4,8 +4,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from restir_engine.core.surface import bump_map
-from restir_engine.core.textures import NearestImage, gradient
+from restir_engine.core.materials.surface import bump_map
+from restir_engine.core.materials.textures import NearestImage, gradient
 
 
 def ramp(w=8, h=4, step=0.1):

@@ -1,7 +1,7 @@
 """Frames with unchanged scene content reuse the acceleration structures and light table."""
 import numpy as np
 
-from restir_engine.core import context_cache
+from restir_engine.core.integrators import context_cache
 from restir_engine.core.renderer import RenderSettings, render_frame
 from scenes_core import floor_with_emitter
 

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from restir_engine.core import bsdf
-from restir_engine.core.bsdf import SurfaceParams
+from restir_engine.core.materials import bsdf
+from restir_engine.core.materials.bsdf import SurfaceParams
 
 N = 400_000
 
@@ -103,7 +103,7 @@ def test_white_metal_reflects_all_energy(roughness, theta):
 def test_stored_ggx_tables_are_the_computed_ones():
     """core/data/ggx_tables.npz (read at start-up instead of seconds of computation) is what
     scripts/make_ggx_tables.py computes."""
-    from restir_engine.core.microfacet_tables import TABLE_FILE, compute_tables
+    from restir_engine.core.materials.microfacet_tables import TABLE_FILE, compute_tables
     computed = compute_tables()
     with np.load(TABLE_FILE) as stored:
         for name in ("E", "E_avg", "S"):
@@ -136,7 +136,7 @@ def test_white_dielectric_loses_no_energy(roughness, theta, f0):
 def test_glossy_bsdf_reflects_its_colour_with_multiscatter(roughness):
     """A Glossy BSDF (constant Fresnel = colour c) reflects c · (E + Fms(c) (1 - E)), Fms = c E_avg/(1 - c(1 - E_avg)):
     Cycles' multiscatter GGX with the constant Fresnel."""
-    from restir_engine.core import microfacet_tables as mt
+    from restir_engine.core.materials import microfacet_tables as mt
     c = np.array([0.9, 0.5, 0.2], np.float32)
     p = SurfaceParams.from_material(np.tile(c, (N, 1)), np.ones(N, np.float32), np.full(N, roughness, np.float32),
                                     np.zeros(N, np.float32), metal_f90=np.zeros(N, np.float32))
@@ -153,7 +153,7 @@ def test_glossy_bsdf_reflects_its_colour_with_multiscatter(roughness):
 def test_tables_agree_with_cycles_published_values():
     """Our GGX tables at the values Cycles' own tables hold (docs/CONVENTIONS.md): E(μ=1) 0.307 at roughness 1 and
     0.915 at 0.5; E_avg 0.409 at roughness 1 and 0.882 at 0.5 (±0.01: the tables' sampling and interpolation)."""
-    from restir_engine.core import microfacet_tables as mt
+    from restir_engine.core.materials import microfacet_tables as mt
     a = np.array([1.0, 0.25], np.float32)
     assert np.allclose(mt.albedo(a, np.ones(2, np.float32)), [0.307, 0.915], atol=0.01)
     assert np.allclose(mt.average_albedo(a), [0.409, 0.882], atol=0.01)
@@ -161,7 +161,7 @@ def test_tables_agree_with_cycles_published_values():
 
 def test_exact_fresnel():
     """The split dielectric Fresnel equals the mean of the s and p reflectances."""
-    from restir_engine.core.bsdf import fresnel_exact
+    from restir_engine.core.materials.bsdf import fresnel_exact
     c = np.linspace(0.01, 1, 50).astype(np.float32)
     for eta in (1.2, 1.5, 2.0):
         st = np.sqrt(1 - c * c) / eta
@@ -173,11 +173,11 @@ def test_exact_fresnel():
 
 
 def test_mix_picks_components_in_proportion_to_their_weights():
-    """core/mix.py: over a uniform grid of ξ each component is picked with probability w_k/W and scaled by W = Σ w
+    """core/materials/mix.py: over a uniform grid of ξ each component is picked with probability w_k/W and scaled by W = Σ w
     (so the expectation is Σ w_k f_k); a textured factor t weighs its sides by 1 - t and t."""
     from types import SimpleNamespace
 
-    from restir_engine.core.mix import hash_uniform, pick_components
+    from restir_engine.core.materials.mix import hash_uniform, pick_components
     tex = np.full((2, 2, 3), 0.25, np.float32)
     mats = SimpleNamespace(mix_first=np.array([-1, 0, 3], np.int32), mix_count=np.array([0, 3, 2], np.int32),
                            mix_comp=np.array([3, 4, 5, 6, 7], np.int32),
@@ -273,7 +273,7 @@ def test_view_terms_from_per_material_mu_rows():
     spec_a/spec_c, the metal's E) from per-material functions of μo interpolated between the GGX tables' μ nodes
     (SurfaceParams.mu_rows), instead of interpolating E and S per hit and combining them: the BSDF agrees with the
     per-hit path within 1e-3 (both interpolate the same tables; the largest gap, 5e-4, is at grazing μo)."""
-    from restir_engine.core import microfacet_tables as mt
+    from restir_engine.core.materials import microfacet_tables as mt
     rng = np.random.default_rng(5)
     m = 6
     table = SurfaceParams.from_material(rng.uniform(0.1, 0.9, (m, 3)), np.array([0, 1.0, 0, 0.6, 0, 0]),

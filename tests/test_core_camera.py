@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scenes_core import perspective_camera, top_down_camera
 
-from restir_engine.core import camera as camera_mod
+from restir_engine.core.geometry import camera as camera_mod
 
 
 @pytest.mark.parametrize("cam", [perspective_camera((0.3, -2.6, 1.3), (0.0, 0.6, 0.5), 640, 360),

@@ -245,7 +245,8 @@ def test_per_hit_shading_stays_float32():
     image. Checked on the regression room (glossy, metal, textured and diffuse materials)."""
     from scenes_core import regression_room
 
-    from restir_engine.core import bsdf, pathtracer
+    from restir_engine.core.materials import bsdf
+    from restir_engine.core.integrators import pathtracer
     from restir_engine.core.sampling import rng
     scene = regression_room(24, 18)
     ctx = pathtracer.build_context(scene, 2)

@@ -144,7 +144,7 @@ def test_image_texture_feeds_base_color(scene):
     tex = s.materials.textures[0]
     assert tex.shape == (2, 4, 3)
     assert np.allclose(tex[:, :2], [1, 0, 0]) and np.allclose(tex[:, 2:], [0, 0, 1])
-    from restir_engine.core.textures import sample_bilinear
+    from restir_engine.core.materials.textures import sample_bilinear
     assert np.allclose(sample_bilinear(tex, np.array([[0.25, 0.5], [0.75, 0.5]], np.float32)), [[1, 0, 0], [0, 0, 1]])
     assert s.geometry.uvs.min() >= 0 and s.geometry.uvs.max() <= 1
 
@@ -163,7 +163,7 @@ def test_light_table_power_conventions(scene):
     light("POINT", (-5, 0, 3), energy=50.0, shadow_soft_size=0.2)
     light("SUN", (0, 0, 10), energy=3.0)
     s = export()
-    from restir_engine.core.lights import LightTable
+    from restir_engine.core.lights.table import LightTable
     table = LightTable(s, scene_radius=10.0)
     assert table.n_geom == 2 and table.n_sun == 1
     # emissive mesh: power = π · L · A · 2 sides; area light: P; point light: P (luminance of white = 1)
@@ -175,7 +175,7 @@ def test_light_table_power_conventions(scene):
     assert np.isclose(area_part, 100.0, rtol=1e-4) and np.isclose(point_part, 50.0, rtol=1e-4)
     assert np.allclose(s.lamps.sun_irradiance[0], 3.0) and np.allclose(s.lamps.sun_dir[0], [0, 0, 1], atol=1e-6)
     # area light faces down (local -Z)
-    from restir_engine.core.lights import triangle_geometry
+    from restir_engine.core.lights.table import triangle_geometry
     ng, _ = triangle_geometry(s.lamps.tris.verts[:2])
     assert np.allclose(ng, [0, 0, -1], atol=1e-6)
 
@@ -226,7 +226,7 @@ def test_metaball_and_emission_texture(scene):
     assert len(s.geometry) > 100  # the metaball's evaluated mesh plus the plane
     i = s.materials.names.index("Glow")
     assert s.materials.emit_tex[i] >= 0 and np.allclose(s.materials.emission[i], 2.0)
-    from restir_engine.core.lights import LightTable
+    from restir_engine.core.lights.table import LightTable
     table = LightTable(s, 10.0)
     assert table.n_geom == 2  # the plane's two triangles are lights, with the texture's mean in their power
     lum = 0.2126 * 0.5 + 0.7152 * 0.25 + 0.0722 * 1.0

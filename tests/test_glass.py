@@ -1,8 +1,8 @@
-"""Glass sampling (core/glass.py) against closed forms: Fresnel, Snell's law, total internal reflection; rough glass
+"""Glass sampling (core/materials/glass.py) against closed forms: Fresnel, Snell's law, total internal reflection; rough glass
 conserves energy (Cycles' multiscatter compensation) and tends to the smooth interface."""
 import numpy as np
 
-from restir_engine.core.glass import sample_glass
+from restir_engine.core.materials.glass import sample_glass
 
 
 def _incident(theta_deg, k):
@@ -85,7 +85,7 @@ def test_rough_glass_conserves_energy():
     """Multiscatter GGX glass (Cycles' default): the single-scattering interface scaled by 1/E reflects and transmits
     all the light on average, entered from either side, at any roughness and angle (mean weight 1 within 5 SE and
     1 % for the tables' interpolation); single-scattering GGX loses what the table says it does."""
-    from restir_engine.core.microfacet_tables import glass_albedo_at
+    from restir_engine.core.materials.microfacet_tables import glass_albedo_at
     k = 400000
     for theta, alpha, ior, front in ((0.0, 0.25, 1.45, True), (60.0, 0.5, 1.5, True), (30.0, 0.8, 1.5, False),
                                      (75.0, 0.1, 2.0, True), (50.0, 0.3, 1.33, False)):

@@ -4,13 +4,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from restir_engine.core import light_tiles
-from restir_engine.core.bsdf import SurfaceParams
-from restir_engine.core.light_tiles import TileSettings
+from restir_engine.core.lights import tiles as light_tiles
+from restir_engine.core.materials.bsdf import SurfaceParams
+from restir_engine.core.lights.tiles import TileSettings
 from restir_engine.core.renderer import RenderSettings, render_frame
 from restir_engine.core.restir.di import shading_value
 from restir_engine.core.sampling import orthonormal_basis, to_local
-from restir_engine.core.target import ShadingTerms
+from restir_engine.core.restir.target import ShadingTerms
 
 
 class _Surf:
@@ -117,7 +117,8 @@ def test_tile_candidates_converge_to_the_path_tracer(method, sampler):
 
 def _block_tiles(scene, width, height_above=0.0):
     """Block tiles for a top-down view of the z = 0 floor of ``scene`` (positions of the pixel centres)."""
-    from restir_engine.core import light_blocks, pathtracer
+    from restir_engine.core.lights import blocks as light_blocks
+    from restir_engine.core.integrators import pathtracer
     ctx = pathtracer.build_context(scene, 0)
     half = 1.2
     c = -half + (np.arange(width) + 0.5) * 2 * half / width
@@ -130,7 +131,7 @@ def test_block_tiles_store_their_blocks_pdf_and_draw_clusters_by_it():
     """Each tile point carries the area pdf of its block's distribution (the one the BSDF candidates' MIS
     evaluates), every block's cluster probabilities sum to 1, and 4096 draws per block follow them
     (chi-square over the clusters, 1e-4 false-alarm level)."""
-    from restir_engine.core.light_blocks import clusters_of
+    from restir_engine.core.lights.blocks import clusters_of
     lights, bt = _block_tiles(_many_coloured_lights(), 40)
     assert np.allclose(bt.q.sum(axis=1), 1.0)
     assert (bt.q > 0).all()  # every cluster keeps a positive probability: unbiased whatever the bound
@@ -152,7 +153,7 @@ def test_block_tiles_store_their_blocks_pdf_and_draw_clusters_by_it():
 def test_block_tiles_favour_the_lights_above_the_block():
     """A block right under a light gives it more probability than the power table does (the point of the
     spatial sampler), a far block less."""
-    from restir_engine.core.light_blocks import clusters_of
+    from restir_engine.core.lights.blocks import clusters_of
     scene = _many_coloured_lights()
     lights, bt = _block_tiles(scene, 40)
     cl = clusters_of(lights)
@@ -165,5 +166,5 @@ def test_block_tiles_favour_the_lights_above_the_block():
     block_pdf = bt.pdf_area(np.array([near, far]), np.array([0, 0]), np.array([0, 0]))
     assert block_pdf[0] > 2 * power_pdf[near], (block_pdf[0], power_pdf[near])
     assert block_pdf[1] < power_pdf[far]
-    from restir_engine.core.light_blocks import CLUSTERS
+    from restir_engine.core.lights.blocks import CLUSTERS
     assert cl.count == min(lights.n_tri, CLUSTERS)

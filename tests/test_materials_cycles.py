@@ -117,7 +117,7 @@ def test_alpha_cutouts_match_cycles(addon):
 @pytest.mark.parametrize("kind,bounces", [("IMAGE", 0), ("CONSTANT", 0), ("IMAGE", 3)])
 def test_world_light_matches_cycles(addon, kind, bounces):
     """Spheres and a floor lit only by the world: an environment image (a sky with a small sun, made by the test,
-    rotated by a Mapping node) or a constant colour, light-sampled (core/world.py) with MIS; per 4 x 4 image cell,
+    rotated by a Mapping node) or a constant colour, light-sampled (core/lights/world.py) with MIS; per 4 x 4 image cell,
     every cell below the horizon able to see a 3 % error except cell 7: the metal sphere's rim reflecting the sky,
     where ours reads ~1.2 % low (z ≈ 3 in 24 seeds; Cycles bends a smooth normal at silhouettes where we bend the
     view vector, docs/CONVENTIONS.md), inside the bound but too close to it for that power."""
@@ -129,7 +129,7 @@ def test_world_light_matches_cycles(addon, kind, bounces):
 
 def test_world_in_reservoirs_matches_cycles(addon):
     """The environment-image world of :func:`test_world_light_matches_cycles` with ReSTIR DI holding the world's
-    samples in its reservoirs (World Light Resampled, spatial reuse; core/world_points.py), direct light: per 4 x 4
+    samples in its reservoirs (World Light Resampled, spatial reuse; core/lights/world_points.py), direct light: per 4 x 4
     image cell against Cycles, the same cells able to see a 3 % error."""
     from bpy_scenes import world_scene
     size = (96, 64)

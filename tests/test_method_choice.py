@@ -1,11 +1,11 @@
-"""The automatic direct and indirect methods (core/method_choice.py) and that the renderer applies and reports them."""
+"""The automatic direct and indirect methods (core/integrators/method_choice.py) and that the renderer applies and reports them."""
 import numpy as np
 from scenes_core import bounce_room, floor_with_emitter, plane_under_world
 from test_light_tiles import _many_coloured_lights
 from test_sphere_lights import floor_under_sphere
 
-from restir_engine.core import pathtracer
-from restir_engine.core.method_choice import (FEW_LIGHTS, GI_MAX_UNCACHED, GI_MIN_SHARE, choose_direct_method,
+from restir_engine.core.integrators import pathtracer
+from restir_engine.core.integrators.method_choice import (FEW_LIGHTS, GI_MAX_UNCACHED, GI_MIN_SHARE, choose_direct_method,
                                               choose_indirect_method, choose_world_method)
 from restir_engine.core.renderer import RenderSettings, render_frame
 

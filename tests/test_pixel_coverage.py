@@ -41,7 +41,7 @@ def emission_reps(strata: int, reps: int) -> np.ndarray:
 
 
 def test_automatic_coverage_follows_visible_emitters():
-    from restir_engine.core import pathtracer
+    from restir_engine.core.integrators import pathtracer
     ctx = pathtracer.build_context(emitter_on_floor(), 0)
     assert coverage_samples(0, ctx.lights, ctx.scene.lamps)[0] > 1
     assert coverage_samples(5, ctx.lights, ctx.scene.lamps)[0] == 4  # rounded down to a square
@@ -105,7 +105,7 @@ def test_coverage_rays_go_where_an_emitter_can_be_seen():
     """Automatic coverage: the extra rays are cast only in the pixels an emitter's projection may touch (every
     pixel the rectangle covers is among them, pixels far from it are not), and not at all when the emitters are
     out of view; the image stays an unbiased estimate (tests above)."""
-    from restir_engine.core import pathtracer
+    from restir_engine.core.integrators import pathtracer
     from restir_engine.core.renderer import FrameRenderer
     scene = emitter_on_floor()
     r = FrameRenderer(scene, RenderSettings(samples=1, max_bounces=0))

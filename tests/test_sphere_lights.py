@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scenes_core import quad, top_down_camera, tris
 
-from restir_engine.core import pathtracer
+from restir_engine.core.integrators import pathtracer
 from restir_engine.core.renderer import RenderSettings, render_frame
 from restir_engine.core.scene import Lamps, MaterialTable, Scene
 from restir_engine.export.lights import _SPHERE

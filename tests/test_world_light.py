@@ -1,4 +1,4 @@
-"""The world as a light (core/world.py): importance sampling of an environment image and of a constant colour, used
+"""The world as a light (core/lights/world.py): importance sampling of an environment image and of a constant colour, used
 by next-event estimation with MIS. Tolerances: 5 standard errors of the per-seed means (each side a z-test with the
 stated bound; the seeds are independent)."""
 import numpy as np
@@ -6,7 +6,7 @@ import pytest
 from scenes_core import plane_under_world
 
 from restir_engine.core.renderer import RenderSettings, render_frame
-from restir_engine.core.world import World
+from restir_engine.core.lights.world import World
 
 
 def sun_sky(h=32, w=64):
@@ -77,7 +77,7 @@ def test_importance_sampling_beats_bsdf_sampling_on_a_sun():
     scene.world_image = sun_sky()
     on = render_frame(scene, RenderSettings(integrator="PATH", max_bounces=0, samples=1, seed=1))
     img_on = on.passes["Combined"][..., 0]
-    from restir_engine.core import pathtracer
+    from restir_engine.core.integrators import pathtracer
     orig = pathtracer.World.__init__
 
     def unsampled(self, *a, **k):
@@ -85,7 +85,7 @@ def test_importance_sampling_beats_bsdf_sampling_on_a_sun():
         self.sampled = False
     pathtracer.World.__init__ = unsampled
     try:
-        from restir_engine.core import context_cache
+        from restir_engine.core.integrators import context_cache
         context_cache.clear()
         off = render_frame(scene, RenderSettings(integrator="PATH", max_bounces=0, samples=1, seed=1))
     finally:
@@ -153,10 +153,10 @@ def test_world_in_reservoirs_lowers_the_noise_under_a_sun():
 
 
 def test_world_points_on_their_sphere():
-    """World points (core/world_points.py): a ray from inside leaves the sphere where exit_coords says; the area
+    """World points (core/lights/world_points.py): a ray from inside leaves the sphere where exit_coords says; the area
     pdf of the world's own sampling, times the area element's Jacobian, is its solid-angle pdf; a point carries
     the world's radiance in its own direction from the centre."""
-    from restir_engine.core.world_points import WorldSphere
+    from restir_engine.core.lights.world_points import WorldSphere
     world = World((0, 0, 0), sun_sky())
     sph = WorldSphere(world, (1.0, -2.0, 0.5), 3.0)
     g = np.random.default_rng(0)

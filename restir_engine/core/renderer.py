@@ -36,26 +36,45 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import camera as camera_mod
-from . import pathtracer
-from .accel import in_worker, pool, thread_count
-from .boiling import THRESHOLD as BOILING_THRESHOLD
-from .boiling import boiling_filter
-from .bsdf import denoising_albedo, luminance_rows
-from .context_cache import context_for, fingerprint
-from .method_choice import GI_MIN_SHARE, WORLD_METHODS, choose_direct_method, choose_indirect_method, choose_world_method
-from .light_blocks import BlockLightTiles
-from .light_tiles import TILE_MODES, LightTiles, TileSettings
+from .geometry import camera as camera_mod
+from .integrators import pathtracer
+from .integrators.context_cache import context_for, fingerprint
+from .integrators.method_choice import (
+    GI_MIN_SHARE,
+    WORLD_METHODS,
+    choose_direct_method,
+    choose_indirect_method,
+    choose_world_method,
+)
+from .lights.blocks import BlockLightTiles
+from .lights.tiles import TILE_MODES, LightTiles, TileSettings
+from .materials.bsdf import denoising_albedo, luminance_rows
+from .parallel.pool import in_worker, pool, thread_count
 from .profile import NullClock
 from .restir import di, gi, reuse
+from .restir.boiling import THRESHOLD as BOILING_THRESHOLD
+from .restir.boiling import boiling_filter
 from .restir.gbuffer import GBuffer
 from .restir.history import TemporalHistory
-from .sampling import (STREAM_CAMERA, STREAM_CHAIN, STREAM_GI_SPATIAL, STREAM_GI_TEMPORAL, STREAM_INITIAL, STREAM_PATH,
-                       STREAM_PROBE,
-                       STREAM_PIXEL_OFFSET, STREAM_SHADE, STREAM_SPATIAL, STREAM_TEMPORAL, STREAM_TILES, finite,
-                       pass_jitter, rng)
+from .restir.target import WIDTH, ShadingTerms
+from .sampling import (
+    STREAM_CAMERA,
+    STREAM_CHAIN,
+    STREAM_GI_SPATIAL,
+    STREAM_GI_TEMPORAL,
+    STREAM_INITIAL,
+    STREAM_PATH,
+    STREAM_PIXEL_OFFSET,
+    STREAM_PROBE,
+    STREAM_SHADE,
+    STREAM_SPATIAL,
+    STREAM_TEMPORAL,
+    STREAM_TILES,
+    finite,
+    pass_jitter,
+    rng,
+)
 from .scene import Scene
-from .target import WIDTH, ShadingTerms
 
 INTEGRATORS = ("PATH", "RESTIR")
 CHUNK_PIXELS = 32768  # pixels per chunk of work (measured: scripts/benchmark_stages.py --tile-sweep)

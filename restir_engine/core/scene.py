@@ -258,5 +258,5 @@ class Scene:
     world_radiance: np.ndarray = field(default_factory=lambda: np.zeros(3, np.float32))
     warnings: list = field(default_factory=list)
     world_image: np.ndarray | None = None     # (h, w, 3) equirectangular radiance (then world_radiance is unused)
-    world_rotation: np.ndarray | None = None  # (3, 3) world -> environment texture frame (core/world.py)
+    world_rotation: np.ndarray | None = None  # (3, 3) world -> environment texture frame (core/lights/world.py)
     motion: Motion | None = None

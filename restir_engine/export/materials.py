@@ -12,7 +12,7 @@ import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
-from ..core.textures import NearestImage
+from ..core.materials.textures import NearestImage
 
 MAGENTA = (1.0, 0.0, 1.0)
 
@@ -214,7 +214,7 @@ class MaterialRegistry:
         row["glass_alpha"] = rough * rough
         row["glass_multiscatter"] = row.get("multiscatter", 1.0)
 
-    # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/mix.py) ---------
+    # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/materials/mix.py) ---------
     def _normal(self, material, node, row: dict) -> None:
         """A BSDF's Normal input: a tangent-space Normal Map node on an Image Texture -> normal_tex and
         normal_strength; a Bump node whose Height is an Image Texture -> bump_tex, bump_strength, bump_distance

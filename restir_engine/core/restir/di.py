@@ -30,15 +30,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..accel import shadow_rays
-from ..bsdf import eval_view, luminance_rows, view_terms
-from ..light_tiles import PackedPoints, TileSettings, light_points, sample_points
-from ..pathtracer import lamp_hits, sample_rays
+from ..geometry.accel import shadow_rays
+from ..integrators.pathtracer import lamp_hits, sample_rays
+from ..lights.tiles import PackedPoints, TileSettings, light_points, sample_points
+from ..materials.bsdf import eval_view, luminance_rows, view_terms
 from ..sampling import cols, dot, finite, to_local, uniform_ints, vmax
-from ..target import FramePoints, with_spots
 from .reservoir import Reservoirs, Stream
+from .target import FramePoints, with_spots
 
-DIRECT_METHODS = ("AUTO", "LIGHT_SAMPLING", "RIS", "RESTIR")  # AUTO: core/method_choice.py
+DIRECT_METHODS = ("AUTO", "LIGHT_SAMPLING", "RIS", "RESTIR")  # AUTO: core/integrators/method_choice.py
 CANDIDATE_BLOCK = 65536  # candidate x surface elements evaluated per pass over memory (256 kB per float32 array)
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..target import ShadingTerms
+from .target import ShadingTerms
 
 
 class GBuffer:

@@ -231,7 +231,7 @@ def temporal_reuse(space, gb, res: Reservoirs, prepared_now, hist, prepared_prev
     disocclusion. The previous confidence is capped at ``confidence_cap`` x the current one.
     ``possible_before(rows)`` (optional): (n,) bool, False where the previous frame could not have produced
     the current sample (a light switched on since): its target there is zero for the MIS weights."""
-    from ..camera import project
+    from ..geometry.camera import project
 
     n = len(_indices(rows))
     prev_gb = hist.gbuf

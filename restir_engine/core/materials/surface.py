@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..sampling import barycentric, cols, dot, norm, orthonormal_basis
 from .bsdf import SurfaceParams, ViewTerms
-from .microfacet_tables import lerp_rows, mu_index
 from .glass import GLASS_SALT
+from .microfacet_tables import lerp_rows, mu_index
 from .mix import hash_uniform, pick_components
-from .sampling import barycentric, cols, dot, norm, orthonormal_basis
 from .textures import apply_texture, gradient, sample
 
 
@@ -29,7 +29,7 @@ class Surface:
         mat = geom.material[prim].astype(np.intp)
         self.mat = mat  # the triangle's material (a Mix/Add shader stays itself here)
         scale = None
-        if ctx.has_mix:  # Mix/Add shaders: one component per hit, scaled by the weights' sum (core/mix.py)
+        if ctx.has_mix:  # Mix/Add shaders: one component per hit, scaled by the weights' sum (core/materials/mix.py)
             mixed = np.flatnonzero(mats.mix_first[mat] >= 0)
             if mixed.size:
                 uv = None
@@ -86,7 +86,7 @@ class Surface:
                 self.params.assign(textured, SurfaceParams.of_table(mats, tm, base))
         if scale is not None:
             self.params.scale(scale)
-        # smooth glass (core/glass.py): picked per point with the material's transmission share; black for every
+        # smooth glass (core/materials/glass.py): picked per point with the material's transmission share; black for every
         # evaluation, sampled as a delta closure by pathtracer.sample_rays
         self.glass = self.glass_front = self.glass_ior = self.glass_reflect = self.glass_refract = None
         self.glass_alpha = self.glass_ms = None

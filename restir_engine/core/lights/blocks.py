@@ -20,8 +20,8 @@ import warnings
 
 import numpy as np
 
-from .accel import in_worker, pool
-from .light_tiles import LightPoints, light_points
+from ..parallel.pool import in_worker, pool
+from .tiles import LightPoints, light_points
 
 CLUSTERS = 1024
 BLOCK = 16  # pixels per side of a screen block

@@ -1,54 +1,23 @@
 """Embree ray queries over structure-of-arrays rays, chunked across a thread pool.
 
 ``embreex``'s ``EmbreeScene.run`` is a single-threaded loop over rtcIntersect1/rtcOccluded1
-that releases the GIL, so chunks of rays run concurrently on a shared thread pool.
+that releases the GIL, so chunks of rays run concurrently on the shared thread pool (core/parallel/pool.py).
 ``tnear`` is fixed at 0 by embreex: callers must offset origins (see :func:`offset_origin`).
 Rays are (3, n) rows like every vector of the core; each call transposes them into the (n, 3) arrays
 ``EmbreeScene.run`` reads.
 """
 from __future__ import annotations
 
-import os
-import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .profile import add_embree_seconds
-from .sampling import cols, dot, norm, vmax
+from ..parallel.pool import run_chunks
+from ..profile import add_embree_seconds
+from ..sampling import cols, dot, norm, vmax
 
 CHUNK_RAYS = 32768  # rays per Embree call: large enough to amortize the call, small for load balance
 MAX_CUTOUT_LAYERS = 32  # transparent cut-out points one ray passes at most (the next hit then counts as opaque)
-
-_POOL: ThreadPoolExecutor | None = None
-
-
-def thread_count() -> int:
-    return max(1, os.cpu_count() or 1)
-
-
-def in_worker() -> bool:
-    """True inside a pool thread: nested work then runs inline instead of waiting on the pool."""
-    return threading.current_thread().name.startswith("restir")
-
-
-def run_chunks(fn, spans) -> None:
-    """Run ``fn(span)`` for every span, on the pool unless already inside a worker."""
-    if in_worker() or len(spans) == 1:
-        for span in spans:
-            fn(span)
-    else:
-        list(pool().map(fn, spans))
-
-
-def pool() -> ThreadPoolExecutor:
-    """The process-wide worker pool (one thread per core)."""
-    global _POOL
-    if _POOL is None:
-        _POOL = ThreadPoolExecutor(max_workers=thread_count(), thread_name_prefix="restir")
-    return _POOL
-
 
 def offset_origin(p: np.ndarray, ng: np.ndarray, direction: np.ndarray) -> np.ndarray:
     """Move points p (3, n) off their surface along the geometric normal ng (3, n), to the side ``direction``

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .bsdf import luminance
-from .sampling import AliasTable, barycentric, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
-from .scene import Lamps, MaterialTable, Scene, TriangleSet
-from .textures import apply_texture, mean_color
+from ..materials.bsdf import luminance
+from ..materials.textures import apply_texture, mean_color
+from ..sampling import AliasTable, barycentric, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
+from ..scene import Lamps, MaterialTable, Scene, TriangleSet
 
 EMPTY = np.zeros(0, np.int64)
 

@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bsdf import fresnel_exact, half_vector_terms, view_terms
-from .light_tiles import PackedPoints, light_points
-from .accel import in_worker, pool
-from .lights import spot_factor
-from .sampling import to_world
+from ..lights.table import spot_factor
+from ..lights.tiles import PackedPoints, light_points
+from ..materials.bsdf import fresnel_exact, half_vector_terms, view_terms
+from ..parallel.pool import in_worker, pool
+from ..sampling import to_world
 
 LUM = np.array([0.2126, 0.7152, 0.0722], np.float32)
 INV_PI = np.float32(1.0 / np.pi)

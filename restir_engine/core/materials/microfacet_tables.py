@@ -17,7 +17,7 @@ Tables (all for height-correlated Smith GGX, single scattering, no cosine-weight
                 directional albedo of a rough dielectric interface (GGX glass: reflection weighted by the exact
                 Fresnel F(ωo·h), refraction by 1 - F, total internal reflection included), entered from the optically
                 thinner side (relative IOR η = η(z) > 1) and from the denser side (1/η); Cycles scales its
-                multiscatter glass by 1/E (core/glass.py).
+                multiscatter glass by 1/E (core/materials/glass.py).
 """
 from __future__ import annotations
 

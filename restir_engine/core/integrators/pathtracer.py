@@ -6,7 +6,7 @@ Estimator per pixel sample (wavefront form, vectorized over the rays of a chunk)
 with power-heuristic MIS weights w = p²/(p_light² + p_bsdf²), both pdfs in solid angle.
 ``max_bounces`` = 0 is direct light only (as in Cycles); Russian roulette from bounce ``rr_start``.
 Lamps (Blender Light objects) emit but do not occlude; a ray collects the nearest lamp in front
-of its geometry hit and continues. The world (core/world.py: a constant colour or an environment image) is a
+of its geometry hit and continues. The world (core/lights/world.py: a constant colour or an environment image) is a
 light too: next-event estimation samples it besides the lights (:func:`world_event`, its own shadow ray) and
 escaping BSDF rays collect it MIS-weighted against that. Suns are light-sampled only.
 
@@ -22,18 +22,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import camera as camera_mod
-from .accel import Accel, Hits, offset_origin, shadow_rays
-from . import microfacet_tables
-from .cutout import Cutout
-from .world import World
-from .world_points import WorldSphere
-from .bsdf import SurfaceParams, diffuse_f, eval_view, sample_bsdf
-from .glass import DELTA_PDF, sample_glass
-from .lights import LightTable, emitted_radiance, spot_factor, triangle_geometry
-from .sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
-from .scene import Scene
-from .surface import Surface
+from ..geometry import camera as camera_mod
+from ..geometry.accel import Accel, Hits, offset_origin, shadow_rays
+from ..lights.table import LightTable, emitted_radiance, spot_factor, triangle_geometry
+from ..lights.world import World
+from ..lights.world_points import WorldSphere
+from ..materials import microfacet_tables
+from ..materials.bsdf import SurfaceParams, diffuse_f, eval_view, sample_bsdf
+from ..materials.cutout import Cutout
+from ..materials.glass import DELTA_PDF, sample_glass
+from ..materials.surface import Surface
+from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
+from ..scene import Scene
 
 
 @dataclass
@@ -53,11 +53,11 @@ class TraceContext:
     film_transparent: bool = False
     material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α
     material_layer: np.ndarray = None   # (m, 32) dielectric layer factor S rows over μo (microfacet_tables)
-    has_mix: bool = False  # some material is a Mix/Add shader (core/mix.py)
-    world: World = None    # the background as a light (core/world.py)
+    has_mix: bool = False  # some material is a Mix/Add shader (core/materials/mix.py)
+    world: World = None    # the background as a light (core/lights/world.py)
     normal_maps: bool = False  # some material has a tangent-space normal map (surface.normal_map)
     bump_maps: bool = False    # some material has a Bump node (surface.bump_map)
-    has_glass: bool = False    # some material has a smooth glass closure (core/glass.py)
+    has_glass: bool = False    # some material has a smooth glass closure (core/materials/glass.py)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import Camera
+from ..scene import Camera
 
 
 def _xform(m: np.ndarray, pts: np.ndarray) -> np.ndarray:

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..sampling import barycentric
 from .mix import hash_uniform
-from .sampling import barycentric
 from .textures import sample
 
 SALT = 0x5BD1E995

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
 TILE_MODES = ("AUTO", "ON", "OFF")
 BLOCK = 16              # pixels per side of a screen block sharing one tile
 AUTO_FACTOR = 8.0       # AUTO: use tiles when candidates per pass exceed this many times the tile points

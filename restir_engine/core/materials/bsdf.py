@@ -27,9 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..sampling import cosine_hemisphere, dot, orthonormal_basis
 from . import microfacet_tables as tables
 from .microfacet_tables import ALPHA_MIN
-from .sampling import cosine_hemisphere, dot, orthonormal_basis
 
 INV_PI = np.float32(1.0 / np.pi)
 _F82 = 6.0 / 7.0  # 1 - cos 82°-ish: the F82 model's reference angle has cos θ = 1/7
@@ -70,7 +70,7 @@ PARAM_ROWS = {"diffuse": slice(0, 3), "a_m": slice(3, 6), "b_m": slice(6, 9), "d
               "msd": slice(24, 27), "diel_f0": slice(27, 30), "alpha": 30, "eta2m1": 31, "f0r": 32, "p_spec": 33,
               "spec_on": 34, "metal": 35, "diel": 36, "on_a": 37, "on_b": 38, "on_ems": slice(39, 42)}
 PARAM_WIDTH = 42
-#: The rows that scale with a lobe's weight (Mix/Add components: core/mix.py)
+#: The rows that scale with a lobe's weight (Mix/Add components: core/materials/mix.py)
 WEIGHT_ROWS = (slice(0, 12), slice(15, 21))
 
 

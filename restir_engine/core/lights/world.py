@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .sampling import cosine_hemisphere, to_world
-from .textures import sample_bilinear
+from ..materials.textures import sample_bilinear
+from ..sampling import cosine_hemisphere, to_world
 
 LUM = np.array([0.2126, 0.7152, 0.0722], np.float32)
 
