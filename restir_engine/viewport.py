@@ -125,8 +125,7 @@ def pass_image(renderer: FrameRenderer, name: str) -> tuple[np.ndarray, dict]:
     """The viewport pass ``name`` (a VIEWPORT_PASSES key) of the renderer's running mean as (h, w, 4) float32
     and facts about its mapping (for the header); a pass the renderer does not have (Reservoir M when the
     direct light is not resampled) is black, with the reason."""
-    acc = renderer.acc
-    h, w = acc["alpha"].shape
+    _x0, _y0, w, h = renderer.ctx.scene.camera.window
     out = np.zeros((h, w, 4), np.float32)
     out[..., 3] = 1.0
     info: dict = {}
@@ -138,7 +137,7 @@ def pass_image(renderer: FrameRenderer, name: str) -> tuple[np.ndarray, dict]:
         return out, info
     if name in ("RES_M", "RES_UCW", "GI_M", "GI_UCW"):
         key = {"RES_M": "res_m", "RES_UCW": "res_w", "GI_M": "gi_m", "GI_UCW": "gi_w"}[name]
-        if key not in acc or (name.startswith("RES") and renderer.candidates is None):
+        if not renderer.has_pass_data(key) or (name.startswith("RES") and renderer.candidates is None):
             info["missing"] = "no reservoirs: " + ("ReSTIR GI is off" if name.startswith("GI")
                                                    else f"the direct light uses {renderer.method}")
             return out, info
@@ -359,9 +358,9 @@ class ViewportSession:
         mats = r.ctx.scene.export_stats.get("instance_matrices") if hasattr(r.ctx.scene, "export_stats") else None
         if mats is None:
             mats = np.zeros((0, 4, 4))
-        r.ctx.scene.motion = Motion(current=mats, prev=mats, next=mats,
+        r.set_motion(Motion(current=mats, prev=mats, next=mats,
                                     camera_prev=dataclasses.replace(prev, width=cam.width, height=cam.height,
-                                                                    window=cam.window))
+                                                                    window=cam.window)))
         self._key = key
 
     def _pass(self, navigation: bool) -> None:
@@ -377,17 +376,15 @@ class ViewportSession:
                 return  # the view moved while this pass was being set up: render the new view first
         # a navigation pass that reuses the last view's reservoirs needs fewer candidates (the first pass of a scene
         # has no history and renders as F12 does)
-        reusing = r.settings.temporal_reuse and r.prev_history is not None and r.prev_history.res is not None
-        r.light_candidate_cap = NAVIGATION_CANDIDATES if navigation and reusing else None
+        cap = NAVIGATION_CANDIDATES if navigation and r.reuses_history() else None
         # full-resolution refinement renders several samples per pass where F12 would (renderer.batch_size); a
         # navigation pass, and the reduced-resolution steps after it, one: they are meant to show an image soon
         batch = 1 if navigation or self._divider > 1 else r.batch_size(self.max_samples - r.samples_done)
         before = r.samples_done
         try:
-            done = r.sample_pass(should_stop=should_stop, batch=batch)
+            done = r.sample_pass(should_stop=should_stop, batch=batch, light_candidate_cap=cap)
         finally:
             self._navigating = False
-            r.light_candidate_cap = None
         seconds = self.clock() - t0
         if not done:
             return
@@ -421,7 +418,7 @@ class ViewportSession:
 
 def _mean_confidence(renderer: FrameRenderer, key: str) -> float | None:
     """Mean reservoir confidence M per sample over the pixels that have one (None: no such reservoirs)."""
-    m = renderer.acc.get(key)
+    m = renderer.sums(key)
     if m is None or not renderer.samples_done:
         return None
     hit = m > 0

@@ -93,8 +93,8 @@ def instrument() -> None:
         for name in ("eval_view", "sample_bsdf"):
             if hasattr(mod, name):
                 setattr(mod, name, _timed(getattr(mod, name)))
-    from restir_engine.core import renderer
-    for mod, name in ((surface, "pick_components"), (target, "fresnel_exact"), (renderer, "denoising_albedo"),
+    from restir_engine.core.pipeline import film
+    for mod, name in ((surface, "pick_components"), (target, "fresnel_exact"), (film, "denoising_albedo"),
                       (pathtracer, "diffuse_f"), (gi, "diffuse_f")):
         if hasattr(mod, name):
             setattr(mod, name, _timed(getattr(mod, name)))

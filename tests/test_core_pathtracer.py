@@ -217,21 +217,21 @@ def test_camera_rays_outside_the_objects_boxes_are_not_traced(monkeypatch):
     """The window pixels outside the projected boxes of the instances (camera.box_pixels) skip the geometry, those
     outside the visible lamps' boxes the lamps: the image is bit-identical to tracing every camera ray against
     everything (same seed), on both integrators."""
-    from restir_engine.core import renderer
+    from restir_engine.core.integrators import pathtracer
+    from restir_engine.core.integrators.context_cache import context_for
+    from restir_engine.core.pipeline import coverage
     scene = _objects_under_world()
     for integrator in ("PATH", "RESTIR"):
         st = RenderSettings(samples=2, max_bounces=2, seed=5, integrator=integrator, direct_method="AUTO",
                             indirect_method="AUTO", data_passes=False)
         masked = render_frame(scene, st)
-        ctx_mask = renderer._geometry_mask(renderer.context_for(scene, 2, False, renderer.pathtracer.build_context)[0],
-                                           scene.camera)
+        ctx_mask = coverage.geometry_mask(context_for(scene, 2, False, pathtracer.build_context)[0], scene.camera)
         assert ctx_mask is not None and 0.02 < ctx_mask.mean() < 0.5
-        lamp_mask = renderer._lamp_mask(renderer.context_for(scene, 2, False, renderer.pathtracer.build_context)[0],
-                                        scene.camera)
+        lamp_mask = coverage.lamp_mask(context_for(scene, 2, False, pathtracer.build_context)[0], scene.camera)
         assert lamp_mask is not None and 0.001 < lamp_mask.mean() < 0.2
         with monkeypatch.context() as m:
-            m.setattr(renderer, "_geometry_mask", lambda ctx, camera: None)
-            m.setattr(renderer, "_lamp_mask", lambda ctx, camera: None)
+            m.setattr(coverage, "geometry_mask", lambda ctx, camera: None)
+            m.setattr(coverage, "lamp_mask", lambda ctx, camera: None)
             full = render_frame(scene, st)
         assert np.array_equal(masked.passes["Combined"], full.passes["Combined"])
         # the objects are in the image: the mask did not just cover an empty view

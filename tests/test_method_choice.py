@@ -124,19 +124,20 @@ def test_gi_reservoir_pass_makes_auto_resample():
 def test_auto_probe_traces_at_most_probe_max_paths(monkeypatch):
     """The probe of a frame without a measurement traces one pixel in PROBE_PIXELS, at most PROBE_MAX (its cost
     stays bounded at high resolutions): its camera rays are the first the frame traces."""
-    from restir_engine.core import renderer
+    from restir_engine.core.integrators import pathtracer
+    from restir_engine.core.pipeline import indirect_choice
     sizes = []
-    real = renderer.pathtracer.primary
+    real = pathtracer.primary
 
     def recording(ctx, x, *a, **k):
         sizes.append(len(x))
         return real(ctx, x, *a, **k)
 
-    monkeypatch.setattr(renderer.pathtracer, "primary", recording)
+    monkeypatch.setattr(pathtracer, "primary", recording)
     scene = bounce_room(DIFFUSE, DIFFUSE, 48, 36)
     _auto(scene, samples=1, seed=11)
-    assert sizes[0] == 48 * 36 // renderer.PROBE_PIXELS
-    monkeypatch.setattr(renderer, "PROBE_MAX", 20)
+    assert sizes[0] == 48 * 36 // indirect_choice.PROBE_PIXELS
+    monkeypatch.setattr(indirect_choice, "PROBE_MAX", 20)
     sizes.clear()
     r = _auto(scene, samples=1, seed=12)
     assert sizes[0] == 20 and r.stats["indirect_method"] == "RESTIR_GI"

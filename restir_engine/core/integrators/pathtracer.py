@@ -410,16 +410,26 @@ class FirstBounce:
     lo_d: np.ndarray = None
 
 
+@dataclass
+class PathResult:
+    """What :func:`continue_paths` found for primary surfaces (n): ``direct`` (3, n) the first BSDF ray's emitter
+    hits (MIS-weighted) and the world it escapes to; ``indirect`` (3, n) bounces 1..max_bounces; ``first`` the
+    :class:`FirstBounce` when asked for (indirect is then its throughput · lo), else None. Radiance, scene-linear."""
+
+    direct: np.ndarray
+    indirect: np.ndarray
+    first: FirstBounce | None = None
+
+
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
                    first_ray=None, first_bounce: bool = False, budget: np.ndarray | None = None,
-                   world_resampled: bool = False):
-    """Continue paths from primary surfaces s (n). Returns (direct (3, n): the first BSDF ray's emitter hits
-    (MIS-weighted; none when ``direct_resampled``) and the world it escapes to (none when ``world_resampled``: the
-    reservoirs hold the world's points too, world_points.py); indirect (3, n): bounces
-    1..max_bounces). ``first_ray`` (a traced :class:`BsdfRay` from s, e.g. ReSTIR's BSDF candidate) is used as
-    the first ray instead of drawing a new one. With ``first_bounce`` a third value, :class:`FirstBounce`, tells
-    where the first rays went and what radiance left there (indirect is then its throughput · lo). ``budget`` (n,)
-    (optional): the bounces each path may still take (fewer than max_bounces behind a specular chain)."""
+                   world_resampled: bool = False) -> PathResult:
+    """Continue paths from primary surfaces s (n) (:class:`PathResult`). With ``direct_resampled`` the direct part
+    leaves out the emitters resampling reaches, with ``world_resampled`` the world too (the reservoirs hold the
+    world's points, world_points.py). ``first_ray`` (a traced :class:`BsdfRay` from s, e.g. ReSTIR's BSDF candidate)
+    is used as the first ray instead of drawing a new one. ``first_bounce`` asks for the :class:`FirstBounce`.
+    ``budget`` (n,) (optional): the bounces each path may still take (fewer than max_bounces behind a specular
+    chain)."""
     n = len(s)
     direct = np.zeros((3, n), np.float32)
     indirect = np.zeros((3, n), np.float32)
@@ -537,7 +547,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             idx = np.arange(len(idx))
             throughput = np.ones((3, len(idx)), np.float32)
     if not first_bounce:
-        return direct, indirect
+        return PathResult(direct, indirect)
     if first is None:
         first = FirstBounce(np.zeros(0, np.int64), np.zeros((3, 0), np.float32), np.zeros(0, np.float32),
                             np.zeros((3, 0), np.float32), np.zeros((3, 0), np.float32),
@@ -547,7 +557,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         first.lo = finite(first.lo)
         first.lo_d = finite(first.lo_d)
         indirect[:, first.rows] = first.throughput * first.lo
-    return direct, indirect, first
+    return PathResult(direct, indirect, first)
 
 
 def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):

@@ -1,0 +1,446 @@
+"""One frame's lifecycle: its trace context (acceleration structures, light table), methods, film and temporal
+history, rendering sample passes through the stages the pass's plan names (plan.py lists them in order).
+
+Images are (h, w, c) float32 with row 0 at the *bottom* (Blender's pass order), covering the camera window
+(border) only. Temporal reuse runs through the first sample pass of each frame: pass 0 reuses the previous frame's
+pass 0 (``prev_history``) and becomes the next frame's (``history``); the other passes of a frame are independent of
+each other, so a frame's average is not correlated.
+
+Sample batches: a pass that keeps no per-pixel state between its stages (no reservoirs, no ReSTIR GI, no
+measurement) may render several samples at once: its chunks then hold their pixel span once per sample, so every
+array of the pass is that many times longer, and a pass that would be bound by NumPy's per-call cost (few pixels
+see a surface) fills its chunks (:meth:`FrameRenderer.batch_size`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..integrators import pathtracer
+from ..integrators.context_cache import context_for, fingerprint
+from ..integrators.method_choice import GI_MIN_SHARE
+from ..parallel.tasks import Progress, Stopped
+from ..profile import NullClock
+from ..restir import di, gi
+from ..restir.history import TemporalHistory
+from ..restir.target import WIDTH, ShadingTerms
+from ..sampling import finite
+from ..scene import Scene
+from . import coverage as coverage_mod
+from . import direct, methods, paths, primary, reuse, shade
+from .data_passes import render_data_passes
+from .film import Film
+from .indirect_choice import IndirectChoice, ratios
+from .plan import PassPlan
+from .runner import PassRunner
+from .settings import RenderSettings, validate
+from .work import make_chunks, place
+
+MAX_BATCH = 8  # samples one pass renders at most (FrameRenderer.batch_size)
+
+
+class Cancelled(Exception):
+    """Raised when ``should_stop`` asked to stop before any sample pass finished."""
+
+
+@dataclass
+class FrameResult:
+    """passes: name -> (h, w, c) float32 (bottom row first); samples_done; seconds; cancelled; stats (with
+    "stages" when a clock timed the frame); history for the next frame (ReSTIR with temporal reuse)."""
+
+    passes: dict
+    samples_done: int
+    seconds: float
+    cancelled: bool = False
+    stats: dict = field(default_factory=dict)
+    history: object = None
+
+
+class FrameRenderer:
+    """One frame's acceleration structures and light table, rendering sample passes into its film.
+
+    ``render_frame`` drives it for final renders; the viewport keeps one alive between redraws and swaps the camera
+    with :meth:`move_camera` (geometry and lights stay built).
+    """
+
+    def __init__(self, scene: Scene, settings: RenderSettings, history=None, clock=None):
+        validate(settings)
+        t0 = time.perf_counter()
+        self.settings = settings
+        self.clock = clock or NullClock()
+        bounces = methods.bounces(settings)
+        self.ctx, self.context_reused = context_for(scene, bounces, settings.film_transparent,
+                                                    pathtracer.build_context)
+        self.indirect = IndirectChoice(settings, bounces, methods.gi_auto(settings), self.ctx)
+        self.gi = None  # gi.GISettings when the indirect light is resampled
+        if settings.integrator == "RESTIR":
+            cam = scene.camera
+            self.spatial = methods.spatial_settings(settings, cam)
+            if methods.gi_possible(settings):
+                self.gi, self.gi_spatial = methods.gi_settings(settings, cam)
+                unbiased = settings.bias_correction == "UNBIASED"
+                self.gi_space = gi.GISpace(self.ctx.geom_accel if unbiased else None, settings.gi_target)
+                lights, lamps = self.ctx.lights, self.ctx.scene.lamps
+                # any change of what emits light (a lamp moved, switched, re-coloured) drops the GI history:
+                # its cached radiance would be stale
+                self.gi_light_key = fingerprint(lights.tri_verts, lights.rows_le, lights.power, lamps.sun_dir,
+                                                lamps.sun_irradiance, self.ctx.scene.world_radiance,
+                                                getattr(self.ctx.scene, "world_image", None))
+        self._choose_direct()
+        self.space = di.LightSpace(self.ctx.lights)
+        self.build_seconds = time.perf_counter() - t0
+        self.set_camera(scene.camera)
+        if history is not None and history.fits(scene.camera):
+            self.adopt_history(history)
+
+    # -- methods ------------------------------------------------------------------------------------
+    def _choose_direct(self) -> None:
+        self._indirect_seen = self.indirect.method  # the indirect method this choice knew of
+        self.direct = methods.choose_direct(self.settings, self.ctx.lights, self.ctx.max_bounces,
+                                            self.indirect.method == "RESTIR_GI")
+
+    @property
+    def method(self) -> str:
+        """The direct method: "PATH" (path tracer) or one of di.DIRECT_METHODS."""
+        return self.direct.method
+
+    @property
+    def candidates(self):
+        """di.CandidateSettings when the direct light is resampled, else None."""
+        return self.direct.candidates
+
+    @property
+    def indirect_method(self) -> str:
+        return self.indirect.method
+
+    @property
+    def gi_auto(self) -> bool:
+        return self.indirect.auto
+
+    def _gi_runs(self) -> bool:
+        """ReSTIR GI runs in the next pass (Auto: while its last measurement says so)."""
+        return self.gi is not None and (not self.gi_auto or self.indirect.method == "RESTIR_GI")
+
+    # -- camera, history and film -------------------------------------------------------------------
+    def adopt_history(self, history) -> None:
+        """Reuse ``history`` (restir.history.TemporalHistory, from another frame or view of this scene or of an
+        edited one) in the next first sample pass: its reservoirs are remapped to this light table (dropped
+        when they cannot be) and its GI reservoirs dropped when anything that emits changed. Reprojection
+        projects with the history's own camera, so its resolution may differ from this one's."""
+        hist = history.remapped(self.ctx.lights)  # None: the lights cannot be mapped
+        if hist is not None and hist.gi_res is not None and (self.gi is None or hist.gi_key != self.gi_light_key):
+            hist = dataclasses.replace(hist, gi_res=None, gi_terms=None)
+        self.prev_history = hist
+
+    def latest_history(self):
+        """The newest temporal history: the current view's first pass's, else the one that pass would reuse."""
+        return self.history if self.history is not None else self.prev_history
+
+    def reuses_history(self) -> bool:
+        """Whether the next first pass merges with a previous frame's (or view's) DI reservoirs."""
+        h = self.prev_history
+        return bool(self.settings.temporal_reuse and h is not None and h.res is not None)
+
+    def move_camera(self, camera, frame: int) -> None:
+        """Viewport navigation: render the same scene from ``camera`` (any resolution) as frame ``frame`` (keys
+        the random streams, so a new view never repeats the last one's noise) and restart accumulation; the
+        newest history is reprojected into the new view's first pass (temporal reuse, as between the frames
+        of an animation with a moving camera)."""
+        hist = self.latest_history()
+        self.settings = dataclasses.replace(self.settings, frame=int(frame))
+        self.indirect.frame = int(frame)
+        self.set_camera(camera)
+        if hist is not None and self.settings.temporal_reuse:
+            self.prev_history = hist
+
+    def set_motion(self, motion) -> None:
+        """The scene's motion (scene.Motion) for the next pass's temporal reprojection."""
+        self.ctx.scene.motion = motion
+
+    def set_camera(self, camera) -> None:
+        """Use another camera (same scene) and restart accumulation."""
+        self.ctx.scene.camera = camera
+        self.coverage, self.coverage_reason, self.coverage_mask = coverage_mod.coverage(
+            self.settings.coverage_samples, self.ctx.lights, self.ctx.scene.lamps, camera)
+        self.masks = primary.CameraMasks(self.coverage_mask, coverage_mod.geometry_mask(self.ctx, camera),
+                                         coverage_mod.lamp_mask(self.ctx, camera))
+        _x0, _y0, w, h = camera.window
+        self.release()
+        self.film = Film(w, h, self.gi is not None, self.settings.denoise_data)
+        self._surfaces_per_chunk = None  # surfaces per chunk and sample in the last pass (batch_size)
+        self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
+        self.gi_skipped = 0  # samples whose pass kept path-traced indirect light (GI_MIN_SHARE)
+        self.reuse_stats = {}  # the last pass's temporal acceptance and confidence (diagnostics)
+        self.used_tiles = False
+        self._data = None
+        self.prev_history = None
+        self.history = None
+
+    @property
+    def samples_done(self) -> int:
+        return self.film.samples
+
+    def has_pass_data(self, key: str) -> bool:
+        """Whether the film accumulates ``key`` (film.py lists the keys)."""
+        return self.film.has(key)
+
+    def sums(self, key: str):
+        """The film's running sum ``key`` (float64, over the samples done), or None where it is not kept."""
+        return self.film.acc.get(key)
+
+    def release(self) -> None:
+        """Hand the film's accumulators back for the next frame's renderer (after :meth:`passes`; this renderer
+        cannot accumulate any more)."""
+        film = getattr(self, "film", None)
+        if film is not None:
+            film.release()
+
+    def combined(self) -> np.ndarray:
+        return self.film.combined()
+
+    def mean(self, key: str) -> np.ndarray:
+        return self.film.mean(key)
+
+    def data_passes(self):
+        """Depth (h, w, 1), Normal (h, w, 3) and Vector (h, w, 4) at pixel centres (data_passes.py)."""
+        if self._data is None:
+            self._data = render_data_passes(self.ctx, self.settings.tile_pixels)
+        return self._data
+
+    def passes(self) -> dict:
+        """All passes (see :class:`FrameResult`); float32, finite everywhere."""
+        out = self.film.passes(self.candidates is not None)
+        if self.settings.data_passes:
+            out["Depth"], out["Normal"], out["Vector"] = (finite(a) for a in self.data_passes())
+        return out
+
+    # -- one sample pass ------------------------------------------------------------------------------
+    def sample_pass(self, progress=None, should_stop=None, batch: int = 1, light_candidate_cap: int | None = None
+                    ) -> bool:
+        """Render the next sample pass (one path per pixel; ``batch`` per pixel where the pass can) into the film,
+        with at most ``light_candidate_cap`` light candidates (viewport navigation). Returns False, keeping the film
+        unchanged, when ``should_stop`` asked to stop part-way."""
+        try:
+            done = self._sample_pass(progress, should_stop, batch, light_candidate_cap)
+        except Stopped:
+            return False
+        self.film.samples += done
+        return True
+
+    def batch_size(self, remaining: int) -> int:
+        """Samples the next pass should render at once (at most ``remaining``): the setting, else as many as bring a
+        chunk to about ``tile_pixels`` surfaces, judged by the last pass (1 before any pass), at most MAX_BATCH."""
+        st = self.settings
+        if not self._can_batch():
+            return 1
+        if st.sample_batch > 0:
+            return max(1, min(remaining, int(st.sample_batch)))
+        if self._surfaces_per_chunk is None:
+            return 1
+        return max(1, min(remaining, MAX_BATCH, int(st.tile_pixels // max(self._surfaces_per_chunk, 1.0))))
+
+    def _can_batch(self) -> bool:
+        """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
+        ReSTIR GI) and measures nothing for Auto indirect (no probe; the first pass without a measurement probes)."""
+        if self.candidates is not None or self._gi_runs():
+            return False
+        if self.gi is None or self.samples_done > 0:
+            return True
+        return self.indirect.measured and not self.indirect.probe_due()
+
+    def _plan(self, batch: int, cap) -> PassPlan:
+        """The pass's plan (plan.py), after the Auto indirect probe where nothing is measured yet."""
+        st, ctx = self.settings, self.ctx
+        s = self.samples_done
+        if not self._can_batch():
+            batch = 1
+        if self.gi_auto and s == 0 and not self.indirect.measured:
+            with self.clock.stage("probe"):  # nothing measured yet (a still, a first frame): measure before choosing
+                self._measured(self.indirect.probe(ctx, st.seed, self.masks.may_hit, self._make_gi))
+        gi_on = self._gi_runs()
+        probe = self.gi_auto and not gi_on and s == 0 and self.indirect.start_first_pass()
+        candidates = self.candidates
+        resampled = candidates is not None
+        if resampled and cap is not None and candidates.light_candidates > cap:
+            candidates = dataclasses.replace(candidates, light_candidates=cap)
+        world_resampled = resampled and candidates.world_resampled(ctx.lights)
+        _x0, _y0, w, h = ctx.scene.camera.window
+        hist = self.prev_history
+        first_with_history = st.temporal_reuse and s == 0 and hist is not None
+        return PassPlan(
+            seed=st.seed, frame=st.frame, sample=s, batch=max(1, int(batch)), resampled=resampled,
+            reusing=self.method == "RESTIR", temporal=first_with_history and hist.res is not None, gi=gi_on,
+            gi_temporal=first_with_history and hist.gi_res is not None, probe=probe,
+            glass_chains=st.integrator == "RESTIR" and (resampled or gi_on), world_resampled=world_resampled,
+            continuing=pathtracer.needs_continuation(ctx, resampled, world_resampled), strata=self.coverage,
+            candidates=candidates, light_tiles=bool(resampled and ctx.lights.tri_alias is not None
+                                                    and candidates.tile_settings.wanted(w * h,
+                                                                                        candidates.light_candidates)))
+
+    def _make_gi(self, surf, first, block, filled: bool = False):
+        return paths.gi_initial(self.gi, self.gi_space, surf, first, block, filled)
+
+    def _measured(self, diagnostics: dict) -> None:
+        """Auto indirect chose again (IndirectChoice.update): the Auto direct method follows when its premise (GI
+        or not) changed; it applies from the next pass on."""
+        before = self._indirect_seen
+        self._indirect_seen = self.indirect.method
+        self.reuse_stats.update(diagnostics)
+        if self.indirect.method != before and self.settings.direct_method == "AUTO":
+            self._choose_direct()
+
+    def _sample_pass(self, progress, should_stop, batch: int, cap) -> int:
+        """One pass of ``plan.batch`` samples through the stages. Returns the samples rendered."""
+        st, ctx, clock = self.settings, self.ctx, self.clock
+        plan = self._plan(batch, cap)
+        _x0, _y0, w, h = ctx.scene.camera.window
+        chunks = make_chunks(PassRunner(plan, None, clock, st.tile_pixels).spans(w * h), plan.batch)
+        # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
+        chunk_stages = 4 + int(plan.resampled) + (int(self.spatial.passes) + 1 if plan.reusing else 0) + \
+            (int(self.gi.passes) + 1 if plan.gi else 0)
+        run = PassRunner(plan, Progress(progress, should_stop, len(chunks) * chunk_stages), clock, st.tile_pixels)
+
+        with run.stage("primary"):
+            run.map(lambda c: primary.primary(ctx, plan, self.masks, c), chunks)
+            n_surf = place(chunks)
+            self._surfaces_per_chunk = n_surf / (len(chunks) * plan.batch)
+        candidates = plan.candidates
+        if plan.resampled:
+            self.reuse_stats["light_candidates"] = candidates.light_candidates
+        if plan.light_tiles:
+            with run.stage("initial"):
+                candidates = direct.with_light_tiles(ctx, plan, chunks, st.light_sampler)
+            self.used_tiles = True
+        # the frame's target terms, one (WIDTH, surfaces) block the chunks write into (reuse gathers from it)
+        terms = np.empty((WIDTH, n_surf), np.float32) if plan.resampled else None
+        # ReSTIR GI's target terms: the same, with the specular lobe off at glossy primary surfaces
+        gi_terms = np.empty((WIDTH, n_surf), np.float32) if plan.gi or plan.probe else None
+        if plan.resampled:
+            with run.stage("initial"):
+                run.map(lambda c: direct.initial(ctx, plan, candidates, terms, c), chunks)
+        with run.stage("paths"):
+            run.map(lambda c: paths.paths(ctx, plan, terms, gi_terms, self._make_gi, c), chunks)
+        gi_reused = self._gi_outcome(plan, chunks)
+        if self.gi is not None and not gi_reused:
+            self.gi_skipped += plan.batch
+        gb = res = gi_res = gb_gi = gi_history = None
+        if plan.reusing or gi_reused:
+            with run.stage("gbuffer"):
+                gb = primary.gbuffer(ctx, chunks, terms if plan.reusing else gi_terms)
+        if plan.reusing:
+            with run.stage("gbuffer"):
+                res = di.DIReservoirs.empty(len(gb))
+                for c in chunks:
+                    res.assign(c.surfaces, c.res)
+                    c.res = None  # the frame's array holds them now
+            res, dropped = reuse.reuse_di(run, st, ctx, self.space, self.spatial, gb, res, self.prev_history,
+                                          self.reuse_stats)
+            self.boiling_dropped += dropped
+            for c in chunks:
+                c.res = res.take(c.surfaces)
+        if gi_reused:
+            with run.stage("gbuffer"):
+                gb_gi = gb.with_terms(ShadingTerms(gi_terms))
+                gi_res = gi.GIReservoirs.empty(len(gb))
+                for c in chunks:
+                    gi_res.assign(c.surfaces, c.gi_res)
+                    c.gi_res = None
+            gi_res, gi_history = reuse.reuse_gi(run, st, ctx, self.gi, self.gi_space, self.gi_spatial, gb_gi, gi_res,
+                                                self.prev_history, self.reuse_stats)
+            for c in chunks:
+                c.gi_res = gi_res.take(c.surfaces)
+        if plan.sample == 0 and gb is not None:
+            self._keep_history(gb, res, gb_gi, gi_history, gi_reused)
+        unbiased = st.bias_correction == "UNBIASED"
+        with run.stage("shade"):
+            run.map(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c), chunks)
+        with run.stage("passes"):
+            world_to_cam = np.ascontiguousarray(ctx.scene.camera.cam_to_world[:3, :3].T, dtype=np.float32)
+            self.film.accumulate(chunks, plan.resampled, world_to_cam, run.stop)
+        return plan.batch
+
+    def _gi_outcome(self, plan: PassPlan, chunks) -> bool:
+        """After the paths stage: whether this pass reuses GI. GI reuse only pays where its reservoirs carry the
+        indirect light: a scene with no bounce light to cache (the default cube) keeps the path-traced indirect
+        light as it is (GI_MIN_SHARE); Auto measures here for the next passes."""
+        gi_on = plan.gi
+        if not (plan.gi or plan.probe):
+            return gi_on
+        sums = np.sum([c.gi_share for c in chunks], axis=0)
+        share, uncached = ratios(sums)
+        self.reuse_stats["gi_share"], self.reuse_stats["gi_uncached"] = share, uncached
+        if self.gi_auto:
+            self._measured(self.indirect.update(sums))  # for the next passes
+        elif share < GI_MIN_SHARE:
+            gi_on = False
+        if not gi_on:
+            paths.keep_path_traced(chunks)
+        for c in chunks:
+            c.path_indirect = None
+        return gi_on
+
+    def _keep_history(self, gb, res, gb_gi, gi_history, gi_reused: bool) -> None:
+        """The next frame's history from this first pass; confidence at most the cap, so no reused M exceeds it."""
+        st, lights = self.settings, self.ctx.lights
+        self.history = TemporalHistory(
+            gb, None if res is None else res.replace(M=np.minimum(res.M, st.confidence_cap)), self.ctx.scene.camera,
+            lights.signature, st.frame, lights.light_uid, lights.uid_space,
+            gi_res=None if gi_history is None else reuse.age_history(self.gi, gi_history),
+            gi_terms=None if gb_gi is None else gb_gi.terms, gi_key=self.gi_light_key if gi_reused else None)
+
+
+def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
+                 clock=None) -> FrameResult:
+    """Render one frame with the chosen integrator.
+
+    progress(fraction, message) is called as chunks finish; should_stop() is polled while they run,
+    and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none).
+    """
+    t0 = time.perf_counter()
+    fr = FrameRenderer(scene, settings, history, clock)
+    cancelled = False
+    while fr.samples_done < settings.samples:
+        s = fr.samples_done
+        batch = fr.batch_size(settings.samples - s)
+        report = None
+        if progress:
+            def report(f, s=s, b=batch):
+                label = f"Sample {s + 1}/{settings.samples}" if b == 1 else \
+                    f"Samples {s + 1}-{s + b}/{settings.samples}"
+                progress((s + f * b) / settings.samples, label)
+        if not fr.sample_pass(report, should_stop, batch):
+            cancelled = True
+            break
+    if fr.samples_done == 0:
+        raise Cancelled("render cancelled before the first sample pass finished")
+    with fr.clock.stage("passes"):
+        passes = fr.passes()
+    samples_done = fr.samples_done
+    fr.release()
+    return FrameResult(passes, samples_done, time.perf_counter() - t0, cancelled, frame_stats(fr, scene, clock),
+                       fr.history)
+
+
+def frame_stats(fr: FrameRenderer, scene: Scene, clock) -> dict:
+    """The frame's diagnostics: methods chosen and why, reuse statistics, counts, timings."""
+    ctx = fr.ctx
+    stats = {"build_seconds": fr.build_seconds, "light_tiles": fr.used_tiles, "triangles": len(scene.geometry),
+             "light_triangles": ctx.lights.n_tri, "suns": ctx.lights.n_sun, "boiling_dropped": fr.boiling_dropped,
+             "context_reused": fr.context_reused, "coverage_samples": fr.coverage,
+             "direct_method": fr.method, "direct_reason": fr.direct.reason,
+             "world_method": fr.direct.world_method, "world_reason": fr.direct.world_reason,
+             "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None, "reuse": dict(fr.reuse_stats),
+             "coverage_reason": fr.coverage_reason,
+             # Auto: the latest choice; otherwise ReSTIR GI unless every pass kept the path-traced light
+             "indirect_method": ("OFF" if ctx.max_bounces == 0 else "PATH" if fr.gi is None else fr.indirect_method
+                                 if fr.gi_auto else "PATH" if fr.gi_skipped == fr.samples_done else
+                                 "RESTIR_GI"),
+             "indirect_reason": fr.indirect.reason,
+             "gi_skipped_passes": fr.gi_skipped,
+             "gi_spatial_radius": fr.gi.radius if fr.gi is not None else None}
+    if clock is not None:
+        stats["stages"] = clock.stages
+    return stats

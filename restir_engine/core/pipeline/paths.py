@@ -1,0 +1,58 @@
+"""Paths stage: the first vertex's BSDF ray and bounces 1..max_bounces (integrators/pathtracer.continue_paths).
+
+It needs no reservoir, so it runs before reuse, and the BSDF candidate's ray it takes over is freed early. Where GI
+runs (or Auto measures), the first bounces become GI's initial reservoirs, and the chunk keeps the path-traced
+indirect light too, for a pass that finds GI carries too little of it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..integrators import pathtracer
+from ..restir import gi
+from ..restir.target import ShadingTerms
+from ..sampling import STREAM_PATH
+from .indirect_choice import PROBE_EVERY, share_sums
+from .plan import PassPlan
+from .work import Chunk
+
+
+def gi_initial(settings: gi.GISettings, space, surf, first, block: np.ndarray, filled: bool = False):
+    """ReSTIR GI's initial reservoirs at surfaces ``surf`` from their first bounces (pathtracer.FirstBounce):
+    (glossy x1 (n,) bool, gi.GIReservoirs, the path-traced indirect light they do not carry (3, n)). ``block``
+    (WIDTH, n) receives the GI target terms (already holding the surfaces' target terms when ``filled``)."""
+    if not filled:
+        ShadingTerms.of_surfaces(surf, block)
+    glossy = gi.glossy_x1(surf.params, settings.roughness_threshold)
+    res, rest = gi.initial(first, gi.diffuse_only(ShadingTerms(block), glossy), len(surf), glossy, space)
+    return glossy, res, rest
+
+
+def paths(ctx, plan: PassPlan, terms, gi_terms, make_gi, c: Chunk) -> None:
+    """Fill ``c.direct`` / ``c.indirect`` (None when nothing continues); where the chunk measures or GI runs, its
+    GI reservoirs and target terms (``gi_terms``, copied from ``terms`` where DI filled them), ``c.glossy``,
+    ``c.gi_share`` and the path-traced indirect light in ``c.path_indirect``. ``make_gi(surf, first, block,
+    filled)`` is :func:`gi_initial` bound to the frame's GI settings."""
+    if not plan.continuing:
+        c.direct, c.indirect = None, None
+        return
+    out = pathtracer.continue_paths(
+        ctx, c.hits.surf, plan.rng(STREAM_PATH, c.index), direct_resampled=plan.resampled, first_ray=c.bsdf_ray,
+        first_bounce=plan.gi or (plan.probe and c.index % PROBE_EVERY == 0),
+        budget=None if c.chain is None else ctx.max_bounces - c.chain.depth, world_resampled=plan.world_resampled)
+    c.bsdf_ray = None
+    c.direct, c.indirect = out.direct, out.indirect
+    if out.first is not None:  # the first bounces: GI's initial samples (and the Auto measurement)
+        block = gi_terms[:, c.surfaces]
+        if plan.resampled:
+            block[:] = terms[:, c.surfaces]
+        c.path_indirect = c.indirect
+        c.glossy, c.gi_res, c.indirect = make_gi(c.hits.surf, out.first, block, filled=plan.resampled)
+        c.gi_share = share_sums(c.path_indirect, c.indirect)
+
+
+def keep_path_traced(chunks: list[Chunk]) -> None:
+    """A pass that does not reuse GI: each chunk's indirect light is the path-traced one again, no GI reservoirs."""
+    for c in chunks:
+        if c.path_indirect is not None:
+            c.indirect, c.gi_res = c.path_indirect, None

@@ -1,0 +1,84 @@
+"""Primary stage: camera rays through a chunk's pixels, the emission seen directly, glass chains; and the frame's
+G-buffer assembled from the chunks' primary hits.
+
+The pass's position in a pixel is Sobol point s, digitally shifted per pixel (the shift keyed without the pass).
+With pixel coverage (``plan.strata`` > 1) the pixel is split into that many strata: the surface is shaded at the
+pass's ray (in whichever stratum it falls), the emission seen directly (and alpha) is averaged over one ray per
+stratum, both unbiased estimates of the box-filtered pixel.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry import camera as camera_mod
+from ..integrators import pathtracer
+from ..restir.gbuffer import GBuffer
+from ..restir.target import ShadingTerms
+from ..sampling import STREAM_CAMERA, STREAM_CHAIN, STREAM_PIXEL_OFFSET, pass_jitter
+from .plan import PassPlan
+from .work import Chunk
+
+
+class CameraMasks:
+    """Which camera rays trace what (coverage.py): ``coverage`` (window pixels,) bool or None, the pixels that get
+    the coverage rays; ``may_hit`` where a ray may meet geometry; ``lamps`` where it may see a lamp."""
+
+    def __init__(self, coverage_mask, may_hit, lamps):
+        self.coverage, self.may_hit, self.lamps = coverage_mask, may_hit, lamps
+
+
+def primary(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
+    """Fill ``c.hits`` (and ``c.chain`` where camera rays continue through glass)."""
+    camera_rays(ctx, plan, masks, c)
+    if plan.glass_chains and ctx.has_glass:
+        # camera rays that met glass continue to the surface behind it, where resampling runs (without
+        # resampling, the path continuation handles glass as the path tracer does, at less cost)
+        c.chain = pathtracer.follow_specular(ctx, c.hits, plan.rng(STREAM_CHAIN, c.index))
+
+
+def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
+    x0, y0, w, _h = ctx.scene.camera.window
+    s = plan.sample
+    r = plan.rng(STREAM_CAMERA, c.index)
+    span = len(c.pixels) // c.batch
+    shift = plan.rng(STREAM_PIXEL_OFFSET, c.index, sample=0).bit_generator.random_raw(span)
+    shift = shift.view(np.uint32).reshape(-1, 2)
+    j = pass_jitter(shift, s) if c.batch == 1 else np.concatenate([pass_jitter(shift, s + b) for b in range(c.batch)])
+    px = (x0 + c.pixels % w).astype(np.float32)
+    py = (y0 + c.pixels // w).astype(np.float32)
+    hit_mask = None if masks.may_hit is None else masks.may_hit[c.pixels]
+    lamp_seen = None if masks.lamps is None else masks.lamps[c.pixels]
+    c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1], hit_mask, lamp_seen)
+    strata = plan.strata
+    if strata == 1:
+        return
+    # one more ray in each other stratum than the shaded ray's, in the pixels near an emitter (masks.coverage)
+    g = int(round(np.sqrt(strata)))
+    sel = slice(None) if masks.coverage is None else np.flatnonzero(masks.coverage[c.pixels])
+    jx, jy, sx, sy = j[sel, 0], j[sel, 1], px[sel], py[sel]
+    if len(jx) == 0:
+        return
+    k0 = np.minimum((jx * g).astype(np.int64), g - 1) + g * np.minimum((jy * g).astype(np.int64), g - 1)
+    k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
+    jj = r.random((2,) + k.shape, dtype=np.float32)
+    em, al = pathtracer.seen_emission(ctx, (sx + ((k % g).astype(np.float32) + jj[0]) / g).ravel(),
+                                      (sy + ((k // g).astype(np.float32) + jj[1]) / g).ravel())
+    inv = np.float32(1.0 / strata)
+    c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
+    c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
+
+
+def gbuffer(ctx, chunks: list[Chunk], terms: np.ndarray) -> GBuffer:
+    """The frame's G-buffer from the chunks' primary hits (surfaces in chunk order) over the target terms
+    ``terms`` (WIDTH, surfaces), whose rows 0-2 are the surfaces' positions."""
+    cam = ctx.scene.camera
+    _x0, _y0, w, h = cam.window
+    surfs = [c.hits.surf for c in chunks]
+    rel = terms[0:3] - camera_mod.position(cam)[:, None]
+    fwd = camera_mod.forward(cam)
+    depth = fwd[0] * rel[0] + fwd[1] * rel[1] + fwd[2] * rel[2]  # planar depth along the camera axis
+    inst = ctx.scene.geometry.instance
+    prim = np.concatenate([sf.prim for sf in surfs])
+    return GBuffer(np.concatenate([c.pixels[c.hits.rows] for c in chunks]), w, h, depth.astype(np.float32),
+                   inst[prim] if inst is not None else np.zeros(len(prim), np.int32),
+                   np.concatenate([sf.mat for sf in surfs]), ShadingTerms(terms))

@@ -1,0 +1,24 @@
+"""Shade stage: each chunk's direct light from its reservoirs' samples with shadow rays (RIS/ReSTIR; the world by
+its own light sample where the reservoirs do not hold it) or by next-event estimation, and GI's shading of its
+reservoirs (one visibility ray each, skipped where the unbiased mode already verified them)."""
+from __future__ import annotations
+
+from ..integrators import pathtracer
+from ..restir import di, gi
+from ..sampling import STREAM_SHADE
+from .plan import PassPlan
+from .work import Chunk
+
+
+def shade(ctx, plan: PassPlan, gi_reused: bool, unbiased: bool, c: Chunk) -> None:
+    r = plan.rng(STREAM_SHADE, c.index)
+    if plan.resampled:
+        direct = di.shade(ctx, c.hits.surf, c.res, r)
+        if ctx.world.sampled and not plan.world_resampled:
+            direct = direct + pathtracer.world_event(ctx, c.hits.surf, r)
+    else:
+        direct = pathtracer.next_event(ctx, c.hits.surf, r)
+    c.direct = direct if c.direct is None else c.direct + direct
+    if gi_reused:
+        # the unbiased mode's reservoirs hold only samples their surface sees (gi.clear_occluded)
+        c.indirect = c.indirect + gi.shade(ctx.geom_accel, c.hits.surf, c.gi_res, c.glossy, verified=unbiased)

@@ -1,0 +1,54 @@
+"""The work item of a sample pass: one span of window pixels and what the stages compute for its surfaces.
+
+Pixels are row-major indices into the camera window; a chunk's random streams are keyed by (seed, frame, pass,
+stream, chunk index), so images do not depend on scheduling. Per-surface rows are (3, n) or (WIDTH, n) float32
+columns in the order of ``hits.rows``; ``first`` places them in the frame's whole-image buffers (the G-buffer and
+the target terms), which the stages that read other pixels (reuse) work on.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+CHUNK_PIXELS = 32768  # pixels per chunk of work (RenderSettings.tile_pixels)
+
+
+@dataclass
+class Chunk:
+    """One span of window pixels through a sample pass: its primary hits and per-surface results."""
+
+    index: int
+    pixels: np.ndarray     # window pixel indices (row-major): the chunk's span, ``batch`` times over
+    batch: int = 1         # samples of each pixel (sample s + b at pixels[b * span : (b + 1) * span])
+    hits: object = None    # pathtracer.PrimaryHits (rows index ``pixels``)                       [primary]
+    chain: object = None   # pathtracer.SpecularChains: its surfaces seen through smooth glass      [primary]
+    first: int = 0         # index of its first surface in the frame's G-buffer                     [primary]
+    res: object = None     # di.DIReservoirs of its surfaces (initial, then after reuse)             [initial, reuse]
+    bsdf_ray: object = None  # the BSDF candidate's traced ray, taken over by the path continuation   [initial]
+    direct: np.ndarray = None    # (3, n) direct light: the continuation's part, then the shaded part [paths, shade]
+    indirect: np.ndarray = None  # (3, n) indirect light                                              [paths, shade]
+    gi_res: object = None  # gi.GIReservoirs of its surfaces                                        [paths, gi reuse]
+    path_indirect: np.ndarray = None  # the path tracer's indirect light (kept where a pass skips GI reuse) [paths]
+    gi_share: tuple = (0.0, 0.0, 0.0, 0.0)  # indirect_choice.share_sums over its surfaces           [paths]
+    glossy: np.ndarray = None  # (n,) bool: GI resamples only the diffuse lobe there (gi.glossy_x1)  [paths]
+
+    @property
+    def surfaces(self) -> slice:
+        """Its surfaces' rows in the frame's whole-image buffers."""
+        return slice(self.first, self.first + len(self.hits.rows))
+
+
+def make_chunks(span_list, batch: int) -> list[Chunk]:
+    """One chunk per pixel span, each holding its span ``batch`` times (one copy per sample of the pass)."""
+    return [Chunk(i, np.arange(sl.start, sl.stop) if batch == 1 else np.tile(np.arange(sl.start, sl.stop), batch),
+                  batch) for i, sl in enumerate(span_list)]
+
+
+def place(chunks: list[Chunk]) -> int:
+    """Give each chunk its first row in the frame's surface order (chunk order); returns the surface count."""
+    first = 0
+    for c in chunks:
+        c.first = first
+        first += len(c.hits.rows)
+    return first
