@@ -8,8 +8,10 @@ import bpy
 import numpy as np
 
 from . import passes as pass_table
+from .core.pipeline import methods
 from .core.renderer import Cancelled, RenderSettings, render_frame
 from .export import ExportError, export_scene, neighbour_frames
+from .properties import scene_settings_to_core
 
 MAX_REPORTED_WARNINGS = 12
 
@@ -28,24 +30,9 @@ LAST_CHOICES: dict = {}
 
 
 def settings_from_scene(scene) -> RenderSettings:
-    s = scene.restir
-    return RenderSettings(samples=int(s.samples), seed=int(s.seed), max_bounces=int(s.max_bounces),
-                          frame=int(scene.frame_current), integrator=s.integrator, direct_method=s.direct_method,
-                          light_candidates=int(s.light_candidates), bsdf_candidates=int(s.bsdf_candidates),
-                          world_method=s.world_method, world_candidates=int(s.world_candidates),
-                          spatial_neighbors=int(s.spatial_neighbors), spatial_radius=float(s.spatial_radius),
-                          spatial_passes=int(s.spatial_passes), bias_correction=s.bias_correction,
-                          temporal_reuse=bool(s.temporal_reuse), confidence_cap=float(s.confidence_cap),
-                          light_tiles=s.light_tiles, light_tile_count=int(s.light_tile_count),
-                          light_tile_size=int(s.light_tile_size), light_sampler=s.light_sampler,
-                          boiling_filter=bool(s.boiling_filter),
-                          boiling_threshold=float(s.boiling_threshold),
-                          coverage_samples=0 if s.coverage_samples == "AUTO" else int(s.coverage_samples),
-                          indirect_method=s.indirect_method, gi_spatial_neighbors=int(s.gi_spatial_neighbors),
-                          gi_spatial_radius=float(s.gi_spatial_radius), gi_spatial_passes=int(s.gi_spatial_passes),
-                          gi_confidence_cap=float(s.gi_confidence_cap), gi_max_age=int(s.gi_max_age),
-                          gi_roughness_threshold=float(s.gi_roughness_threshold),
-                          film_transparent=bool(scene.render.film_transparent))
+    """The core's settings from ``scene.restir`` (properties.SCENE_FIELDS), the frame and the film's transparency."""
+    return RenderSettings(frame=int(scene.frame_current), film_transparent=bool(scene.render.film_transparent),
+                          **scene_settings_to_core(scene.restir))
 
 
 def with_data_passes(settings: RenderSettings, view_layer) -> RenderSettings:
@@ -127,9 +114,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         t0 = time.perf_counter()
         settings = with_data_passes(settings_from_scene(scene), view_layer)
         # AUTO may resolve to ReSTIR (known once the scene is exported): keep and preroll its history too
-        wants_temporal = settings.integrator == "RESTIR" and settings.temporal_reuse and (
-            settings.direct_method in ("RESTIR", "AUTO") or
-            (settings.indirect_method in ("RESTIR_GI", "AUTO") and settings.max_bounces > 0))
+        wants_temporal = methods.keeps_history(settings)
         key = (scene.name, view_layer.name)
         prev = _TEMPORAL_HISTORY.pop(key, None)
         history = prev[1] if prev is not None and prev[0] == scene.frame_current - 1 else None

@@ -4,15 +4,15 @@ core pass name). Combined is always on; the others follow the view layer's check
 reservoir passes exist only when the integrator produces reservoirs (never as placeholders)."""
 from __future__ import annotations
 
+from .core.pipeline import methods
+
 
 def has_reservoirs(scene) -> bool:
-    s = scene.restir
-    return s.integrator == "RESTIR" and s.direct_method in ("AUTO", "RIS", "RESTIR")  # AUTO resamples when asked
+    return methods.resamples_direct(scene.restir)
 
 
 def has_gi_reservoirs(scene) -> bool:
-    s = scene.restir
-    return s.integrator == "RESTIR" and s.indirect_method in ("RESTIR_GI", "AUTO") and s.max_bounces > 0  # as above
+    return methods.gi_possible(scene.restir)
 
 
 PASSES = (

@@ -1,6 +1,8 @@
 """Settings stored in the .blend: ``scene.restir`` (render) and ``view_layer.restir`` (passes)."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
@@ -24,16 +26,35 @@ def _denoise_option(settings, context):
     update_option(settings, context)
 
 
-class RestirSceneSettings(bpy.types.PropertyGroup):
-    integrator: EnumProperty(
+@dataclass(frozen=True)
+class Field:
+    """One ``scene.restir`` setting: its property name (kept as saved .blend files, presets and scripts use it), the
+    bpy.props function and its arguments, and ``to_core``, which turns the stored value into the RenderSettings
+    field of the same name (None: a Blender-side setting the core does not read)."""
+
+    name: str
+    prop: object
+    to_core: object
+    kwargs: dict
+
+
+def _coverage(value: str) -> int:
+    return 0 if value == "AUTO" else int(value)
+
+
+# The table every scene setting is written in once: RestirSceneSettings is generated from it, settings_from_scene
+# (engine.py) reads through it, and tests/blender/test_settings_table.py checks it against RenderSettings, the
+# presets and the panels.
+SCENE_FIELDS = (
+    Field("integrator", EnumProperty, str, dict(
         name="Integrator",
         description="Light transport algorithm",
         items=[("PATH", "Path Tracing", "Unbiased reference path tracer: next-event estimation and BSDF sampling "
                 "combined by multiple importance sampling", 0),
                ("RESTIR", "ReSTIR", "Direct light of the first hit by resampled importance sampling (ReSTIR DI "
                 "stages, see Direct Method); indirect light path traced", 1)],
-        default="RESTIR", update=_update_passes)
-    direct_method: EnumProperty(
+        default="RESTIR", update=_update_passes)),
+    Field("direct_method", EnumProperty, str, dict(
         name="Direct Method",
         description="How the ReSTIR integrator estimates direct light at the first hit",
         items=[("AUTO", "Auto", "Light sampling where the scene has a few lights, ReSTIR where resampling pays "
@@ -43,8 +64,8 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                 "unshadowed contribution, then trace one shadow ray (unbiased)", 1),
                ("RESTIR", "ReSTIR", "RIS, then reuse of the previous frame's reservoirs (temporal) "
                 "and of neighbouring pixels' (spatial)", 2)],
-        default="AUTO", update=_update_passes)
-    coverage_samples: EnumProperty(
+        default="AUTO", update=_update_passes)),
+    Field("coverage_samples", EnumProperty, _coverage, dict(
         name="Pixel Coverage",
         description="Camera rays per pixel for the emission seen directly (lamps, emissive surfaces, the world): "
                     "the pixel is split into strata, the lighting is shaded at one ray and the emission averaged "
@@ -55,12 +76,14 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                ("4", "4 Rays", "2 x 2 strata", 4),
                ("9", "9 Rays", "3 x 3 strata", 9),
                ("16", "16 Rays", "4 x 4 strata", 16)],
-        default="AUTO")
-    light_candidates: IntProperty(name="Light Candidates", description="Light samples per pixel resampled by RIS",
-                                  default=CandidateSettings.light_candidates, min=0, soft_max=256)
-    bsdf_candidates: IntProperty(name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",
-                                 default=CandidateSettings.bsdf_candidates, min=0, soft_max=8)
-    world_method: EnumProperty(
+        default="AUTO")),
+    Field("light_candidates", IntProperty, int, dict(
+        name="Light Candidates", description="Light samples per pixel resampled by RIS",
+        default=CandidateSettings.light_candidates, min=0, soft_max=256)),
+    Field("bsdf_candidates", IntProperty, int, dict(
+        name="BSDF Candidates", description="BSDF-sampled rays per pixel resampled by RIS",
+        default=CandidateSettings.bsdf_candidates, min=0, soft_max=8)),
+    Field("world_method", EnumProperty, str, dict(
         name="World Light",
         description="How resampled direct light treats the world (environment image or colour)",
         items=[("AUTO", "Auto", "In the reservoirs for an environment image that is the only light, else light-"
@@ -69,13 +92,13 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                                           "frames like any light"),
                ("LIGHT_SAMPLED", "Light Sampled", "One world light sample per shaded point beside the reservoirs "
                                                   "(MIS with the BSDF)")],
-        default="AUTO")
-    world_candidates: IntProperty(
+        default="AUTO")),
+    Field("world_candidates", IntProperty, int, dict(
         name="World Candidates",
         description="Directions per pixel drawn from the world's own distribution and resampled with the lights "
                     "(World Light resampled)",
-        default=CandidateSettings.world_candidates, min=0, soft_max=8)
-    light_tiles: EnumProperty(
+        default=CandidateSettings.world_candidates, min=0, soft_max=8)),
+    Field("light_tiles", EnumProperty, str, dict(
         name="Light Tiles",
         description="Draw light candidates from small presampled tiles of light points (one tile per 16x16 "
                     "pixel block) instead of the full light table: the same result on average, much cheaper "
@@ -84,69 +107,83 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                 "eight times (any image larger than about 180x180 at 32 candidates)", 0),
                ("ON", "On", "Always draw candidates from tiles", 1),
                ("OFF", "Off", "Draw every candidate from the full light table", 2)],
-        default=TileSettings.mode)
-    light_sampler: EnumProperty(
+        default=TileSettings.mode)),
+    Field("light_sampler", EnumProperty, str, dict(
         name="Tile Sampling",
         description="How the light tiles are drawn",
         items=[("SPATIAL", "Spatial", "One tile per 16x16 pixel block, drawn with more probability for the lights "
                 "near that block's surfaces (light clusters weighted by power over distance, 10 % by power alone): "
                 "surfaces next to an emitter get candidates from it", 0),
                ("POWER", "Power", "Tiles drawn by light power alone, one picked at random per block", 1)],
-        default="SPATIAL")
-    light_tile_count: IntProperty(name="Tiles", description="Light tiles drawn per sample pass", default=TileSettings.count,
-                                  min=1, soft_max=1024)
-    light_tile_size: IntProperty(name="Tile Size", description="Light points per tile", default=TileSettings.size, min=1,
-                                 soft_max=8192)
-    temporal_reuse: BoolProperty(name="Temporal Reuse", description="Reuse the reservoir the pixel's surface had "
-                                 "in the previous frame of an animation (through each frame's first sample pass; "
-                                 "the other passes stay independent, so a frame's average is not correlated)",
-                                 default=True)
-    preroll_frames: IntProperty(name="Preroll Frames", description="When an animation job starts without the "
-                                "previous frame's history (the first frame of a farm chunk), first render the first "
-                                "sample pass of this many frames before it, unsaved: the chunk then matches a "
-                                "sequential render exactly", default=3, min=0, soft_max=16)
-    confidence_cap: FloatProperty(name="Confidence Cap", description="Largest confidence M a reused reservoir keeps",
-                                  default=TemporalSettings.confidence_cap, min=1.0, soft_max=100.0)
-    spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring reservoirs merged per spatial pass",
-                                   default=SpatialSettings.neighbors, min=0, soft_max=16)
-    spatial_radius: FloatProperty(name="Radius", description="Spatial reuse radius in pixels; 0 = automatic: "
-                                  "8 px at 640x360, scaled with the image diagonal (4 px at least)",
-                                  default=SpatialSettings.radius, min=0.0, soft_max=100.0, subtype="PIXEL")
-    spatial_passes: IntProperty(name="Passes", description="Spatial reuse passes (more passes add correlation)",
-                                default=SpatialSettings.passes, min=0, soft_max=4)
-    bias_correction: EnumProperty(
+        default="SPATIAL")),
+    Field("light_tile_count", IntProperty, int, dict(
+        name="Tiles", description="Light tiles drawn per sample pass", default=TileSettings.count,
+        min=1, soft_max=1024)),
+    Field("light_tile_size", IntProperty, int, dict(
+        name="Tile Size", description="Light points per tile", default=TileSettings.size, min=1,
+        soft_max=8192)),
+    Field("temporal_reuse", BoolProperty, bool, dict(
+        name="Temporal Reuse", description="Reuse the reservoir the pixel's surface had "
+        "in the previous frame of an animation (through each frame's first sample pass; "
+        "the other passes stay independent, so a frame's average is not correlated)",
+        default=True)),
+    Field("preroll_frames", IntProperty, None, dict(
+        name="Preroll Frames", description="When an animation job starts without the "
+        "previous frame's history (the first frame of a farm chunk), first render the first "
+        "sample pass of this many frames before it, unsaved: the chunk then matches a "
+        "sequential render exactly", default=3, min=0, soft_max=16)),
+    Field("confidence_cap", FloatProperty, float, dict(
+        name="Confidence Cap", description="Largest confidence M a reused reservoir keeps",
+        default=TemporalSettings.confidence_cap, min=1.0, soft_max=100.0)),
+    Field("spatial_neighbors", IntProperty, int, dict(
+        name="Neighbors", description="Neighbouring reservoirs merged per spatial pass",
+        default=SpatialSettings.neighbors, min=0, soft_max=16)),
+    Field("spatial_radius", FloatProperty, float, dict(
+        name="Radius", description="Spatial reuse radius in pixels; 0 = automatic: "
+        "8 px at 640x360, scaled with the image diagonal (4 px at least)",
+        default=SpatialSettings.radius, min=0.0, soft_max=100.0, subtype="PIXEL")),
+    Field("spatial_passes", IntProperty, int, dict(
+        name="Passes", description="Spatial reuse passes (more passes add correlation)",
+        default=SpatialSettings.passes, min=0, soft_max=4)),
+    Field("bias_correction", EnumProperty, str, dict(
         name="Bias Correction",
         description="How merged reservoirs are normalized",
         items=[("NONE", "None (1/M)", "Fastest; darkens where neighbours could not have produced the sample", 0),
                ("UNBIASED", "Unbiased (pairwise MIS)", "Pairwise MIS weights with confidences: converges to the "
                 "path tracer and Cycles, robust where neighbours' targets differ; two target evaluations per neighbour", 1)],
-        default=SpatialSettings.bias_correction)
-    boiling_filter: BoolProperty(
+        default=SpatialSettings.bias_correction)),
+    Field("boiling_filter", BoolProperty, bool, dict(
         name="Boiling Filter", description="With bias correction None: empty reservoirs whose contribution is "
         "far above their 16x16 pixel block's mean, so a rare bright sample does not spread into blotches over "
-        "neighbours and frames. Biased (darker); never used by the unbiased mode", default=False)
-    boiling_threshold: FloatProperty(
+        "neighbours and frames. Biased (darker); never used by the unbiased mode", default=False)),
+    Field("boiling_threshold", FloatProperty, float, dict(
         name="Threshold", description="A reservoir is emptied when its contribution exceeds this many times its "
-        "block's mean (lower filters more)", default=BOILING_THRESHOLD, min=1.5, soft_max=100.0)
-    use_denoising: BoolProperty(name="Denoise", description="Denoise F12 and animation frames in the compositor: "
-                                "Blender's Denoise node (Open Image Denoise) on Combined with the Denoising Albedo "
-                                "and Normal passes (turning this on sets the nodes and passes up)", default=False,
-                                update=_denoise_option)
-    samples: IntProperty(name="Samples", description="Iterations averaged per frame", default=16, min=1,
-                         soft_max=4096)
-    viewport_samples: IntProperty(name="Viewport Samples", description="Samples the Rendered viewport accumulates "
-                                  "for a still view before it stops", default=MAX_VIEWPORT_SAMPLES, min=1,
-                                  soft_max=4096)
-    viewport_budget_ms: IntProperty(name="Navigation Budget (ms)", description="Time the first image after a view "
-                                    "change may take: while the view moves, the viewport renders at 1/2, 1/4 "
-                                    "or 1/8 resolution to stay under it, then refines at full resolution "
-                                    "(0 = always full resolution)", default=int(DEFAULT_BUDGET * 1000), min=0,
-                                    soft_max=2000)
-    seed: IntProperty(name="Seed", description="Noise pattern; different seeds give independent noise", default=0,
-                      min=0)
-    max_bounces: IntProperty(name="Max Bounces", description="Indirect bounces (0 = direct light only)",
-                             default=4, min=0, soft_max=32, max=1024)
-    indirect_method: EnumProperty(
+        "block's mean (lower filters more)", default=BOILING_THRESHOLD, min=1.5, soft_max=100.0)),
+    Field("use_denoising", BoolProperty, None, dict(
+        name="Denoise", description="Denoise F12 and animation frames in the compositor: "
+        "Blender's Denoise node (Open Image Denoise) on Combined with the Denoising Albedo "
+        "and Normal passes (turning this on sets the nodes and passes up)", default=False,
+        update=_denoise_option)),
+    Field("samples", IntProperty, int, dict(
+        name="Samples", description="Iterations averaged per frame", default=16, min=1,
+        soft_max=4096)),
+    Field("viewport_samples", IntProperty, None, dict(
+        name="Viewport Samples", description="Samples the Rendered viewport accumulates "
+        "for a still view before it stops", default=MAX_VIEWPORT_SAMPLES, min=1,
+        soft_max=4096)),
+    Field("viewport_budget_ms", IntProperty, None, dict(
+        name="Navigation Budget (ms)", description="Time the first image after a view "
+        "change may take: while the view moves, the viewport renders at 1/2, 1/4 "
+        "or 1/8 resolution to stay under it, then refines at full resolution "
+        "(0 = always full resolution)", default=int(DEFAULT_BUDGET * 1000), min=0,
+        soft_max=2000)),
+    Field("seed", IntProperty, int, dict(
+        name="Seed", description="Noise pattern; different seeds give independent noise", default=0,
+        min=0)),
+    Field("max_bounces", IntProperty, int, dict(
+        name="Max Bounces", description="Indirect bounces (0 = direct light only)",
+        default=4, min=0, soft_max=32, max=1024)),
+    Field("indirect_method", EnumProperty, str, dict(
         name="Indirect Method",
         description="How the ReSTIR integrator estimates indirect light (bounces) at the first hit",
         items=[("AUTO", "Auto", "ReSTIR GI where its reservoirs carry most of the indirect light's noise, path "
@@ -158,26 +195,41 @@ class RestirSceneSettings(bpy.types.PropertyGroup):
                 "light leaving it; reservoirs of x2 points are reused over frames (temporal) and neighbouring "
                 "pixels (spatial) with the reconnection shift. Glossy surfaces keep path-traced samples for "
                 "their sharp lobes", 2)],
-        default="AUTO", update=_update_passes)
-    gi_spatial_neighbors: IntProperty(name="Neighbors", description="Neighbouring GI reservoirs merged per spatial "
-                                      "pass (unbiased mode: one visibility ray each)",
-                                      default=GISettings.neighbors, min=0, soft_max=16)
-    gi_spatial_radius: FloatProperty(name="Radius", description="GI spatial reuse radius in pixels; 0 = automatic: "
-                                     "0.75 x the direct light's (6 px at 640x360, scaled with the image diagonal, 4 px at least)",
-                                     default=GISettings.radius, min=0.0, soft_max=100.0, subtype="PIXEL")
-    gi_spatial_passes: IntProperty(name="Passes", description="GI spatial reuse passes",
-                                   default=GISettings.passes, min=0, soft_max=4)
-    gi_confidence_cap: FloatProperty(name="Confidence Cap", description="Largest confidence M a reused GI "
-                                     "reservoir keeps", default=GISettings.confidence_cap, min=1.0, soft_max=100.0)
-    gi_max_age: IntProperty(name="Max Sample Age", description="Frames a GI sample may be carried by temporal "
-                            "reuse before it is dropped (its cached radiance ages while objects move; any change "
-                            "of the lights drops the whole GI history at once)", default=GISettings.max_age, min=0,
-                            soft_max=100)
-    gi_roughness_threshold: FloatProperty(
+        default="AUTO", update=_update_passes)),
+    Field("gi_spatial_neighbors", IntProperty, int, dict(
+        name="Neighbors", description="Neighbouring GI reservoirs merged per spatial "
+        "pass (unbiased mode: one visibility ray each)",
+        default=GISettings.neighbors, min=0, soft_max=16)),
+    Field("gi_spatial_radius", FloatProperty, float, dict(
+        name="Radius", description="GI spatial reuse radius in pixels; 0 = automatic: "
+        "0.75 x the direct light's (6 px at 640x360, scaled with the image diagonal, 4 px at least)",
+        default=GISettings.radius, min=0.0, soft_max=100.0, subtype="PIXEL")),
+    Field("gi_spatial_passes", IntProperty, int, dict(
+        name="Passes", description="GI spatial reuse passes",
+        default=GISettings.passes, min=0, soft_max=4)),
+    Field("gi_confidence_cap", FloatProperty, float, dict(
+        name="Confidence Cap", description="Largest confidence M a reused GI "
+        "reservoir keeps", default=GISettings.confidence_cap, min=1.0, soft_max=100.0)),
+    Field("gi_max_age", IntProperty, int, dict(
+        name="Max Sample Age", description="Frames a GI sample may be carried by temporal "
+        "reuse before it is dropped (its cached radiance ages while objects move; any change "
+        "of the lights drops the whole GI history at once)", default=GISettings.max_age, min=0,
+        soft_max=100)),
+    Field("gi_roughness_threshold", FloatProperty, float, dict(
         name="Roughness Threshold", description="Below this roughness a surface's specular lobe is too sharp to "
         "reconnect: seen by the camera, only its diffuse lobe is resampled (the specular keeps its path-traced "
-        "sample). Light leaving a bounce's surface is always split: only its diffuse part is cached for reuse", default=GISettings.roughness_threshold,
-        min=0.0, max=1.0)
+        "sample). Light leaving a bounce's surface is always split: only its diffuse part is cached for reuse",
+        default=GISettings.roughness_threshold, min=0.0, max=1.0)),
+)
+
+
+class RestirSceneSettings(bpy.types.PropertyGroup):
+    __annotations__ = {f.name: f.prop(**f.kwargs) for f in SCENE_FIELDS}
+
+
+def scene_settings_to_core(s) -> dict:
+    """{RenderSettings field: value} of the scene settings ``s`` (``scene.restir``) the core reads."""
+    return {f.name: f.to_core(getattr(s, f.name)) for f in SCENE_FIELDS if f.to_core is not None}
 
 
 class RestirViewLayerSettings(bpy.types.PropertyGroup):

@@ -142,7 +142,7 @@ def test_panels_draw_with_the_last_render_choices(addon):
                                                "coverage_samples": 4, "coverage_reason": "emitters can be seen",
                                                "spatial_radius": 8.0}
     try:
-        for panel in (panels.RESTIR_PT_sampling, panels.RESTIR_PT_passes):
+        for panel in panels.PANELS:
             class Fake:
                 layout = Layout()
                 split_layout = panels.RestirPanel.split_layout

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import bpy
 
+from ..core.pipeline import methods
 from ..presets import PRESET_ITEMS
 
 ENGINE = "RESTIR"
@@ -74,63 +75,96 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
         col.prop(s, "seed")
         layout.prop(s, "coverage_samples")
         last = _last_choices(context.scene)
-        if s.integrator == "RESTIR":
-            layout.prop(s, "direct_method")
-            if last and (s.direct_method == "AUTO" or s.coverage_samples == "AUTO"):
-                box = layout.box()
-                box.scale_y = 0.8
-                if s.direct_method == "AUTO":
-                    box.label(text=f"Last render: {last['direct_method'].replace('_', ' ').title()}", icon="INFO")
-                    box.label(text=last["direct_reason"])
-                if s.coverage_samples == "AUTO":
-                    box.label(text=f"Pixel coverage: {last['coverage_samples']} "
-                                   f"ray{'s' if last['coverage_samples'] != 1 else ''} ({last['coverage_reason']})")
-            col = layout.column(align=True)
-            col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
-            col.prop(s, "light_candidates")
-            col.prop(s, "bsdf_candidates")
-            col = layout.column(align=True)
-            col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
-            col.prop(s, "world_method")
-            sub = col.column(align=True)
-            sub.active = s.world_method != "LIGHT_SAMPLED"
-            sub.prop(s, "world_candidates")
-            if last and s.world_method == "AUTO" and last.get("world_reason"):
-                box = col.box()
-                box.scale_y = 0.8
-                box.label(text=f"Last render: {last['world_method'].replace('_', ' ').title()}", icon="INFO")
-                box.label(text=last["world_reason"])
-            col = layout.column(align=True)
-            col.active = s.direct_method in ("AUTO", "RIS", "RESTIR")
-            col.prop(s, "light_tiles")
-            sub = col.column(align=True)
-            sub.active = s.light_tiles != "OFF"
-            sub.prop(s, "light_sampler")
-            row = sub.column(align=True)
-            row.active = s.light_sampler == "POWER"  # spatial tiles: one per block, their own size
-            row.prop(s, "light_tile_count")
-            row.prop(s, "light_tile_size")
-            if s.direct_method in ("RESTIR", "AUTO"):
-                col = layout.column(align=True, heading="Temporal Reuse")
-                col.prop(s, "temporal_reuse", text="")
-                sub = col.column()
-                sub.active = s.temporal_reuse
-                sub.prop(s, "confidence_cap")
-                sub.prop(s, "preroll_frames")
-                col = layout.column(align=True, heading="Spatial Reuse")
-                col.prop(s, "spatial_neighbors")
-                col.prop(s, "spatial_radius")
-                if s.spatial_radius == 0 and last and last.get("spatial_radius"):
-                    col.label(text=f"Auto radius in the last render: {last['spatial_radius']:.1f} px")
-                col.prop(s, "spatial_passes")
-                layout.prop(s, "bias_correction")
-                col = layout.column(align=True, heading="Boiling Filter")
-                col.active = s.bias_correction == "NONE"  # biased: the unbiased mode never applies it
-                row = col.row(align=True)
-                row.prop(s, "boiling_filter", text="")
-                sub = row.row(align=True)
-                sub.active = s.boiling_filter
-                sub.prop(s, "boiling_threshold")
+        if last and s.coverage_samples == "AUTO":
+            _last_box(layout, None, f"Pixel coverage: {last['coverage_samples']} "
+                                    f"ray{'s' if last['coverage_samples'] != 1 else ''} ({last['coverage_reason']})")
+
+
+def _last_box(layout, headline, text):
+    """An info box with what Auto chose in the last render: ``headline`` (or none) and ``text``."""
+    box = layout.box()
+    box.scale_y = 0.8
+    if headline:
+        box.label(text=headline, icon="INFO")
+    box.label(text=text)
+
+
+def _title(method: str) -> str:
+    return method.replace("_", " ").title()
+
+
+class RESTIR_PT_sampling_direct(RestirPanel, bpy.types.Panel):
+    bl_label = "Direct Light"
+    bl_parent_id = "RESTIR_PT_sampling"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.scene.restir.integrator == "RESTIR"
+
+    def draw(self, context):
+        layout = self.split_layout()
+        s = context.scene.restir
+        last = _last_choices(context.scene)
+        layout.prop(s, "direct_method")
+        if last and s.direct_method == "AUTO":
+            _last_box(layout, f"Last render: {_title(last['direct_method'])}", last["direct_reason"])
+        resampled = methods.resamples_direct(s)
+        col = layout.column(align=True)
+        col.active = resampled
+        col.prop(s, "light_candidates")
+        col.prop(s, "bsdf_candidates")
+        col = layout.column(align=True)
+        col.active = resampled
+        col.prop(s, "world_method")
+        sub = col.column(align=True)
+        sub.active = s.world_method != "LIGHT_SAMPLED"
+        sub.prop(s, "world_candidates")
+        if last and s.world_method == "AUTO" and last.get("world_reason"):
+            _last_box(col, f"Last render: {_title(last['world_method'])}", last["world_reason"])
+        col = layout.column(align=True)
+        col.active = resampled
+        col.prop(s, "light_tiles")
+        sub = col.column(align=True)
+        sub.active = s.light_tiles != "OFF"
+        sub.prop(s, "light_sampler")
+        row = sub.column(align=True)
+        row.active = s.light_sampler == "POWER"  # spatial tiles: one per block, their own size
+        row.prop(s, "light_tile_count")
+        row.prop(s, "light_tile_size")
+
+
+class RESTIR_PT_sampling_reuse(RestirPanel, bpy.types.Panel):
+    bl_label = "Reuse"
+    bl_parent_id = "RESTIR_PT_sampling"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and methods.reuses_direct(context.scene.restir)
+
+    def draw(self, context):
+        layout = self.split_layout()
+        s = context.scene.restir
+        last = _last_choices(context.scene)
+        col = layout.column(align=True, heading="Temporal Reuse")
+        col.prop(s, "temporal_reuse", text="")
+        sub = col.column()
+        sub.active = s.temporal_reuse
+        sub.prop(s, "confidence_cap")
+        sub.prop(s, "preroll_frames")
+        col = layout.column(align=True, heading="Spatial Reuse")
+        col.prop(s, "spatial_neighbors")
+        col.prop(s, "spatial_radius")
+        if s.spatial_radius == 0 and last and last.get("spatial_radius"):
+            col.label(text=f"Auto radius in the last render: {last['spatial_radius']:.1f} px")
+        col.prop(s, "spatial_passes")
+        layout.prop(s, "bias_correction")
+        col = layout.column(align=True, heading="Boiling Filter")
+        col.active = s.bias_correction == "NONE"  # biased: the unbiased mode never applies it
+        row = col.row(align=True)
+        row.prop(s, "boiling_filter", text="")
+        sub = row.row(align=True)
+        sub.active = s.boiling_filter
+        sub.prop(s, "boiling_threshold")
 
 
 class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
@@ -145,23 +179,20 @@ class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
         layout = self.split_layout()
         s = context.scene.restir
         layout.prop(s, "indirect_method")
-        if s.indirect_method not in ("RESTIR_GI", "AUTO"):
+        if s.indirect_method not in ("RESTIR_GI", "AUTO"):  # the settings below are ReSTIR GI's
             return
         if s.max_bounces == 0:
             layout.label(text="Max Bounces is 0: there is no indirect light", icon="INFO")
         last = _last_choices(context.scene)
         if last and s.indirect_method == "AUTO" and last.get("indirect_reason"):
-            box = layout.box()
-            box.scale_y = 0.8
             label = {"RESTIR_GI": "ReSTIR GI", "PATH": "Path Tracing"}.get(last["indirect_method"], "Off")
-            box.label(text=f"Last render: {label}", icon="INFO")
-            box.label(text=last["indirect_reason"])
+            _last_box(layout, f"Last render: {label}", last["indirect_reason"])
         elif last and last.get("gi_skipped_passes"):
             layout.label(text=f"Last render: path-traced indirect light in {last['gi_skipped_passes']} of "
                               f"{last.get('samples', '?')} samples (almost no bounce light to cache)", icon="INFO")
-        if s.direct_method in ("RESTIR", "AUTO"):
-            layout.label(text="Temporal reuse and bias correction: as set for direct light")
-        else:  # the shared settings are not drawn above for these direct methods
+        if methods.reuses_direct(s):
+            layout.label(text="Temporal reuse and bias correction: as set under Reuse")
+        else:  # the shared settings are not drawn under Reuse for these direct methods
             layout.prop(s, "temporal_reuse")
             layout.prop(s, "bias_correction")
         col = layout.column(align=True, heading="Temporal Reuse")
@@ -229,7 +260,7 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl.restir, "use_pass_reservoir_ucw")
         col = layout.column(heading="ReSTIR GI", align=True)
         sc = context.scene.restir
-        col.active = sc.integrator == "RESTIR" and sc.indirect_method in ("RESTIR_GI", "AUTO") and sc.max_bounces > 0
+        col.active = methods.gi_possible(sc)
         if sc.indirect_method == "AUTO":
             col.label(text="Auto uses ReSTIR GI when a GI reservoir pass is on")
         col.prop(vl.restir, "use_pass_gi_reservoir_m")
@@ -255,7 +286,8 @@ class RESTIR_PT_viewport_render_pass(bpy.types.Panel):
         self.layout.prop(context.space_data.shading.restir, "render_pass", text="")
 
 
-PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_indirect, RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths,
+PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_direct, RESTIR_PT_sampling_reuse, RESTIR_PT_sampling_indirect,
+          RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths,
           RESTIR_PT_passes)  # Render Properties
 VIEW_PANELS = (RESTIR_PT_viewport_render_pass,)  # the 3D view's header popovers
 

@@ -83,3 +83,19 @@ def gi_settings(st, camera) -> tuple[gi.GISettings, reuse.SpatialSettings]:
     g = gi.GISettings(max(0, int(st.gi_spatial_neighbors)), max(1.0, radius), max(0, int(st.gi_spatial_passes)),
                       float(st.gi_confidence_cap), max(0, int(st.gi_max_age)), float(st.gi_roughness_threshold))
     return g, reuse.SpatialSettings(g.neighbors, g.radius, g.passes, st.bias_correction)
+
+
+def resamples_direct(st) -> bool:
+    """Whether the direct light may come from reservoirs (RIS or ReSTIR; Auto resamples where it pays or a reservoir
+    pass is asked for)."""
+    return st.integrator == "RESTIR" and st.direct_method in ("AUTO", "RIS", "RESTIR")
+
+
+def reuses_direct(st) -> bool:
+    """Whether the DI reservoirs may be reused over frames and pixels (ReSTIR, or Auto choosing it)."""
+    return st.integrator == "RESTIR" and st.direct_method in ("RESTIR", "AUTO")
+
+
+def keeps_history(st) -> bool:
+    """Whether a frame may leave a temporal history for the next (DI or GI reservoirs with temporal reuse)."""
+    return bool(st.temporal_reuse) and (reuses_direct(st) or gi_possible(st))
