@@ -34,7 +34,7 @@ from harness.metrics import rel_mse  # noqa: E402
 from harness.report import efficiency_bars, save_bar_figure  # noqa: E402
 from harness.reference import reference_image, reference_lit  # noqa: E402
 from harness.scenes import ensure_blend  # noqa: E402
-from restir_engine.core.integrators import pathtracer# noqa: E402
+from restir_engine.core.integrators import trace_context  # noqa: E402
 from restir_engine.core.integrators.context_cache import context_for  # noqa: E402
 from restir_engine.core.integrators.method_choice import choose_direct_method  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
@@ -88,7 +88,7 @@ def main():
         bpy.ops.wm.open_mainfile(filepath=path)
         scene = export_scene(bpy.context.evaluated_depsgraph_get())
         render_frame(scene, RenderSettings(samples=1, integrator="RESTIR", data_passes=False))  # warm-up
-        lights = context_for(scene, 0, False, pathtracer.build_context)[0].lights
+        lights = context_for(scene, 0, False, trace_context.build_context)[0].lights
         for bounces in args.bounces:
             for label, frames in (("still", 1), ("animation", 4)):
                 auto, reason = choose_direct_method(lights, False, bounces)

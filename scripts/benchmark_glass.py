@@ -24,7 +24,7 @@ import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
 from bpy_scenes import configure_cycles, glass_scene, render_passes  # noqa: E402
-from restir_engine.core.integrators import pathtracer# noqa: E402
+from restir_engine.core.integrators import camera_paths, trace_context  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.engine import settings_from_scene  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
@@ -39,10 +39,10 @@ OUT = os.path.join(ROOT, "docs", "results", "materials")
 
 def glass_mask(core) -> np.ndarray:
     """(h, w) bool: the camera ray through the pixel centre first meets a glass closure."""
-    ctx = pathtracer.build_context(core, BOUNCES)
+    ctx = trace_context.build_context(core, BOUNCES)
     h, w = SIZE[1], SIZE[0]
     y, x = np.mgrid[0:h, 0:w]
-    hits = pathtracer.primary(ctx, (x.ravel() + 0.5).astype(np.float32), (y.ravel() + 0.5).astype(np.float32))
+    hits = camera_paths.primary(ctx, (x.ravel() + 0.5).astype(np.float32), (y.ravel() + 0.5).astype(np.float32))
     mask = np.zeros(h * w, bool)
     if hits.surf.glass is not None:
         mask[hits.rows[hits.surf.glass]] = True

@@ -18,3 +18,19 @@ def addon():
     if not hasattr(bpy.types.Scene, "restir"):
         restir_engine.register()
     yield restir_engine
+
+
+SUBJECTS = ("core", "restir", "materials", "blender", "cycles", "tools")
+# the long statistical suites, run alone with -m slow (or left out with -m "not slow")
+SLOW = {"cycles"}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark each test with its subject (its folder under tests/) and the slow suites with ``slow``."""
+    for item in items:
+        parts = os.path.relpath(str(item.fspath), os.path.dirname(os.path.abspath(__file__))).split(os.sep)
+        subject = parts[0] if len(parts) > 1 and parts[0] in SUBJECTS else None
+        if subject is not None:
+            item.add_marker(getattr(pytest.mark, subject))
+        if subject in SLOW or item.get_closest_marker("slow_case"):
+            item.add_marker(pytest.mark.slow)

@@ -77,20 +77,39 @@ def _tree(tree) -> list:
 
 
 def _mesh(mesh) -> str:
-    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    """sha256 of a mesh's vertices and faces, independent of where each face's corners start (the same primitive
+    operator can start them at another corner in another call): per corner (vertex, its face's material, UVs) sorted,
+    and the faces as sorted vertex sets, sorted."""
+    co = np.zeros(len(mesh.vertices) * 3, np.float32)
     mesh.vertices.foreach_get("co", co)
-    loops = np.empty(len(mesh.loops), np.int32)
+    loops = np.zeros(len(mesh.loops), np.int64)
     mesh.loops.foreach_get("vertex_index", loops)
-    mats = np.empty(len(mesh.polygons), np.int32)
+    start = np.zeros(len(mesh.polygons), np.int64)
+    mesh.polygons.foreach_get("loop_start", start)
+    total = np.zeros(len(mesh.polygons), np.int64)
+    mesh.polygons.foreach_get("loop_total", total)
+    mats = np.zeros(len(mesh.polygons), np.int64)
     mesh.polygons.foreach_get("material_index", mats)
-    h = hashlib.sha256(np.round(co, 6).tobytes())
-    h.update(loops.tobytes())
-    h.update(mats.tobytes())
+    face_of_loop = np.repeat(np.arange(len(start)), total)[np.argsort(np.repeat(start, total) +
+                                                                      _ranks(total), kind="stable")]
+    columns = [loops.astype(np.float64), mats[face_of_loop].astype(np.float64)]
     for layer in mesh.uv_layers:
-        uv = np.empty(len(mesh.loops) * 2, np.float32)
+        uv = np.zeros(len(mesh.loops) * 2, np.float32)
         layer.data.foreach_get("uv", uv)
-        h.update(np.round(uv, 6).tobytes())
+        columns += [np.round(uv[0::2], 5).astype(np.float64), np.round(uv[1::2], 5).astype(np.float64)]
+    corners = np.stack(columns, axis=1)
+    corners = corners[np.lexsort(corners.T[::-1])]
+    faces = sorted(tuple(sorted(loops[s0:s0 + n].tolist())) for s0, n in zip(start.tolist(), total.tolist()))
+    h = hashlib.sha256(np.round(co, 5).tobytes())
+    h.update(corners.tobytes())
+    h.update(repr(faces).encode())
     return h.hexdigest()
+
+
+def _ranks(total: np.ndarray) -> np.ndarray:
+    """0, 1, ..., n-1 for each face of ``total`` corners, concatenated."""
+    ends = np.cumsum(total)
+    return np.arange(int(ends[-1]) if len(ends) else 0) - np.repeat(ends - total, total)
 
 
 _LIGHT_PROPS = ("type", "energy", "color", "shadow_soft_size", "size", "size_y", "shape", "spot_size", "spot_blend",
@@ -142,7 +161,11 @@ def scene_fingerprint(scene) -> str:
         img.pixels.foreach_get(px)
         record["images"][img.name] = (tuple(img.size), img.colorspace_settings.name,
                                       hashlib.sha256(np.round(px, 5).tobytes()).hexdigest())
-    return hashlib.sha256(json.dumps(record, sort_keys=True, default=str).encode()).hexdigest()
+    text = json.dumps(record, sort_keys=True, default=str)
+    if os.environ.get("RESTIR_FINGERPRINT_DUMP"):
+        with open(os.environ["RESTIR_FINGERPRINT_DUMP"], "a") as f:
+            f.write(text + "\n")
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 class StaleReference(AssertionError):
@@ -159,6 +182,13 @@ def cycles_cells(case: str, build, configure, render, reduce, reps: int, samples
     how = mode()
     path = _path(case)
     meta = {"case": case, "reps": reps, "seeds": list(range(reps)), "samples": samples, "bounces": bounces}
+    if os.environ.get("RESTIR_REFINGERPRINT"):  # one-off: the fingerprint function changed, the scenes did not
+        with open(path) as f:
+            data = json.load(f)
+        data["fingerprint"] = fingerprint
+        with open(path, "w") as f:
+            json.dump(data, f, indent=1)
+            f.write("\n")
     if how == "stored":
         if not os.path.exists(path):
             raise StaleReference(f"no stored Cycles reference {os.path.relpath(path)}: render it with "

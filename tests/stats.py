@@ -20,6 +20,12 @@ def standard_error(x: np.ndarray, axis: int = 0) -> np.ndarray:
     return x.std(axis=axis, ddof=1) / np.sqrt(x.shape[axis])
 
 
+def welch_se(a: np.ndarray, b: np.ndarray, axis: int = 0) -> np.ndarray:
+    """Standard error of the difference of the means of two independent sets of repetitions along ``axis``."""
+    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
+    return np.sqrt(a.var(axis=axis, ddof=1) / a.shape[axis] + b.var(axis=axis, ddof=1) / b.shape[axis])
+
+
 def robust_var(x: np.ndarray) -> float:
     """The variance of normal data with the spread of ``x`` (1.4826 x its median absolute deviation, squared)."""
     return float((1.4826 * np.median(np.abs(x - np.median(x)))) ** 2)

@@ -11,62 +11,24 @@ light too: next-event estimation samples it besides the lights (:func:`world_eve
 escaping BSDF rays collect it MIS-weighted against that. Suns are light-sampled only.
 
 The path is split in three calls so that another direct-light estimator can take the place of the first
-vertex's next-event estimation: :func:`primary` (camera rays, emission seen directly), :func:`next_event`
+vertex's next-event estimation: camera_paths.primary (camera rays, emission seen directly), :func:`next_event`
 (NEE at a set of surfaces) and :func:`continue_paths` (the BSDF half of the first vertex's direct light,
 then bounces 1..max_bounces). With ``direct_resampled`` the first BSDF ray's emitter hits are left to the
 resampled estimator (ReSTIR DI) and the ray may be the one that estimator already traced.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import camera as camera_mod
-from ..geometry.accel import Accel, Hits, offset_origin, shadow_rays
-from ..lights.table import LightTable, emitted_radiance, spot_factor, triangle_geometry
-from ..lights.world import World
-from ..lights.world_points import WorldSphere
-from ..materials import microfacet_tables
+from ..geometry.accel import offset_origin, shadow_rays
+from ..lights.table import emitted_radiance, spot_factor
 from ..materials.bsdf import SurfaceParams, diffuse_f, eval_view, sample_bsdf
-from ..materials.cutout import Cutout
 from ..materials.glass import DELTA_PDF, sample_glass
 from ..materials.surface import Surface
 from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
-from ..scene import Scene
-
-
-@dataclass
-class TraceContext:
-    """Everything a chunk needs, built once per frame (reused while the scene content is unchanged).
-    Per-triangle data the path tracer gathers is kept as rows (structure of arrays)."""
-
-    scene: Scene
-    geom_accel: Accel
-    lamp_accel: Accel
-    lights: LightTable
-    geom_ng: np.ndarray  # (n, 3) unit geometric normals
-    lamp_ng: np.ndarray
-    material_params: SurfaceParams  # per material, untextured (gathered per hit)
-    max_bounces: int
-    rr_start: int = 3
-    film_transparent: bool = False
-    material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α
-    material_layer: np.ndarray = None   # (m, 32) dielectric layer factor S rows over μo (microfacet_tables)
-    has_mix: bool = False  # some material is a Mix/Add shader (core/materials/mix.py)
-    world: World = None    # the background as a light (core/lights/world.py)
-    normal_maps: bool = False  # some material has a tangent-space normal map (surface.normal_map)
-    bump_maps: bool = False    # some material has a Bump node (surface.bump_map)
-    has_glass: bool = False    # some material has a smooth glass closure (core/materials/glass.py)
-    geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
-    geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
-    geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
-    lamp_ng_rows: np.ndarray = None     # (3, n_lamp) lamp_ng as rows
-    geom_derived: "GeometryDerived" = None  # the geometry-only arrays above, kept for a rebuild over the same triangles
-    emit_accel: Accel = None  # the emissive scene triangles alone (light index = primitive index), or None
-    # what rendering this content measured (shared by the frames and views that reuse this context):
-    # "auto_indirect" -> the last frame's AUTO indirect measurement and choice (renderer.FrameRenderer._remember)
-    measured: dict = field(default_factory=dict)
+from .trace_context import TraceContext
 
 
 def power_heuristic(a, b):
@@ -121,154 +83,6 @@ def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
     light = ctx.lights.lamp_to_light[prim]
     pdf = np.where(light >= 0, ctx.lights.pdf_solid_angle(np.maximum(light, 0), cols(o, sel), t, cos_l), 0.0)
     return le, pdf.astype(np.float32)
-
-
-@dataclass
-class PrimaryHits:
-    """Camera rays through n raster points: emission seen directly (3, n), alpha (n,), the rows that hit
-    geometry (k,) and their surfaces (surface.Surface, k)."""
-
-    emitted: np.ndarray
-    alpha: np.ndarray
-    rows: np.ndarray
-    surf: Surface
-
-
-def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray | None = None,
-            may_see_lamp: np.ndarray | None = None) -> PrimaryHits:
-    """Camera rays through raster points (x, y) (window pixels + jitter, y up). ``may_hit`` / ``may_see_lamp`` (n,)
-    bool: False where the ray is known to meet no geometry / no lamp visible to the camera (projected boxes,
-    camera.box_pixels and camera.emitter_pixels), which is then not traced against it; under a constant world a ray
-    that may meet neither is not generated at all (it sees the world's colour, or nothing on a transparent film)."""
-    if may_hit is not None and ctx.world.image is None:
-        need = may_hit if not len(ctx.scene.lamps.tris) else \
-            np.ones(len(x), bool) if may_see_lamp is None else may_hit | may_see_lamp
-        if not need.all():
-            idx = np.flatnonzero(need)
-            sub = primary(ctx, x[idx], y[idx], may_hit[idx], None if may_see_lamp is None else may_see_lamp[idx])
-            transparent = ctx.film_transparent
-            emitted = np.empty((3, len(x)), np.float32)
-            emitted[:] = 0.0 if transparent else ctx.world.color[:, None]
-            emitted[:, idx] = sub.emitted
-            alpha = np.full(len(x), 0.0 if transparent else 1.0, np.float32)
-            alpha[idx] = sub.alpha
-            return PrimaryHits(emitted, alpha, idx[sub.rows], sub.surf)
-    cam = ctx.scene.camera
-    o, d, tmax = camera_mod.generate_rays(cam, x, y)
-    if may_hit is None or may_hit.all():
-        hits = ctx.geom_accel.intersect(o, d, tmax)
-    else:
-        hits = Hits(len(x))
-        idx = np.flatnonzero(may_hit)
-        if idx.size:
-            sub = ctx.geom_accel.intersect(cols(o, idx), cols(d, idx), None if tmax is None else tmax[idx])
-            hits.prim[idx], hits.t[idx], hits.u[idx], hits.v[idx] = sub.prim, sub.t, sub.u, sub.v
-    emitted, alpha = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
-    rows = np.flatnonzero(hits.prim >= 0)
-    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
-    return PrimaryHits(emitted, alpha, rows, surf)
-
-
-def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
-    """What camera rays through raster points (x, y) see emitted (3, n) and their alpha (n,): the part of
-    :func:`primary` that needs no surface (extra rays per pixel for pixel coverage)."""
-    o, d, tmax = camera_mod.generate_rays(ctx.scene.camera, x, y)
-    return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax))
-
-
-def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: np.ndarray | None = None):
-    """Emission (3, n) camera rays meet first: visible lamps in front of the hit, emissive surfaces, the world
-    where nothing is hit (unless the film is transparent); alpha (n,) 0 where nothing is hit on a transparent
-    film. ``camera`` False: rays continuing a camera ray through delta interfaces (every lamp is seen, the film's
-    transparency does not apply). ``lamp_mask`` (n,) bool: only these rays may see a lamp (None: all)."""
-    n = len(hits.prim)
-    emitted = np.zeros((3, n), np.float32)
-    alpha = np.ones(n, np.float32)
-    rows = None if lamp_mask is None else np.flatnonzero(lamp_mask)
-    if len(ctx.scene.lamps.tris) and (rows is None or rows.size):  # lamps seen (camera rays: those visible to them)
-        far = hits.t if tmax is None else np.minimum(hits.t, tmax)
-        oo, dd = (o, d) if rows is None else (cols(o, rows), cols(d, rows))
-        lh = lamp_hits(ctx, oo, dd, far if rows is None else far[rows])
-        sel = np.flatnonzero(lh.prim >= 0)
-        if camera:
-            sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
-        if sel.size:
-            em = _lamp_emission(ctx, lh, oo, dd, sel)[0]
-            emitted[:, sel if rows is None else rows[sel]] += em
-    miss = hits.prim < 0
-    if ctx.film_transparent and camera:
-        alpha[miss] = 0.0
-    elif miss.any():
-        m = np.flatnonzero(miss)
-        emitted[:, m] += ctx.world.radiance(cols(d, m))
-    if ctx.lights.n_geom:  # emissive surfaces (mesh emission is two-sided by default)
-        prim = np.maximum(hits.prim, 0)
-        em = np.flatnonzero((hits.prim >= 0) & (ctx.lights.geom_to_light[prim] >= 0))
-        if em.size:
-            emitted[:, em] += emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em],
-                                               hits.v[em])
-    return finite(emitted), alpha
-
-
-@dataclass
-class SpecularChains:
-    """Camera paths continued through smooth glass to the first other surface (:func:`follow_specular`): per
-    remaining hit row, the throughput (3, k) of the delta interfaces crossed and their number ``depth`` (k,)."""
-
-    throughput: np.ndarray
-    depth: np.ndarray
-
-
-def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generator) -> SpecularChains | None:
-    """Continue the camera rays that met smooth glass through its delta interfaces (reflection or refraction
-    drawn by Fresnel) until they meet another surface, in place: ``hits.surf`` becomes that surface (so resampling
-    runs where the light is actually shaded), the emission met on the way (lamps, emissive surfaces, the world,
-    times the throughput so far; MIS weight 1 after a delta interface) joins ``hits.emitted``, and rows that
-    escape, die on a shading-normal artefact or exceed the bounce budget leave ``hits.rows``. Returns the chains
-    (None when no camera ray met glass)."""
-    s = hits.surf
-    if s.glass is None or ctx.max_bounces == 0:
-        return None
-    n = len(hits.rows)
-    prim, b1, b2 = s.prim.copy(), s.b1.copy(), s.b2.copy()
-    o, d, t = s.p.copy(), -s.wo, np.zeros(n, np.float32)
-    thr = np.ones((3, n), np.float32)
-    depth = np.zeros(n, np.int64)
-    alive = np.ones(n, bool)
-    idx = np.flatnonzero(s.glass)
-    cur = s.take(idx)
-    for k in range(ctx.max_bounces + 1):  # as the path tracer: rays from vertices 0..max_bounces find emission,
-        ray = sample_rays(cur, rng.random((3, len(idx)), dtype=np.float32))  # vertices up to max_bounces are shaded
-        alive[np.setdiff1d(idx, idx[ray.rows])] = False
-        idx = idx[ray.rows]
-        if idx.size == 0:
-            break
-        thr[:, idx] *= ray.f
-        depth[idx] += 1
-        hit = ctx.geom_accel.intersect(ray.o, ray.d)
-        em, _a = _seen(ctx, ray.o, ray.d, None, hit, camera=False)
-        pix = hits.rows[idx]
-        hits.emitted[:, pix] += finite(cols(thr, idx) * em)
-        got = (hit.prim >= 0) & (depth[idx] <= ctx.max_bounces)
-        alive[idx[~got]] = False
-        sel = np.flatnonzero(got)
-        idx = idx[sel]
-        if idx.size == 0:
-            break
-        prim[idx], b1[idx], b2[idx], t[idx] = hit.prim[sel], hit.u[sel], hit.v[sel], hit.t[sel]
-        o[:, idx], d[:, idx] = cols(ray.o, sel), cols(ray.d, sel)
-        cur = Surface(ctx, prim[idx], b1[idx], b2[idx], o[:, idx], d[:, idx], t[idx])
-        more = np.zeros(len(idx), bool) if cur.glass is None else cur.glass
-        if not more.any():
-            idx = idx[:0]
-            break
-        cur = cur.take(np.flatnonzero(more))
-        idx = idx[more]
-    alive[idx] = False  # still on glass when the bounce budget ran out
-    keep = np.flatnonzero(alive)
-    hits.rows = hits.rows[keep]
-    hits.surf = Surface(ctx, prim[keep], b1[keep], b2[keep], o[:, keep], d[:, keep], t[keep])
-    return SpecularChains(thr[:, keep], depth[keep])
 
 
 def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False):
@@ -421,6 +235,41 @@ class PathResult:
     first: FirstBounce | None = None
 
 
+def _lamps_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, add) -> None:
+    """Lamps in front of the rays' hits (``collect``: only those rays, or None for all), MIS-weighted against
+    light sampling (solid-angle pdfs)."""
+    lh = lamp_hits(ctx, o, d, hits.t)
+    sel = np.flatnonzero((lh.prim >= 0) if collect is None else (lh.prim >= 0) & collect)
+    if sel.size:
+        le, pl = _lamp_emission(ctx, lh, o, d, sel)
+        le *= power_heuristic(prev_pdf[sel], pl)
+        add(sel, le)
+
+
+def _world_on_rays(ctx: TraceContext, d, esc, prev_pdf, origin_n, add) -> None:
+    """The world seen by the escaping rays ``esc``; MIS-weighted where the world was light-sampled at the vertex
+    (``origin_n``: the receivers' normals, for a constant world's light-sample pdf)."""
+    de = cols(d, esc)
+    le = ctx.world.radiance(de)
+    if origin_n is not None:
+        le *= power_heuristic(prev_pdf[esc], ctx.world.pdf(de, cols(origin_n, esc)))
+    add(esc, le)
+
+
+def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) -> None:
+    """Emissive triangles hit by the rays ``hsel`` (primitives ``hp``), MIS-weighted against light sampling."""
+    light = ctx.lights.geom_to_light[hp]
+    em = np.flatnonzero((light >= 0) if collect is None else (light >= 0) & collect[hsel])
+    if em.size:
+        hs = hsel[em]
+        le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
+        cos_l = -dot(cols(d, hs), cols(ctx.geom_ng_rows, hp[em]))
+        le *= (cos_l > 0) | ctx.lights.tri_two_sided[light[em]]
+        pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
+        le *= power_heuristic(prev_pdf[hs], pl)
+        add(hs, le)
+
+
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
                    first_ray=None, first_bounce: bool = False, budget: np.ndarray | None = None,
                    world_resampled: bool = False) -> PathResult:
@@ -489,45 +338,28 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         # resampling cannot reach
         collect = None if not (bounce == 0 and direct_resampled) else \
             (np.zeros(len(keep), bool) if ray.delta is None else ray.delta[keep])
+
+        def add(sel, le, target=target, idx=idx, throughput=throughput, dthr=dthr):
+            """Radiance ``le`` (3, k) arriving along the rays ``sel`` into their paths' estimates."""
+            target[:, idx[sel]] += finite(cols(throughput, sel) * le)
+            if dthr is not None:
+                first.lo_d[:, idx[sel]] += finite(cols(dthr, sel) * le)
+
         if (collect is None or collect.any()) and len(lamps.tris):
-            lh = lamp_hits(ctx, o, d, hits.t)
-            sel = np.flatnonzero((lh.prim >= 0) if collect is None else (lh.prim >= 0) & collect)
-            if sel.size:
-                le, pl = _lamp_emission(ctx, lh, o, d, sel)
-                le *= power_heuristic(prev_pdf[sel], pl)
-                target[:, idx[sel]] += finite(cols(throughput, sel) * le)
-                if dthr is not None:
-                    first.lo_d[:, idx[sel]] += finite(cols(dthr, sel) * le)
+            _lamps_on_rays(ctx, o, d, hits, prev_pdf, collect, add)
         hit = hits.prim >= 0
         esc = np.flatnonzero(~hit)
         if world_resampled and collect is not None:  # only delta rays, which resampling cannot reach
             esc = esc[collect[esc]]
         if esc.size and world_on:  # film transparency affects camera rays only
-            de = cols(d, esc)
-            le = ctx.world.radiance(de)
-            if ctx.world.sampled:  # the world was light-sampled at this vertex too
-                le *= power_heuristic(prev_pdf[esc], ctx.world.pdf(de, cols(origin_n, esc)))
-            target[:, idx[esc]] += finite(cols(throughput, esc) * le)
-            if dthr is not None:
-                first.lo_d[:, idx[esc]] += finite(cols(dthr, esc) * le)
+            _world_on_rays(ctx, d, esc, prev_pdf, origin_n if ctx.world.sampled else None, add)
         hsel = np.flatnonzero(hit)
         if hsel.size == 0:
             break
         hp = hits.prim[hsel]
         last = None if budget is None else budget[idx[hsel]] <= bounce  # this path's bounces are spent
         if collect is None or collect.any():
-            light = ctx.lights.geom_to_light[hp]
-            em = np.flatnonzero((light >= 0) if collect is None else (light >= 0) & collect[hsel])
-            if em.size:
-                hs = hsel[em]
-                le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
-                cos_l = -dot(cols(d, hs), cols(ctx.geom_ng_rows, hp[em]))
-                le *= (cos_l > 0) | ctx.lights.tri_two_sided[light[em]]
-                pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
-                le *= power_heuristic(prev_pdf[hs], pl)
-                target[:, idx[hs]] += finite(cols(throughput, hs) * le)
-                if dthr is not None:
-                    first.lo_d[:, idx[hs]] += finite(cols(dthr, hs) * le)
+            _emitters_hit(ctx, d, hits, hsel, hp, prev_pdf, collect, add)
         if bounce == ctx.max_bounces:
             break
         if last is not None and last.any():
@@ -558,123 +390,3 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         first.lo_d = finite(first.lo_d)
         indirect[:, first.rows] = first.throughput * first.lo
     return PathResult(direct, indirect, first)
-
-
-def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
-    """First hit at raster points (x, y): planar depth along the camera axis (n,) (1e10 = nothing,
-    as Cycles), the world-space shading normal facing the camera (n, 3) (zero = nothing) and the motion
-    vector (n, 4) in Blender's convention: (prev - current, current - next) raster positions in pixels
-    (zero without neighbouring-frame data or where nothing is hit)."""
-    cam = ctx.scene.camera
-    o, d, tmax = camera_mod.generate_rays(cam, x, y)
-    hits = ctx.geom_accel.intersect(o, d, tmax)
-    depth = np.full(len(x), 1e10, np.float32)
-    normal = np.zeros((len(x), 3), np.float32)
-    vector = np.zeros((len(x), 4), np.float32)
-    hit = np.flatnonzero(hits.prim >= 0)
-    if hit.size:
-        s = Surface(ctx, hits.prim[hit], hits.u[hit], hits.v[hit], cols(o, hit), cols(d, hit), hits.t[hit])
-        depth[hit] = dot(s.p - camera_mod.position(cam)[:, None], camera_mod.forward(cam)[:, None])
-        normal[hit] = s.ns.T
-        motion = ctx.scene.motion
-        inst = ctx.scene.geometry.instance
-        if motion is not None and inst is not None:
-            here = np.stack([x[hit], y[hit]], axis=1)
-            for which, which_cols, sign in (("prev", slice(0, 2), 1.0), ("next", slice(2, 4), -1.0)):
-                other_cam = motion.camera_prev if which == "prev" else motion.camera_next
-                if other_cam is None:
-                    continue
-                moved = motion.moved_points(s.p, inst[s.prim], which)
-                raster, _z = camera_mod.project(other_cam, moved)
-                vector[hit, which_cols] = sign * (raster - here)
-    return depth, normal, np.where(np.isfinite(vector), vector, 0.0).astype(np.float32)
-
-
-@dataclass
-class GeometryDerived:
-    """Per-triangle arrays derived from the geometry alone (kept while the triangles are unchanged)."""
-
-    bounds: tuple          # (min (3,), max (3,)) of the finite vertices, or None when there are none
-    ng: np.ndarray         # (n, 3) unit geometric normals
-    ng_rows: np.ndarray    # (3, n)
-    flat: np.ndarray       # (n,) bool: the three corner normals are equal
-    normal_rows: np.ndarray  # (9, n) corner shading normals as rows
-    boxes: tuple = None    # (lo (k, 3), hi (k, 3)): each instance's box (one box without instances; camera.box_pixels)
-
-    @staticmethod
-    def of(geom) -> "GeometryDerived":
-        verts = geom.verts.reshape(-1, 3)
-        finite = verts[np.isfinite(verts).all(axis=1)]
-        bounds = (finite.min(0), finite.max(0)) if len(finite) else None
-        boxes = instance_boxes(geom, bounds)
-        ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
-        nrm = geom.normals
-        flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
-        return GeometryDerived(bounds, ng, np.ascontiguousarray(ng.T), flat,
-                               np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32), boxes)
-
-
-def instance_boxes(geom, bounds) -> tuple:
-    """(lo (k, 3), hi (k, 3)) float32: the bounding box of each instance's finite vertices (geometry.instance),
-    or the scene's ``bounds`` as one box when there are no instances; empty without geometry."""
-    empty = (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.float32))
-    if bounds is None:
-        return empty
-    inst = geom.instance
-    if inst is None or len(inst) == 0 or inst.min() == inst.max():
-        return np.asarray(bounds[0], np.float32)[None], np.asarray(bounds[1], np.float32)[None]
-    v = geom.verts
-    ok = np.isfinite(v).all(axis=2)[..., None]
-    tlo = np.where(ok, v, np.inf).min(axis=1)
-    thi = np.where(ok, v, -np.inf).max(axis=1)
-    order = np.argsort(inst, kind="stable")
-    starts = np.flatnonzero(np.r_[True, np.diff(inst[order]) != 0])
-    lo = np.minimum.reduceat(tlo[order], starts)
-    hi = np.maximum.reduceat(thi[order], starts)
-    keep = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
-    return lo[keep].astype(np.float32), hi[keep].astype(np.float32)
-
-
-def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False, accels: dict | None = None
-                  ) -> TraceContext:
-    """Everything the chunks need for ``scene``. ``accels`` (optional) hands over what an earlier context built
-    over exactly these triangles (an edit of materials, lamps or the world): "geom" / "lamp" Embree scenes
-    (Accel), "derived" (GeometryDerived); they are reused instead of rebuilt."""
-    accels = accels or {}
-    geom = scene.geometry
-    lamps = scene.lamps
-    derived = accels.get("derived") or GeometryDerived.of(geom)
-    lamp_verts = lamps.tris.verts.reshape(-1, 3)
-    lamp_verts = lamp_verts[np.isfinite(lamp_verts).all(axis=1)]
-    boxes = [b for b in (derived.bounds, (lamp_verts.min(0), lamp_verts.max(0)) if len(lamp_verts) else None)
-             if b is not None]
-    lo = np.min([b[0] for b in boxes], axis=0) if boxes else np.zeros(3)
-    hi = np.max([b[1] for b in boxes], axis=0) if boxes else np.zeros(3)
-    radius = float(np.linalg.norm(hi - lo) / 2) if boxes else 1.0
-    geom_ng = derived.ng
-    lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
-    params = SurfaceParams.of_table(scene.materials)
-    geom_ng_rows = derived.ng_rows
-    cut = Cutout.of(geom, scene.materials)
-    geom_accel = accels["geom"].with_cutout(cut, geom_ng_rows if cut else None) if "geom" in accels else \
-        Accel(geom.verts, cut, geom_ng_rows if cut else None)
-    world = World(scene.world_radiance, getattr(scene, "world_image", None), getattr(scene, "world_rotation", None))
-    lights = LightTable(scene, max(radius, 1e-3))
-    if world.sampled:  # the world's points may enter ReSTIR DI reservoirs (di.CandidateSettings.world_candidates)
-        lights.attach_world(WorldSphere(world, (lo + hi) / 2, max(radius, 1e-3)))
-    return TraceContext(scene=scene, geom_accel=geom_accel,
-                        lamp_accel=accels["lamp"] if "lamp" in accels else Accel(lamps.tris.verts),
-                        lights=lights, geom_ng=geom_ng, lamp_ng=lamp_ng,
-                        emit_accel=Accel(lights.tri_verts[:lights.n_geom]) if lights.n_geom else None,
-                        material_params=params, max_bounces=int(max(0, max_bounces)),
-                        film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
-                        material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),
-                        has_mix=scene.materials.mix_first is not None and bool((scene.materials.mix_first >= 0).any()),
-                        normal_maps=scene.materials.normal_tex is not None
-                        and bool((scene.materials.normal_tex >= 0).any()),
-                        bump_maps=scene.materials.bump_tex is not None and bool((scene.materials.bump_tex >= 0).any()),
-                        has_glass=scene.materials.transmission is not None
-                        and bool((scene.materials.transmission > 0).any()),
-                        world=world,
-                        geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
-                        lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..integrators import pathtracer
+from ..integrators import camera_paths
 from ..parallel.pool import pool
 
 
@@ -25,7 +25,7 @@ def render_data_passes(ctx, tile_pixels: int):
     def gbuffer_tile(tile):
         tx, ty, tw, th = tile
         cy, cx = np.mgrid[0:th, 0:tw]
-        dep, nrm, vec = pathtracer.gbuffer(ctx, (x0 + tx + cx.ravel() + 0.5).astype(np.float32),
+        dep, nrm, vec = camera_paths.gbuffer(ctx, (x0 + tx + cx.ravel() + 0.5).astype(np.float32),
                                            (y0 + ty + cy.ravel() + 0.5).astype(np.float32))
         depth[ty:ty + th, tx:tx + tw] = dep.reshape(th, tw, 1)
         normal[ty:ty + th, tx:tx + tw] = nrm.reshape(th, tw, 3)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..integrators import pathtracer
+from ..integrators import pathtracer, trace_context
 from ..integrators.context_cache import context_for, fingerprint
 from ..integrators.method_choice import GI_MIN_SHARE
 from ..parallel.tasks import Progress, Stopped
@@ -73,7 +73,7 @@ class FrameRenderer:
         self.clock = clock or NullClock()
         bounces = methods.bounces(settings)
         self.ctx, self.context_reused = context_for(scene, bounces, settings.film_transparent,
-                                                    pathtracer.build_context)
+                                                    trace_context.build_context)
         self.indirect = IndirectChoice(settings, bounces, methods.gi_auto(settings), self.ctx)
         self.gi = None  # gi.GISettings when the indirect light is resampled
         if settings.integrator == "RESTIR":

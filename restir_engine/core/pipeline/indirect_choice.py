@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..integrators import pathtracer
+from ..integrators import camera_paths, pathtracer
 from ..integrators.method_choice import choose_indirect_method
 from ..materials.bsdf import luminance_rows
 from ..restir.target import WIDTH
@@ -88,7 +88,7 @@ class IndirectChoice:
         r = rng(seed, self.frame, 0, STREAM_PROBE)
         pix = r.integers(0, w * h, max(1, min((w * h) // PROBE_PIXELS, PROBE_MAX)))
         jit = r.random((2, len(pix)), dtype=np.float32)
-        hits = pathtracer.primary(ctx, (x0 + pix % w).astype(np.float32) + jit[0],
+        hits = camera_paths.primary(ctx, (x0 + pix % w).astype(np.float32) + jit[0],
                                   (y0 + pix // w).astype(np.float32) + jit[1], None if may_hit is None else may_hit[pix])
         surf = hits.surf
         sums = np.zeros(4)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import camera as camera_mod
-from ..integrators import pathtracer
+from ..integrators import camera_paths
 from ..restir.gbuffer import GBuffer
 from ..restir.target import ShadingTerms
 from ..sampling import STREAM_CAMERA, STREAM_CHAIN, STREAM_PIXEL_OFFSET, pass_jitter
@@ -33,7 +33,7 @@ def primary(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     if plan.glass_chains and ctx.has_glass:
         # camera rays that met glass continue to the surface behind it, where resampling runs (without
         # resampling, the path continuation handles glass as the path tracer does, at less cost)
-        c.chain = pathtracer.follow_specular(ctx, c.hits, plan.rng(STREAM_CHAIN, c.index))
+        c.chain = camera_paths.follow_specular(ctx, c.hits, plan.rng(STREAM_CHAIN, c.index))
 
 
 def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
@@ -48,7 +48,7 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     py = (y0 + c.pixels // w).astype(np.float32)
     hit_mask = None if masks.may_hit is None else masks.may_hit[c.pixels]
     lamp_seen = None if masks.lamps is None else masks.lamps[c.pixels]
-    c.hits = pathtracer.primary(ctx, px + j[:, 0], py + j[:, 1], hit_mask, lamp_seen)
+    c.hits = camera_paths.primary(ctx, px + j[:, 0], py + j[:, 1], hit_mask, lamp_seen)
     strata = plan.strata
     if strata == 1:
         return
@@ -61,7 +61,7 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     k0 = np.minimum((jx * g).astype(np.int64), g - 1) + g * np.minimum((jy * g).astype(np.int64), g - 1)
     k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
     jj = r.random((2,) + k.shape, dtype=np.float32)
-    em, al = pathtracer.seen_emission(ctx, (sx + ((k % g).astype(np.float32) + jj[0]) / g).ravel(),
+    em, al = camera_paths.seen_emission(ctx, (sx + ((k % g).astype(np.float32) + jj[0]) / g).ravel(),
                                       (sy + ((k // g).astype(np.float32) + jj[1]) / g).ravel())
     inv = np.float32(1.0 / strata)
     c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv

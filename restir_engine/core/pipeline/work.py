@@ -21,8 +21,8 @@ class Chunk:
     index: int
     pixels: np.ndarray     # window pixel indices (row-major): the chunk's span, ``batch`` times over
     batch: int = 1         # samples of each pixel (sample s + b at pixels[b * span : (b + 1) * span])
-    hits: object = None    # pathtracer.PrimaryHits (rows index ``pixels``)                       [primary]
-    chain: object = None   # pathtracer.SpecularChains: its surfaces seen through smooth glass      [primary]
+    hits: object = None    # camera_paths.PrimaryHits (rows index ``pixels``)                       [primary]
+    chain: object = None   # camera_paths.SpecularChains: its surfaces seen through smooth glass      [primary]
     first: int = 0         # index of its first surface in the frame's G-buffer                     [primary]
     res: object = None     # di.DIReservoirs of its surfaces (initial, then after reuse)             [initial, reuse]
     bsdf_ray: object = None  # the BSDF candidate's traced ray, taken over by the path continuation   [initial]

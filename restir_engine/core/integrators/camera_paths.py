@@ -1,0 +1,198 @@
+"""Camera paths: primary hits through pixel positions (the emission seen directly, film alpha, cut-outs), camera
+paths continued through smooth glass to the surface behind (ReSTIR resamples there), and the data passes' G-buffer
+(depth, normal, motion vector at pixel centres)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry import camera as camera_mod
+from ..geometry.accel import Hits
+from ..lights.table import emitted_radiance
+from ..materials.surface import Surface
+from ..sampling import cols, dot, finite
+from .pathtracer import _lamp_emission, lamp_hits, sample_rays
+from .trace_context import TraceContext
+
+
+@dataclass
+class PrimaryHits:
+    """Camera rays through n raster points: emission seen directly (3, n), alpha (n,), the rows that hit
+    geometry (k,) and their surfaces (surface.Surface, k)."""
+
+    emitted: np.ndarray
+    alpha: np.ndarray
+    rows: np.ndarray
+    surf: Surface
+
+
+def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray | None = None,
+            may_see_lamp: np.ndarray | None = None) -> PrimaryHits:
+    """Camera rays through raster points (x, y) (window pixels + jitter, y up). ``may_hit`` / ``may_see_lamp`` (n,)
+    bool: False where the ray is known to meet no geometry / no lamp visible to the camera (projected boxes,
+    camera.box_pixels and camera.emitter_pixels), which is then not traced against it; under a constant world a ray
+    that may meet neither is not generated at all (it sees the world's colour, or nothing on a transparent film)."""
+    if may_hit is not None and ctx.world.image is None:
+        need = may_hit if not len(ctx.scene.lamps.tris) else \
+            np.ones(len(x), bool) if may_see_lamp is None else may_hit | may_see_lamp
+        if not need.all():
+            idx = np.flatnonzero(need)
+            sub = primary(ctx, x[idx], y[idx], may_hit[idx], None if may_see_lamp is None else may_see_lamp[idx])
+            transparent = ctx.film_transparent
+            emitted = np.empty((3, len(x)), np.float32)
+            emitted[:] = 0.0 if transparent else ctx.world.color[:, None]
+            emitted[:, idx] = sub.emitted
+            alpha = np.full(len(x), 0.0 if transparent else 1.0, np.float32)
+            alpha[idx] = sub.alpha
+            return PrimaryHits(emitted, alpha, idx[sub.rows], sub.surf)
+    cam = ctx.scene.camera
+    o, d, tmax = camera_mod.generate_rays(cam, x, y)
+    if may_hit is None or may_hit.all():
+        hits = ctx.geom_accel.intersect(o, d, tmax)
+    else:
+        hits = Hits(len(x))
+        idx = np.flatnonzero(may_hit)
+        if idx.size:
+            sub = ctx.geom_accel.intersect(cols(o, idx), cols(d, idx), None if tmax is None else tmax[idx])
+            hits.prim[idx], hits.t[idx], hits.u[idx], hits.v[idx] = sub.prim, sub.t, sub.u, sub.v
+    emitted, alpha = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
+    rows = np.flatnonzero(hits.prim >= 0)
+    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
+    return PrimaryHits(emitted, alpha, rows, surf)
+
+
+def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
+    """What camera rays through raster points (x, y) see emitted (3, n) and their alpha (n,): the part of
+    :func:`primary` that needs no surface (extra rays per pixel for pixel coverage)."""
+    o, d, tmax = camera_mod.generate_rays(ctx.scene.camera, x, y)
+    return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax))
+
+
+def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: np.ndarray | None = None):
+    """Emission (3, n) camera rays meet first: visible lamps in front of the hit, emissive surfaces, the world
+    where nothing is hit (unless the film is transparent); alpha (n,) 0 where nothing is hit on a transparent
+    film. ``camera`` False: rays continuing a camera ray through delta interfaces (every lamp is seen, the film's
+    transparency does not apply). ``lamp_mask`` (n,) bool: only these rays may see a lamp (None: all)."""
+    n = len(hits.prim)
+    emitted = np.zeros((3, n), np.float32)
+    alpha = np.ones(n, np.float32)
+    rows = None if lamp_mask is None else np.flatnonzero(lamp_mask)
+    if len(ctx.scene.lamps.tris) and (rows is None or rows.size):  # lamps seen (camera rays: those visible to them)
+        far = hits.t if tmax is None else np.minimum(hits.t, tmax)
+        oo, dd = (o, d) if rows is None else (cols(o, rows), cols(d, rows))
+        lh = lamp_hits(ctx, oo, dd, far if rows is None else far[rows])
+        sel = np.flatnonzero(lh.prim >= 0)
+        if camera:
+            sel = sel[ctx.scene.lamps.camera_visible[lh.prim[sel]]]
+        if sel.size:
+            em = _lamp_emission(ctx, lh, oo, dd, sel)[0]
+            emitted[:, sel if rows is None else rows[sel]] += em
+    miss = hits.prim < 0
+    if ctx.film_transparent and camera:
+        alpha[miss] = 0.0
+    elif miss.any():
+        m = np.flatnonzero(miss)
+        emitted[:, m] += ctx.world.radiance(cols(d, m))
+    if ctx.lights.n_geom:  # emissive surfaces (mesh emission is two-sided by default)
+        prim = np.maximum(hits.prim, 0)
+        em = np.flatnonzero((hits.prim >= 0) & (ctx.lights.geom_to_light[prim] >= 0))
+        if em.size:
+            emitted[:, em] += emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em],
+                                               hits.v[em])
+    return finite(emitted), alpha
+
+
+@dataclass
+class SpecularChains:
+    """Camera paths continued through smooth glass to the first other surface (:func:`follow_specular`): per
+    remaining hit row, the throughput (3, k) of the delta interfaces crossed and their number ``depth`` (k,)."""
+
+    throughput: np.ndarray
+    depth: np.ndarray
+
+
+def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generator) -> SpecularChains | None:
+    """Continue the camera rays that met smooth glass through its delta interfaces (reflection or refraction
+    drawn by Fresnel) until they meet another surface, in place: ``hits.surf`` becomes that surface (so resampling
+    runs where the light is actually shaded), the emission met on the way (lamps, emissive surfaces, the world,
+    times the throughput so far; MIS weight 1 after a delta interface) joins ``hits.emitted``, and rows that
+    escape, die on a shading-normal artefact or exceed the bounce budget leave ``hits.rows``. Returns the chains
+    (None when no camera ray met glass)."""
+    s = hits.surf
+    if s.glass is None or ctx.max_bounces == 0:
+        return None
+    n = len(hits.rows)
+    prim, b1, b2 = s.prim.copy(), s.b1.copy(), s.b2.copy()
+    o, d, t = s.p.copy(), -s.wo, np.zeros(n, np.float32)
+    thr = np.ones((3, n), np.float32)
+    depth = np.zeros(n, np.int64)
+    alive = np.ones(n, bool)
+    idx = np.flatnonzero(s.glass)
+    cur = s.take(idx)
+    for k in range(ctx.max_bounces + 1):  # as the path tracer: rays from vertices 0..max_bounces find emission,
+        ray = sample_rays(cur, rng.random((3, len(idx)), dtype=np.float32))  # vertices up to max_bounces are shaded
+        alive[np.setdiff1d(idx, idx[ray.rows])] = False
+        idx = idx[ray.rows]
+        if idx.size == 0:
+            break
+        thr[:, idx] *= ray.f
+        depth[idx] += 1
+        hit = ctx.geom_accel.intersect(ray.o, ray.d)
+        em, _a = _seen(ctx, ray.o, ray.d, None, hit, camera=False)
+        pix = hits.rows[idx]
+        hits.emitted[:, pix] += finite(cols(thr, idx) * em)
+        got = (hit.prim >= 0) & (depth[idx] <= ctx.max_bounces)
+        alive[idx[~got]] = False
+        sel = np.flatnonzero(got)
+        idx = idx[sel]
+        if idx.size == 0:
+            break
+        prim[idx], b1[idx], b2[idx], t[idx] = hit.prim[sel], hit.u[sel], hit.v[sel], hit.t[sel]
+        o[:, idx], d[:, idx] = cols(ray.o, sel), cols(ray.d, sel)
+        cur = Surface(ctx, prim[idx], b1[idx], b2[idx], o[:, idx], d[:, idx], t[idx])
+        more = np.zeros(len(idx), bool) if cur.glass is None else cur.glass
+        if not more.any():
+            idx = idx[:0]
+            break
+        cur = cur.take(np.flatnonzero(more))
+        idx = idx[more]
+    alive[idx] = False  # still on glass when the bounce budget ran out
+    keep = np.flatnonzero(alive)
+    hits.rows = hits.rows[keep]
+    hits.surf = Surface(ctx, prim[keep], b1[keep], b2[keep], o[:, keep], d[:, keep], t[keep])
+    return SpecularChains(thr[:, keep], depth[keep])
+
+
+
+
+def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
+    """First hit at raster points (x, y): planar depth along the camera axis (n,) (1e10 = nothing,
+    as Cycles), the world-space shading normal facing the camera (n, 3) (zero = nothing) and the motion
+    vector (n, 4) in Blender's convention: (prev - current, current - next) raster positions in pixels
+    (zero without neighbouring-frame data or where nothing is hit)."""
+    cam = ctx.scene.camera
+    o, d, tmax = camera_mod.generate_rays(cam, x, y)
+    hits = ctx.geom_accel.intersect(o, d, tmax)
+    depth = np.full(len(x), 1e10, np.float32)
+    normal = np.zeros((len(x), 3), np.float32)
+    vector = np.zeros((len(x), 4), np.float32)
+    hit = np.flatnonzero(hits.prim >= 0)
+    if hit.size:
+        s = Surface(ctx, hits.prim[hit], hits.u[hit], hits.v[hit], cols(o, hit), cols(d, hit), hits.t[hit])
+        depth[hit] = dot(s.p - camera_mod.position(cam)[:, None], camera_mod.forward(cam)[:, None])
+        normal[hit] = s.ns.T
+        motion = ctx.scene.motion
+        inst = ctx.scene.geometry.instance
+        if motion is not None and inst is not None:
+            here = np.stack([x[hit], y[hit]], axis=1)
+            for which, which_cols, sign in (("prev", slice(0, 2), 1.0), ("next", slice(2, 4), -1.0)):
+                other_cam = motion.camera_prev if which == "prev" else motion.camera_next
+                if other_cam is None:
+                    continue
+                moved = motion.moved_points(s.p, inst[s.prim], which)
+                raster, _z = camera_mod.project(other_cam, moved)
+                vector[hit, which_cols] = sign * (raster - here)
+    return depth, normal, np.where(np.isfinite(vector), vector, 0.0).astype(np.float32)
+
+

@@ -1,0 +1,141 @@
+"""The trace context: everything a frame's chunks need, built once per scene content (acceleration structures,
+the light table, per-material rows, per-triangle normals, the world), and the instances' screen boxes."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.accel import Accel
+from ..lights.table import LightTable, triangle_geometry
+from ..lights.world import World
+from ..lights.world_points import WorldSphere
+from ..materials import microfacet_tables
+from ..materials.bsdf import SurfaceParams
+from ..materials.cutout import Cutout
+from ..scene import Scene
+
+
+@dataclass
+class TraceContext:
+    """Everything a chunk needs, built once per frame (reused while the scene content is unchanged).
+    Per-triangle data the path tracer gathers is kept as rows (structure of arrays)."""
+
+    scene: Scene
+    geom_accel: Accel
+    lamp_accel: Accel
+    lights: LightTable
+    geom_ng: np.ndarray  # (n, 3) unit geometric normals
+    lamp_ng: np.ndarray
+    material_params: SurfaceParams  # per material, untextured (gathered per hit)
+    max_bounces: int
+    rr_start: int = 3
+    film_transparent: bool = False
+    material_albedo: np.ndarray = None  # (m, 32) GGX albedo rows over μo at each material's α
+    material_layer: np.ndarray = None   # (m, 32) dielectric layer factor S rows over μo (microfacet_tables)
+    has_mix: bool = False  # some material is a Mix/Add shader (core/materials/mix.py)
+    world: World = None    # the background as a light (core/lights/world.py)
+    normal_maps: bool = False  # some material has a tangent-space normal map (surface.normal_map)
+    bump_maps: bool = False    # some material has a Bump node (surface.bump_map)
+    has_glass: bool = False    # some material has a smooth glass closure (core/materials/glass.py)
+    geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
+    geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
+    geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
+    lamp_ng_rows: np.ndarray = None     # (3, n_lamp) lamp_ng as rows
+    geom_derived: "GeometryDerived" = None  # the geometry-only arrays above, kept for a rebuild over the same triangles
+    emit_accel: Accel = None  # the emissive scene triangles alone (light index = primitive index), or None
+    # what rendering this content measured (shared by the frames and views that reuse this context):
+    # "auto_indirect" -> the last frame's AUTO indirect measurement and choice (renderer.FrameRenderer._remember)
+    measured: dict = field(default_factory=dict)
+
+
+
+
+@dataclass
+class GeometryDerived:
+    """Per-triangle arrays derived from the geometry alone (kept while the triangles are unchanged)."""
+
+    bounds: tuple          # (min (3,), max (3,)) of the finite vertices, or None when there are none
+    ng: np.ndarray         # (n, 3) unit geometric normals
+    ng_rows: np.ndarray    # (3, n)
+    flat: np.ndarray       # (n,) bool: the three corner normals are equal
+    normal_rows: np.ndarray  # (9, n) corner shading normals as rows
+    boxes: tuple = None    # (lo (k, 3), hi (k, 3)): each instance's box (one box without instances; camera.box_pixels)
+
+    @staticmethod
+    def of(geom) -> "GeometryDerived":
+        verts = geom.verts.reshape(-1, 3)
+        finite = verts[np.isfinite(verts).all(axis=1)]
+        bounds = (finite.min(0), finite.max(0)) if len(finite) else None
+        boxes = instance_boxes(geom, bounds)
+        ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
+        nrm = geom.normals
+        flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
+        return GeometryDerived(bounds, ng, np.ascontiguousarray(ng.T), flat,
+                               np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32), boxes)
+
+
+def instance_boxes(geom, bounds) -> tuple:
+    """(lo (k, 3), hi (k, 3)) float32: the bounding box of each instance's finite vertices (geometry.instance),
+    or the scene's ``bounds`` as one box when there are no instances; empty without geometry."""
+    empty = (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.float32))
+    if bounds is None:
+        return empty
+    inst = geom.instance
+    if inst is None or len(inst) == 0 or inst.min() == inst.max():
+        return np.asarray(bounds[0], np.float32)[None], np.asarray(bounds[1], np.float32)[None]
+    v = geom.verts
+    ok = np.isfinite(v).all(axis=2)[..., None]
+    tlo = np.where(ok, v, np.inf).min(axis=1)
+    thi = np.where(ok, v, -np.inf).max(axis=1)
+    order = np.argsort(inst, kind="stable")
+    starts = np.flatnonzero(np.r_[True, np.diff(inst[order]) != 0])
+    lo = np.minimum.reduceat(tlo[order], starts)
+    hi = np.maximum.reduceat(thi[order], starts)
+    keep = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
+    return lo[keep].astype(np.float32), hi[keep].astype(np.float32)
+
+
+def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False, accels: dict | None = None
+                  ) -> TraceContext:
+    """Everything the chunks need for ``scene``. ``accels`` (optional) hands over what an earlier context built
+    over exactly these triangles (an edit of materials, lamps or the world): "geom" / "lamp" Embree scenes
+    (Accel), "derived" (GeometryDerived); they are reused instead of rebuilt."""
+    accels = accels or {}
+    geom = scene.geometry
+    lamps = scene.lamps
+    derived = accels.get("derived") or GeometryDerived.of(geom)
+    lamp_verts = lamps.tris.verts.reshape(-1, 3)
+    lamp_verts = lamp_verts[np.isfinite(lamp_verts).all(axis=1)]
+    boxes = [b for b in (derived.bounds, (lamp_verts.min(0), lamp_verts.max(0)) if len(lamp_verts) else None)
+             if b is not None]
+    lo = np.min([b[0] for b in boxes], axis=0) if boxes else np.zeros(3)
+    hi = np.max([b[1] for b in boxes], axis=0) if boxes else np.zeros(3)
+    radius = float(np.linalg.norm(hi - lo) / 2) if boxes else 1.0
+    geom_ng = derived.ng
+    lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
+    params = SurfaceParams.of_table(scene.materials)
+    geom_ng_rows = derived.ng_rows
+    cut = Cutout.of(geom, scene.materials)
+    geom_accel = accels["geom"].with_cutout(cut, geom_ng_rows if cut else None) if "geom" in accels else \
+        Accel(geom.verts, cut, geom_ng_rows if cut else None)
+    world = World(scene.world_radiance, getattr(scene, "world_image", None), getattr(scene, "world_rotation", None))
+    lights = LightTable(scene, max(radius, 1e-3))
+    if world.sampled:  # the world's points may enter ReSTIR DI reservoirs (di.CandidateSettings.world_candidates)
+        lights.attach_world(WorldSphere(world, (lo + hi) / 2, max(radius, 1e-3)))
+    return TraceContext(scene=scene, geom_accel=geom_accel,
+                        lamp_accel=accels["lamp"] if "lamp" in accels else Accel(lamps.tris.verts),
+                        lights=lights, geom_ng=geom_ng, lamp_ng=lamp_ng,
+                        emit_accel=Accel(lights.tri_verts[:lights.n_geom]) if lights.n_geom else None,
+                        material_params=params, max_bounces=int(max(0, max_bounces)),
+                        film_transparent=film_transparent, material_albedo=microfacet_tables.albedo_rows(params.alpha),
+                        material_layer=microfacet_tables.layer_rows(params.alpha, params.f0r),
+                        has_mix=scene.materials.mix_first is not None and bool((scene.materials.mix_first >= 0).any()),
+                        normal_maps=scene.materials.normal_tex is not None
+                        and bool((scene.materials.normal_tex >= 0).any()),
+                        bump_maps=scene.materials.bump_tex is not None and bool((scene.materials.bump_tex >= 0).any()),
+                        has_glass=scene.materials.transmission is not None
+                        and bool((scene.materials.transmission > 0).any()),
+                        world=world,
+                        geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
+                        lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)

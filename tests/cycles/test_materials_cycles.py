@@ -1,0 +1,213 @@
+"""Materials against Cycles (same bpy, CPU): the Principled BSDF at every view angle, Glossy and Diffuse BSDFs.
+
+Scenes (tests/bpy_scenes.py): a 6 x 4 grid of spheres (SPHERE_GRID: Principled dielectrics at roughness 0.1-1,
+IOR 1.2/1.5/2.0, Specular IOR Level 0/0.5/1, Specular Tint; metals at roughness 0.1-1 and a tinted metal; Glossy
+BSDFs; a Diffuse BSDF; a half-metal; a white and a black dielectric) lit by an area light or an emissive quad, and
+a floor of four materials seen at grazing angles by a low camera. Each side renders 16 independent seeds (Cycles'
+from the stored reference, tests/cycles_reference.py); per
+sphere (its pixels only) or per floor cell the means are compared with Welch z-scores, with the bound of
+tests/test_cycles_accuracy.py: |ours - Cycles| < 5 SE + 0.5 % of Cycles (two-sided p ≈ 2e-5 per cell at
+the SE bound; the margin is 4x tighter than the 2 % the materials issue asks for).
+
+Power: the cells that isolate a lobe (diffuse, the layered diffuse of a white dielectric, the dielectric specular
+of a black one, rough metals, a Glossy BSDF, rough dielectrics of IOR 1.2 and 2.0) must each have a bound tighter
+than a 3 % error: |1.03 x - x| > 5 SE + 0.5 % at the cell's mean x (relative SE below about 0.5 %), so a 3 % error
+in any of those lobes fails at least half the time, and almost surely where the SE is well inside that. (The check
+once scaled the *measured* mean by 1.03, which made it fail by chance where that mean fell 2-3 SE below Cycles'.)
+Before the Cycles layering (diffuse weighted by 1 - Schlick(f0, cos θ_view)) the floor's rough dielectrics read
+38 % dark in the far cells and spheres were off by up to 8 % (docs/RESULTS.md "Principled BSDF").
+"""
+import numpy as np
+import pytest
+from bpy_scenes import SPHERE_GRID, alpha_scene, grazing_floor, material_spheres
+from cycles_compare import cycles_reference, ours_cells
+from stats import assert_cells_match, cell_means, image_cells
+
+ROWS, COLS = len(SPHERE_GRID), len(SPHERE_GRID[0])
+SIZE = (144, 96)
+# (row, col) of the cells that isolate one lobe each (see the module docstring)
+LOBE_CELLS = {"diffuse": (3, 2), "layered diffuse": (3, 4), "dielectric specular": (3, 5), "metal 0.5": (1, 2),
+              "metal 1.0": (1, 4), "glossy": (3, 1), "IOR 1.2": (2, 1), "IOR 2.0": (2, 3)}
+TRANSPARENT = 32  # Cycles' transparent bounces: cut-outs pass up to 32 transparent points in ours
+
+
+def sphere_masks(size=SIZE):
+    """(rows*COLS, h, w) bool: the pixels inside each sphere (orthographic camera, 6 units across, radius 0.4,
+    half a pixel in from the silhouette; rows = height / cell size), row 0 of the image at the top."""
+    w, h = size
+    rows = h * COLS // w
+    yy, xx = np.mgrid[0:h, 0:w] + 0.5
+    r = 0.4 * w / COLS - 0.5
+    return np.array([(yy - (i + 0.5) * h / rows) ** 2 + (xx - (j + 0.5) * w / COLS) ** 2 < r * r
+                     for i in range(rows) for j in range(COLS)])
+
+
+def by_masks(masks):
+    return lambda images: cell_means(images, masks)
+
+
+def both(case, build, bounces, ours_samples, cycles_samples, reduce, **settings):
+    """((REPS, cells) ours, (REPS, cells) Cycles' stored reference ``case``) of ``build()``."""
+    ours = ours_cells(build, bounces, ours_samples, reduce, **settings)
+    ref = cycles_reference(case, build, bounces, cycles_samples, reduce, transparent_max_bounces=TRANSPARENT)
+    return ours, ref
+
+
+def grid_names():
+    return [f"{kind} base {base} roughness {rough} {extra}" for row in SPHERE_GRID for kind, base, rough, extra in row]
+
+
+POWER = [r * COLS + c for r, c in LOBE_CELLS.values()]
+
+
+@pytest.mark.parametrize("light,bounces", [("AREA", 0), ("QUAD", 0), ("AREA", 3)])
+def test_material_grid_path_tracer_matches_cycles(addon, light, bounces):
+    ours, ref = both(f"spheres_{light.lower()}_b{bounces}", lambda: material_spheres(light, SIZE), bounces, 32, 64,
+                     by_masks(sphere_masks()), integrator="PATH")
+    assert_cells_match(ours, ref, grid_names(), POWER)
+
+
+def test_material_grid_restir_di_matches_cycles(addon):
+    """ReSTIR DI's target and shading use the same material model: unbiased mode converges to Cycles per sphere."""
+    ours, ref = both("spheres_area_b0", lambda: material_spheres("AREA", SIZE), 0, 16, 64, by_masks(sphere_masks()),
+                     integrator="RESTIR", direct_method="RESTIR", bias_correction="UNBIASED", temporal_reuse=True,
+                     spatial_neighbors=5)
+    assert_cells_match(ours, ref, grid_names(), POWER)
+
+
+def test_grazing_floor_matches_cycles(addon):
+    """Rough Principled floors seen at grazing angles (the issue's 11-12 % dark case; 38 % in this scene's far
+    cells before the fix): 4 x 4 image cells, the sky cells (black in Cycles) left out; the three rows of floor
+    cells below the horizon row must each be able to see a 3 % error."""
+    size = (96, 64)
+    a, b = both("grazing_floor", lambda: grazing_floor(size), 0, 64, 64, by_masks(image_cells(size)),
+                integrator="PATH")
+    lit = np.flatnonzero(b.mean(axis=0) > 0.02)
+    assert set(range(4, 16)) <= set(lit)
+    assert_cells_match(a[:, lit], b[:, lit], [f"cell {k}" for k in lit],
+                       power=[i for i, k in enumerate(lit) if k >= 4])
+
+
+def test_mix_and_add_shaders_match_cycles(addon):
+    """Mix (constant factor, an image-texture factor, nested, two Principled BSDFs of different roughness) and Add
+    shaders (two BSDFs; Emission + Principled) per sphere against Cycles. Before, the exporter blended the
+    components' parameters (reported as an approximation)."""
+    from bpy_scenes import MIX_GRID
+    size = (144, 24)
+    masks = sphere_masks(size)[:len(MIX_GRID[0])]
+    ours, ref = both("mix_add", lambda: material_spheres("AREA", size, MIX_GRID), 0, 64, 256, by_masks(masks),
+                     integrator="PATH")
+    names = [str(spec[:2]) for spec in MIX_GRID[0]]
+    assert_cells_match(ours, ref, names, power=[1, 2, 3, 5])
+
+
+def path_vs_cycles_cells(case, build, bounces, size=(96, 64)):
+    """Per-seed means of the 4 x 4 image cells of ``build(size)`` rendered by our path tracer (64 samples) and by
+    Cycles (128, the stored reference ``case``): ((REPS, 16), (REPS, 16))."""
+    return both(case, lambda: build(size), bounces, 64, 128, by_masks(image_cells(size)), integrator="PATH")
+
+
+def test_alpha_cutouts_match_cycles(addon):
+    """Principled Alpha 0.4 and a Mix(Transparent, Diffuse) whose factor is a checker image (Closest
+    interpolation), seen by the camera in front of a wall and casting shadows: camera, shadow and (with the wall
+    behind) every ray passes the transparent points as Cycles' transparency does, per 4 x 4 image cell."""
+    assert_cells_match(*path_vs_cycles_cells("alpha_cutouts", alpha_scene, 0), [f"cell {k}" for k in range(16)],
+                       power=range(16))
+
+
+@pytest.mark.parametrize("kind,bounces", [("IMAGE", 0), ("CONSTANT", 0), ("IMAGE", 3)])
+def test_world_light_matches_cycles(addon, kind, bounces):
+    """Spheres and a floor lit only by the world: an environment image (a sky with a small sun, made by the test,
+    rotated by a Mapping node) or a constant colour, light-sampled (core/lights/world.py) with MIS; per 4 x 4 image cell,
+    every cell below the horizon able to see a 3 % error except cell 7: the metal sphere's rim reflecting the sky,
+    where ours reads ~1.2 % low (z ≈ 3 in 24 seeds; Cycles bends a smooth normal at silhouettes where we bend the
+    view vector, docs/CONVENTIONS.md), inside the bound but too close to it for that power."""
+    from bpy_scenes import world_scene
+    cells = path_vs_cycles_cells(f"world_{kind.lower()}_b{bounces}", lambda size: world_scene(kind, size, rotation_z=0.8),
+                                 bounces)
+    assert_cells_match(*cells, [f"cell {k}" for k in range(16)], power=[4, 5, 6] + list(range(8, 16)))
+
+
+def test_world_in_reservoirs_matches_cycles(addon):
+    """The environment-image world of :func:`test_world_light_matches_cycles` with ReSTIR DI holding the world's
+    samples in its reservoirs (World Light Resampled, spatial reuse; core/lights/world_points.py), direct light: per 4 x 4
+    image cell against Cycles, the same cells able to see a 3 % error."""
+    from bpy_scenes import world_scene
+    size = (96, 64)
+    ours, ref = both("world_image_b0", lambda: world_scene("IMAGE", size, rotation_z=0.8), 0, 32, 128,
+                     by_masks(image_cells(size)), direct_method="RESTIR", world_method="RESAMPLED")
+    assert_cells_match(ours, ref, [f"cell {k}" for k in range(16)], power=[4, 5, 6] + list(range(8, 16)))
+
+
+def test_normal_maps_match_cycles(addon):
+    """Tangent-space Normal Map nodes (strength 1 on the floor, 0.5 on a wall whose UVs run another way) on
+    Principled BSDFs, lit at grazing angles: Cycles' bump-map correction (the diffuse lobe's shadowing term and the
+    hemisphere test against the unmapped normal) and its valid-reflection normal for the specular lobes are
+    modelled; per 4 x 4 image cell, every cell able to see a 3 % error. (Before those two corrections the cells
+    read 2-9 % bright; on a normal-mapped sphere, which this test leaves out, one cell still reads 0.65 % high,
+    docs/RESULTS.md.)"""
+    from bpy_scenes import normal_map_scene
+    assert_cells_match(*path_vs_cycles_cells("normal_maps", normal_map_scene, 0), [f"cell {k}" for k in range(16)],
+                       power=range(16))
+
+
+def test_bump_maps_match_cycles(addon):
+    """Bump nodes on a height map of ridges (floor: strength 1; wall: strength 0.5, inverted) on Principled BSDFs,
+    lit at grazing angles: per 4 x 4 image cell, every cell able to see a 3 % error. Cycles differentiates the
+    height over a tenth of a pixel's footprint (Filter Width 0.1), we exactly along the UVs; a central difference
+    one texel apart instead (2.5 % weaker slopes at 16 texels per ridge) read up to 2 % off in 5 cells."""
+    from bpy_scenes import bump_scene
+    assert_cells_match(*path_vs_cycles_cells("bump_maps", bump_scene, 0), [f"cell {k}" for k in range(16)], power=range(16))
+
+
+@pytest.mark.parametrize("integrator,window", [("PATH", False), ("RESTIR", False), ("RESTIR", True)])
+def test_smooth_glass_matches_cycles(addon, integrator, window):
+    """Smooth glass spheres (a Glass BSDF, a tinted Principled with Transmission 1, a half-transmissive red
+    Principled) before a checkered wall, 4 bounces: refraction, reflection, total internal reflection and the
+    caustics under them (BSDF paths through delta interfaces hitting the lamp), by the path tracer and by the
+    default integrator (camera paths continue through the glass to the surface behind, where resampling runs,
+    with the bounces they have left), also with a glass pane across the lower half of the view; per 4 x 4 image
+    cell, every cell able to see a 3 % error except cells 8-10 (the spheres' caustics: rel SE 0.4-0.6 %, so
+    5 SE + 0.5 % reaches 3 %) and cell 11 (the half-transmissive sphere, whose roughness-0 dielectric layer reads
+    0.7-1.0 % low, |z| up to 3.4, not yet explained: inside the bound but too close to it for that power); they
+    are held to the bound only. (With Base Color tinting each crossing instead of
+    its square root, as Cycles' Principled does, the tinted sphere's cells read 4 % dark.)"""
+    from bpy_scenes import glass_scene
+    size = (96, 64)
+    kw = {"integrator": "PATH"} if integrator == "PATH" else {}
+    ours, ref = both("glass_smooth_window" if window else "glass_smooth", lambda: glass_scene(size, window=window), 4,
+                     64, 128, by_masks(image_cells(size)), **kw)
+    assert_cells_match(ours, ref, [f"cell {k}" for k in range(16)],
+                       power=[k for k in range(16) if k not in (8, 9, 10, 11)])
+
+
+@pytest.mark.parametrize("integrator", ["PATH", "RESTIR"])
+def test_rough_glass_matches_cycles(addon, integrator):
+    """The glass spheres rough: a Glass BSDF at roughness 0.3, the tinted Principled at 0.2 and the half-transmissive
+    one at 0.5 (Multiscatter GGX, Blender's default: the interface scaled by 1/E, its directional albedo), 4 bounces,
+    by the path tracer and by the default integrator (camera paths continue through rough glass as through smooth);
+    per 4 x 4 image cell, every cell but the caustics' (8-11, rel SE up to 0.8 %) able to see a 3 % error. Without
+    the 1/E compensation each crossing would keep only E of the light: 0.86-1.0 at roughness 0.3 and 0.67-0.99 at 0.5
+    (entering, IOR 1.45-1.5, from grazing to normal incidence)."""
+    from bpy_scenes import glass_scene
+    size = (96, 64)
+    kw = {"integrator": "PATH"} if integrator == "PATH" else {}
+    rough = (0.3, 0.2, 0.5)
+    # twice the smooth test's samples: at 64 / 128 spp the Glass BSDF sphere's cell had rel SE 0.4 %, where
+    # 5 SE + 0.5 % no longer sees a 3 % error (Python 3.13 run); 0.23 % at these samples
+    ours, ref = both("glass_rough", lambda: glass_scene(size, roughness=rough), 4, 128, 256,
+                     by_masks(image_cells(size)), **kw)
+    assert_cells_match(ours, ref, [f"cell {k}" for k in range(16)],
+                       power=[k for k in range(16) if k not in (8, 9, 10, 11)])
+
+
+def test_rough_diffuse_matches_cycles(addon):
+    """Diffuse BSDF Roughness 0.3 / 0.6 / 1 and Principled Diffuse Roughness 0.5 / 1: Cycles' energy-preserving
+    Oren–Nayar, per sphere, each able to see a 3 % error (rendered as Lambert before: -2.4 % to +3.8 %)."""
+    from bpy_scenes import ROUGH_DIFFUSE_GRID
+    size = (144, 24)
+    masks = sphere_masks(size)[:len(ROUGH_DIFFUSE_GRID[0])]
+    ours, ref = both("rough_diffuse", lambda: material_spheres("AREA", size, ROUGH_DIFFUSE_GRID), 0, 32, 64,
+                     by_masks(masks), integrator="PATH")
+    names = [f"{k} roughness {r} {e}" for k, _c, r, e in ROUGH_DIFFUSE_GRID[0]]
+    assert_cells_match(ours, ref, names, power=range(6))
