@@ -12,6 +12,7 @@ says how to render the reference again, so stored data cannot silently go stale.
   ``stored`` (default)  the committed data (a CI run renders only our side);
   ``render``            Cycles renders afresh and nothing is written (the slow suite as it ran before);
   ``update``            Cycles renders afresh and the data is written (scripts/make_cycles_refs.sh).
+``RESTIR_FINGERPRINT_DUMP=FILE`` appends each fingerprinted record (JSON) to FILE, to see what changed in a scene.
 """
 from __future__ import annotations
 
@@ -182,13 +183,6 @@ def cycles_cells(case: str, build, configure, render, reduce, reps: int, samples
     how = mode()
     path = _path(case)
     meta = {"case": case, "reps": reps, "seeds": list(range(reps)), "samples": samples, "bounces": bounces}
-    if os.environ.get("RESTIR_REFINGERPRINT"):  # one-off: the fingerprint function changed, the scenes did not
-        with open(path) as f:
-            data = json.load(f)
-        data["fingerprint"] = fingerprint
-        with open(path, "w") as f:
-            json.dump(data, f, indent=1)
-            f.write("\n")
     if how == "stored":
         if not os.path.exists(path):
             raise StaleReference(f"no stored Cycles reference {os.path.relpath(path)}: render it with "
