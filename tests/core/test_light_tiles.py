@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from restir_engine.core.lights import tiles as light_tiles
-from restir_engine.core.materials.bsdf import SurfaceParams
+from restir_engine.core.materials.params import SurfaceParams
 from restir_engine.core.lights.tiles import TileSettings
 from restir_engine.core.renderer import RenderSettings, render_frame
 from restir_engine.core.restir.di import shading_value

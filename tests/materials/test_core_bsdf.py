@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from restir_engine.core.materials import bsdf
-from restir_engine.core.materials.bsdf import SurfaceParams
+from restir_engine.core.materials.params import PARAM_ROWS, SurfaceParams
 
 N = 400_000
 
@@ -242,7 +242,7 @@ def test_rows_gathered_on_first_use_equal_the_block():
     mat = rng.choice(m, n, p=[0.5, 0.1, 0.3, 0.1])
     lazy, eager = table.gather(mat), table.take(mat)
     assert len(lazy) == n and lazy.lobes == table.lobes
-    for name in bsdf.PARAM_ROWS:
+    for name in PARAM_ROWS:
         np.testing.assert_array_equal(getattr(lazy, name), getattr(eager, name))
     np.testing.assert_array_equal(lazy.grey("fd"), eager.fd[0])
     sub = np.arange(0, n, 7)

@@ -24,7 +24,8 @@ import numpy as np
 
 from ..geometry.accel import offset_origin, shadow_rays
 from ..lights.table import emitted_radiance, spot_factor
-from ..materials.bsdf import SurfaceParams, diffuse_f, eval_view, sample_bsdf
+from ..materials.bsdf import diffuse_f, eval_view, sample_bsdf
+from ..materials.params import SurfaceParams
 from ..materials.glass import DELTA_PDF, sample_glass
 from ..materials.surface import Surface
 from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
@@ -208,7 +209,7 @@ class FirstBounce:
     """Where the first BSDF rays of primary surfaces (n) went, for ReSTIR GI: ``rows`` (k,) the surfaces whose
     ray hit geometry at x2; ``throughput`` (3, k) f·|cos θ|/p of that ray (p: ``pdf`` (k,), solid angle);
     x2 ``p`` (3, k), its geometric normal ``n2`` (3, k) turned toward the primary surface, its BSDF parameters
-    ``params`` (bsdf.SurfaceParams, k) and ``lo`` (3, k) the radiance leaving x2 toward the primary surface
+    ``params`` (params.SurfaceParams, k) and ``lo`` (3, k) the radiance leaving x2 toward the primary surface
     estimated by the rest of the path (next-event estimation at x2 and bounces 2..max_bounces; not x2's own
     emission, which is the primary surface's direct light), ``lo_d`` (3, k) the part of it x2's diffuse lobe
     reflects (the same light samples weighed by the diffuse lobe alone). The path tracer's indirect light is
@@ -270,6 +271,29 @@ def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) 
         add(hs, le)
 
 
+def _vertex_light(ctx: TraceContext, s: Surface, rng, target, idx, throughput, first, dthr, at_x2: bool) -> None:
+    """Next-event estimation at a path vertex after the first, into ``target`` (and, past a first bounce, the
+    diffuse part ``first.lo_d``): at x2 split by lobe (throughput is 1 there), after it weighted by the throughput
+    and by the throughput through x2's diffuse lobe ``dthr``."""
+    if at_x2:
+        ne, ne_d = next_event(ctx, s, rng, None, diffuse=True)
+        target[:, idx] += ne
+        first.lo_d[:, idx] += ne_d
+    elif dthr is not None:
+        ne = next_event(ctx, s, rng, None)
+        target[:, idx] += ne * throughput
+        first.lo_d[:, idx] += ne * dthr
+    else:
+        target[:, idx] += next_event(ctx, s, rng, throughput)
+
+
+def _no_first_bounce(ctx: TraceContext) -> FirstBounce:
+    """A FirstBounce of no rays (no path reached a second vertex)."""
+    z3 = np.zeros((3, 0), np.float32)
+    return FirstBounce(np.zeros(0, np.int64), z3, np.zeros(0, np.float32), z3.copy(), z3.copy(),
+                       ctx.material_params.take(np.zeros(0, np.intp)), z3.copy(), z3.copy())
+
+
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
                    first_ray=None, first_bounce: bool = False, budget: np.ndarray | None = None,
                    world_resampled: bool = False) -> PathResult:
@@ -290,16 +314,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     dthr = None  # with first_bounce, after x2's BSDF sample: the throughput through x2's diffuse lobe alone
     for bounce in range(ctx.max_bounces + 1):
         target = direct if bounce == 0 else (indirect if first is None else first.lo)
-        if bounce == 1 and first is not None:  # at x2: split by lobe (throughput is 1 here)
-            ne, ne_d = next_event(ctx, s, rng, None, diffuse=True)
-            target[:, idx] += ne
-            first.lo_d[:, idx] += ne_d
-        elif bounce > 0 and dthr is not None:
-            ne = next_event(ctx, s, rng, None)
-            target[:, idx] += ne * throughput
-            first.lo_d[:, idx] += ne * dthr
-        elif bounce > 0:
-            target[:, idx] += next_event(ctx, s, rng, throughput)
+        if bounce > 0:
+            _vertex_light(ctx, s, rng, target, idx, throughput, first, dthr, at_x2=bounce == 1 and first is not None)
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -------
         ray = first_ray if bounce == 0 and first_ray is not None else \
             sample_rays(s, rng.random((3, len(idx)), dtype=np.float32))
@@ -381,10 +397,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     if not first_bounce:
         return PathResult(direct, indirect)
     if first is None:
-        first = FirstBounce(np.zeros(0, np.int64), np.zeros((3, 0), np.float32), np.zeros(0, np.float32),
-                            np.zeros((3, 0), np.float32), np.zeros((3, 0), np.float32),
-                            ctx.material_params.take(np.zeros(0, np.intp)), np.zeros((3, 0), np.float32),
-                            np.zeros((3, 0), np.float32))
+        first = _no_first_bounce(ctx)
     else:
         first.lo = finite(first.lo)
         first.lo_d = finite(first.lo_d)

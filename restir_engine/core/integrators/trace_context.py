@@ -11,7 +11,7 @@ from ..lights.table import LightTable, triangle_geometry
 from ..lights.world import World
 from ..lights.world_points import WorldSphere
 from ..materials import microfacet_tables
-from ..materials.bsdf import SurfaceParams
+from ..materials.params import SurfaceParams
 from ..materials.cutout import Cutout
 from ..scene import Scene
 

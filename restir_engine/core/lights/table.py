@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..materials.bsdf import luminance
+from ..materials.params import luminance
 from ..materials.textures import apply_texture, mean_color
 from ..sampling import AliasTable, barycentric, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
 from ..scene import Lamps, MaterialTable, Scene, TriangleSet

@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..sampling import barycentric, cols, dot, norm, orthonormal_basis
-from .bsdf import SurfaceParams, ViewTerms
+from .bsdf import ViewTerms
+from .params import SurfaceParams
 from .glass import GLASS_SALT
 from .microfacet_tables import lerp_rows, mu_index
 from .mix import hash_uniform, pick_components
@@ -21,27 +22,61 @@ class Surface:
 
     def __init__(self, ctx, prim, u, v, o, d, t):
         geom = ctx.scene.geometry
-        mats = ctx.scene.materials
         prim = prim.astype(np.intp)  # one index conversion for every gather below
         self.prim = prim
         self.b1, self.b2 = u, v
         self.p = (o + d * t).astype(np.float32, copy=False)
         mat = geom.material[prim].astype(np.intp)
         self.mat = mat  # the triangle's material (a Mix/Add shader stays itself here)
-        scale = None
-        if ctx.has_mix:  # Mix/Add shaders: one component per hit, scaled by the weights' sum (core/materials/mix.py)
-            mixed = np.flatnonzero(mats.mix_first[mat] >= 0)
-            if mixed.size:
-                uv = None
-                if geom.uvs is not None:
-                    c = np.take(geom.uvs, prim[mixed], axis=0)
-                    uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[mixed][:, None], v[mixed][:, None])
-                comp, w = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv)
-                mat = mat.copy()
-                mat[mixed] = comp
-                scale = np.ones(len(mat), np.float32)
-                scale[mixed] = w
+        mat, scale = self._pick_mix_components(ctx, mat)
         ng = cols(ctx.geom_ng_rows, prim)
+        ns = self._interpolated_normal(ctx, ng)
+        ns, mapped, smooth_n = self._mapped_normal(ctx, mat, ns, ng, d)
+        # shading normal on the geometric normal's side, both facing the incoming ray
+        s_ng = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
+        s_ns = np.where(dot(ns, ng) < 0, -s_ng, s_ng)
+        self.ng = ng * s_ng
+        self.ns = ns * s_ns
+        self.wo = -d
+        self.bsdf_mat = mat  # the material whose BSDF the hit uses
+        self._material_params(ctx, mat, scale)
+        self._glass(ctx, mat, scale, s_ng)
+        self.t, self.bt = orthonormal_basis(self.ns)
+        self._bump_shadowing(mapped, smooth_n, s_ng)
+        self._view_frame()
+        mu = self._specular_normal()
+        # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal): looked
+        # up once per hit when first used (α and η are constant per material: one interpolation in μo)
+        self._mu, self._tables = mu, (ctx.material_albedo, ctx.material_layer)
+        self._at = self._albedo = self._layer = None
+
+    def _uv(self, geom, rows) -> np.ndarray:
+        """(k, 2) texture coordinates of the hits ``rows``."""
+        c = np.take(geom.uvs, self.prim[rows], axis=0)
+        return barycentric(c[:, 0], c[:, 1], c[:, 2], self.b1[rows][:, None], self.b2[rows][:, None])
+
+    def _pick_mix_components(self, ctx, mat):
+        """Mix/Add shaders: one component per hit, scaled by the weights' sum (core/materials/mix.py). Returns
+        (the material each hit uses (n,), the scale (n,) float32 or None where no hit is mixed)."""
+        if not ctx.has_mix:
+            return mat, None
+        mats, geom = ctx.scene.materials, ctx.scene.geometry
+        mixed = np.flatnonzero(mats.mix_first[mat] >= 0)
+        if not mixed.size:
+            return mat, None
+        prim, u, v = self.prim, self.b1, self.b2
+        uv = self._uv(geom, mixed) if geom.uvs is not None else None
+        comp, w = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv)
+        mat = mat.copy()
+        mat[mixed] = comp
+        scale = np.ones(len(mat), np.float32)
+        scale[mixed] = w
+        return mat, scale
+
+    def _interpolated_normal(self, ctx, ng) -> np.ndarray:
+        """(3, n) unit shading normals: interpolated on smooth triangles, the corner normal on flat ones, the
+        geometric normal where the interpolation degenerates."""
+        prim, u, v = self.prim, self.b1, self.b2
         smooth = np.flatnonzero(~ctx.geom_flat[prim])
         if smooth.size == len(prim):
             c = cols(ctx.geom_normal_rows, prim)
@@ -56,88 +91,108 @@ class Surface:
         bad = ~np.isfinite(ln) | (ln < 0.5)
         if bad.any():
             ns[:, bad] = ng[:, bad]
-        mapped = None  # hits whose normal a Normal Map and/or a Bump node changed
+        return ns
+
+    def _mapped_normal(self, ctx, mat, ns, ng, d):
+        """Normal Map and Bump nodes applied to ``ns`` (in place). Returns (ns, the hits they changed or None, those
+        hits' smooth normals before mapping (3, k) or None)."""
+        mats, geom = ctx.scene.materials, ctx.scene.geometry
+        prim, u, v = self.prim, self.b1, self.b2
         none = np.empty(0, np.intp)
         nmap = np.flatnonzero(mats.normal_tex[mat] >= 0) if ctx.normal_maps and geom.tangents is not None else none
         bump = np.flatnonzero(mats.bump_tex[mat] >= 0) if ctx.bump_maps and geom.uvs is not None else none
-        if len(nmap) or len(bump):
-            mapped = np.union1d(nmap, bump)
-            smooth_n = ns[:, mapped].copy()
-            if len(nmap):
-                ns[:, nmap] = normal_map(mats, geom, mat, prim, u, v, ns, nmap)
-            if len(bump):  # about the normal facing the ray, as Cycles (then turned back like every normal)
-                facing = np.where(dot(cols(ng, bump), cols(d, bump)) > 0, np.float32(-1.0), np.float32(1.0))
-                ns[:, bump] = bump_map(mats, geom, mat, prim, u, v, ns[:, bump] * facing, bump) * facing
-        # shading normal on the geometric normal's side, both facing the incoming ray
-        s_ng = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
-        s_ns = np.where(dot(ns, ng) < 0, -s_ng, s_ng)
-        self.ng = ng * s_ng
-        self.ns = ns * s_ns
-        self.wo = -d
-        self.bsdf_mat = mat  # the material whose BSDF the hit uses
+        if not (len(nmap) or len(bump)):
+            return ns, None, None
+        mapped = np.union1d(nmap, bump)
+        smooth_n = ns[:, mapped].copy()
+        if len(nmap):
+            ns[:, nmap] = normal_map(mats, geom, mat, prim, u, v, ns, nmap)
+        if len(bump):  # about the normal facing the ray, as Cycles (then turned back like every normal)
+            facing = np.where(dot(cols(ng, bump), cols(d, bump)) > 0, np.float32(-1.0), np.float32(1.0))
+            ns[:, bump] = bump_map(mats, geom, mat, prim, u, v, ns[:, bump] * facing, bump) * facing
+        return ns, mapped, smooth_n
+
+    def _material_params(self, ctx, mat, scale) -> None:
+        """The hits' BSDF parameters: a view of the material table, re-derived where a texture drives the base
+        colour, scaled by the Mix weights."""
+        mats, geom = ctx.scene.materials, ctx.scene.geometry
         self.params = ctx.material_params.gather(mat)
         if geom.uvs is not None:
             textured = np.flatnonzero(mats.base_tex[mat] >= 0)
             if textured.size:  # re-derive the parameters where a texture drives the base colour
-                c = np.take(geom.uvs, prim[textured], axis=0)
-                uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[textured][:, None], v[textured][:, None])  # (k, 2)
+                uv = self._uv(geom, textured)  # (k, 2)
                 tm = mat[textured]
                 base = apply_texture(mats.base_color[tm], mats.base_tex[tm], uv, mats.textures)
                 self.params.assign(textured, SurfaceParams.of_table(mats, tm, base))
         if scale is not None:
             self.params.scale(scale)
-        # smooth glass (core/materials/glass.py): picked per point with the material's transmission share; black for every
-        # evaluation, sampled as a delta closure by pathtracer.sample_rays
+
+    def _glass(self, ctx, mat, scale, s_ng) -> None:
+        """Smooth glass (core/materials/glass.py): picked per point with the material's transmission share; black
+        for every evaluation, sampled as a delta closure by pathtracer.sample_rays."""
         self.glass = self.glass_front = self.glass_ior = self.glass_reflect = self.glass_refract = None
         self.glass_alpha = self.glass_ms = None
-        if ctx.has_glass:
-            cand = np.flatnonzero(mats.transmission[mat] > 0)
-            if cand.size:
-                pick = hash_uniform(prim[cand] ^ GLASS_SALT, u[cand], v[cand]) < mats.transmission[mat[cand]]
-                rows = cand[pick]
-                if rows.size:
-                    n = len(prim)
-                    self.glass = np.zeros(n, bool)  # per surface: uses the glass closure
-                    self.glass[rows] = True
-                    self.glass_front = s_ng > 0  # the ray came from outside (against the outward normal)
-                    gm = mat[rows]
-                    w = np.ones(rows.size, np.float32) if scale is None else scale[rows]
-                    self.glass_ior = np.ones(n, np.float32)
-                    self.glass_ior[rows] = mats.glass_ior[gm]
-                    self.glass_alpha = np.zeros(n, np.float32)
-                    self.glass_alpha[rows] = mats.glass_alpha[gm]
-                    self.glass_ms = np.zeros(n, bool)
-                    self.glass_ms[rows] = mats.glass_multiscatter[gm] > 0
-                    self.glass_reflect = np.zeros((3, n), np.float32)
-                    self.glass_reflect[:, rows] = mats.glass_reflect[gm].T * w
-                    self.glass_refract = np.zeros((3, n), np.float32)
-                    self.glass_refract[:, rows] = mats.glass_refract[gm].T * w
-                    k = rows.size
-                    self.params.assign(rows, SurfaceParams.from_material(np.zeros((k, 3), np.float32),
-                                                                         np.zeros(k), np.ones(k), np.zeros(k)))
-        self.t, self.bt = orthonormal_basis(self.ns)
+        if not ctx.has_glass:
+            return
+        mats, prim, u, v = ctx.scene.materials, self.prim, self.b1, self.b2
+        cand = np.flatnonzero(mats.transmission[mat] > 0)
+        if not cand.size:
+            return
+        pick = hash_uniform(prim[cand] ^ GLASS_SALT, u[cand], v[cand]) < mats.transmission[mat[cand]]
+        rows = cand[pick]
+        if not rows.size:
+            return
+        n = len(prim)
+        self.glass = np.zeros(n, bool)  # per surface: uses the glass closure
+        self.glass[rows] = True
+        self.glass_front = s_ng > 0  # the ray came from outside (against the outward normal)
+        gm = mat[rows]
+        w = np.ones(rows.size, np.float32) if scale is None else scale[rows]
+        self.glass_ior = np.ones(n, np.float32)
+        self.glass_ior[rows] = mats.glass_ior[gm]
+        self.glass_alpha = np.zeros(n, np.float32)
+        self.glass_alpha[rows] = mats.glass_alpha[gm]
+        self.glass_ms = np.zeros(n, bool)
+        self.glass_ms[rows] = mats.glass_multiscatter[gm] > 0
+        self.glass_reflect = np.zeros((3, n), np.float32)
+        self.glass_reflect[:, rows] = mats.glass_reflect[gm].T * w
+        self.glass_refract = np.zeros((3, n), np.float32)
+        self.glass_refract[:, rows] = mats.glass_refract[gm].T * w
+        k = rows.size
+        self.params.assign(rows, SurfaceParams.from_material(np.zeros((k, 3), np.float32), np.zeros(k), np.ones(k),
+                                                             np.zeros(k)))
+
+    def _bump_shadowing(self, mapped, smooth_n, s_ng) -> None:
+        """The unmapped (smooth) normal in the local frame and its shadowing term, for Cycles' bump shadowing."""
         self.bump_n = self.bump_a2 = None
-        if mapped is not None:  # the unmapped (smooth) normal in the local frame, for Cycles' bump shadowing
-            sn = smooth_n * s_ng[mapped]
-            self.bump_n = np.zeros((3, len(prim)), np.float32)
-            self.bump_n[2] = 1.0
-            self.bump_n[0, mapped] = dot(sn, cols(self.t, mapped))
-            self.bump_n[1, mapped] = dot(sn, cols(self.bt, mapped))
-            self.bump_n[2, mapped] = dot(sn, cols(self.ns, mapped))
-            cos_d = np.clip(np.abs(self.bump_n[2]), 1e-6, 1.0)
-            self.bump_a2 = np.clip(0.125 * (1.0 / (cos_d * cos_d) - 1.0), 0.0, 1.0).astype(np.float32)
+        if mapped is None:
+            return
+        sn = smooth_n * s_ng[mapped]
+        self.bump_n = np.zeros((3, len(self.prim)), np.float32)
+        self.bump_n[2] = 1.0
+        self.bump_n[0, mapped] = dot(sn, cols(self.t, mapped))
+        self.bump_n[1, mapped] = dot(sn, cols(self.bt, mapped))
+        self.bump_n[2, mapped] = dot(sn, cols(self.ns, mapped))
+        cos_d = np.clip(np.abs(self.bump_n[2]), 1e-6, 1.0)
+        self.bump_a2 = np.clip(0.125 * (1.0 / (cos_d * cos_d) - 1.0), 0.0, 1.0).astype(np.float32)
+
+    def _view_frame(self) -> None:
+        """wo in the local frame (t, bt, ns); views below the shading hemisphere (a shading-normal artefact) bent
+        to the horizon."""
         wo = self.wo
         wo_l = np.empty_like(wo)
         wo_l[0] = dot(wo, self.t)
         wo_l[1] = dot(wo, self.bt)
-        # view vectors below the shading hemisphere (shading-normal artefact): bend to the horizon
         wo_l[2] = np.maximum(dot(wo, self.ns), np.float32(1e-4))
         wo_l /= norm(wo_l)
         self.wo_l = wo_l
-        # Cycles' specular normal: where the mirror reflection of the view about the shading normal would leave
-        # below the geometric surface, the specular lobes use a normal bent toward ng just enough (the diffuse
-        # lobe keeps the shading normal)
+
+    def _specular_normal(self) -> np.ndarray:
+        """Cycles' specular normal: where the mirror reflection of the view about the shading normal would leave
+        below the geometric surface, the specular lobes use a normal bent toward ng just enough (the diffuse lobe
+        keeps the shading normal); ``spec_n`` (3, n) in the local frame or None. Returns μo about it (n,)."""
         self.spec_n = None
+        wo_l = self.wo_l
         mu = wo_l[2]
         bent = np.flatnonzero(dot(self.ns, self.ng) < np.float32(0.99999))
         if bent.size:
@@ -145,16 +200,13 @@ class Surface:
             rows = bent[changed]
             if rows.size:
                 n2 = n2[:, changed]
-                self.spec_n = np.zeros((3, len(prim)), np.float32)
+                self.spec_n = np.zeros((3, len(self.prim)), np.float32)
                 self.spec_n[2] = 1.0
                 self.spec_n[0, rows] = dot(n2, cols(self.t, rows))
                 self.spec_n[1, rows] = dot(n2, cols(self.bt, rows))
                 self.spec_n[2, rows] = dot(n2, cols(self.ns, rows))
                 mu = dot(wo_l, self.spec_n)
-        # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal): looked
-        # up once per hit when first used (α and η are constant per material: one interpolation in μo)
-        self._mu, self._tables = mu, (ctx.material_albedo, ctx.material_layer)
-        self._at = self._albedo = self._layer = None
+        return mu
 
     def __len__(self) -> int:
         return len(self.prim)

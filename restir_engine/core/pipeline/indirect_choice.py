@@ -13,7 +13,7 @@ import numpy as np
 
 from ..integrators import camera_paths, pathtracer
 from ..integrators.method_choice import choose_indirect_method
-from ..materials.bsdf import luminance_rows
+from ..materials.params import luminance_rows
 from ..restir.target import WIDTH
 from ..sampling import STREAM_PROBE, rng
 

@@ -33,7 +33,8 @@ import numpy as np
 from ..geometry.accel import shadow_rays
 from ..integrators.pathtracer import lamp_hits, sample_rays
 from ..lights.tiles import PackedPoints, TileSettings, light_points, sample_points
-from ..materials.bsdf import eval_view, luminance_rows, view_terms
+from ..materials.bsdf import eval_view, view_terms
+from ..materials.params import luminance_rows
 from ..sampling import cols, dot, finite, to_local, uniform_ints, vmax
 from .reservoir import Reservoirs, Stream
 from .target import FramePoints, with_spots

@@ -43,7 +43,7 @@ from .reservoir import Reservoirs
 from .target import LUM as _LUM
 
 INDIRECT_METHODS = ("AUTO", "OFF", "PATH", "RESTIR_GI")  # AUTO: core/integrators/method_choice.py
-GI_TARGETS = ("INTEGRAND", "RADIANCE")  # p̂ = lum(f · Lo) |cos θ1| G  or  lum(Lo) G (measured: docs/RESULTS.md)
+GI_TARGETS = ("INTEGRAND", "RADIANCE")  # p̂ = lum(f · Lo) |cos θ1| G  or  lum(Lo) G (compared in docs/RESULTS.md)
 JACOBIAN_LIMIT = 10.0  # biased mode: shifts whose |J| is outside [1/10, 10] are rejected (as RTXDI's sample app)
 
 
@@ -63,7 +63,7 @@ class GISettings:
 
     neighbors: int = 3
     radius: float = 0.0
-    passes: int = 4  # measured on interior_gi 640x360 (docs/RESULTS.md, "ReSTIR GI"): 1 -> 4 passes, relMSE / 8
+    passes: int = 4  # spatial passes per sample (the choice: docs/RESULTS.md, "ReSTIR GI")
     confidence_cap: float = 20.0
     max_age: int = 30
     roughness_threshold: float = 0.3
@@ -219,7 +219,7 @@ def clear_occluded(accel, terms, res: GIReservoirs) -> GIReservoirs:
     place. Run after each merge of the unbiased mode: a reservoir then only ever holds samples its own surface
     sees, the domain its technique is credited with in the neighbours' MIS weights (``GISpace.evaluate_mis``).
     Without it a sample passed on by an earlier spatial pass could be invisible to the surface holding it and the
-    MIS weights of later passes summed to more than one (measured +1.8 % after 4 frames with 4 passes). The
+    MIS weights of later passes summed to more than one (biased bright; docs/RESULTS.md, "ReSTIR GI"). The
     estimate is unchanged otherwise: an occluded sample contributes nothing when shaded."""
     live = np.flatnonzero(res.has_sample())
     if live.size:

@@ -142,7 +142,7 @@ class SpatialSettings:
     bias_correction: str = "UNBIASED"
 
 
-AUTO_RADIUS = 8.0          # pixels at 640 x 360 (measured: docs/RESULTS.md, "Spatial radius")
+AUTO_RADIUS = 8.0          # pixels at 640 x 360 (the choice: docs/RESULTS.md, "Spatial radius")
 AUTO_RADIUS_MIN = 4.0
 _REFERENCE_DIAGONAL = float(np.hypot(640, 360))
 
