@@ -1,6 +1,6 @@
 """The AUTO methods of the ReSTIR integrator, with the reason shown in the UI. Chosen from measurements:
-scripts/benchmark_direct_methods.py (docs/RESULTS.md, "Choosing the direct-light method") and
-scripts/benchmark_integrators.py ("Choosing the integrator per scene"): efficiency 1 / (relMSE x time) on the
+scripts/bench.py direct_methods (docs/RESULTS.md, "Choosing the direct-light method") and
+scripts/bench.py integrators ("Choosing the integrator per scene"): efficiency 1 / (relMSE x time) on the
 harness scenes at 320x180.
 
 Direct light (chosen when the frame starts):
@@ -14,7 +14,7 @@ Direct light (chosen when the frame starts):
   light sampling on those scenes with direct light only).
 - No lights but an environment image: ReSTIR DI with the world in its reservoirs where the direct light is what is
   left (direct only, or with ReSTIR GI), light sampling beside path-traced bounces
-  (scripts/benchmark_world_reservoirs.py).
+  (scripts/bench.py world_reservoirs).
 
 Indirect light (measured in the first sample pass of every frame, from the path-traced first bounces):
 - ReSTIR GI caches the diffuse light leaving the first bounce's point x2; light it cannot hold (off glossy and
@@ -29,7 +29,7 @@ FEW_LIGHTS = 8  # light entries (emissive triangles, lamps; a point/spot sphere 
 GI_MIN_SHARE = 0.05   # ReSTIR GI (even when set by the user) is skipped in a pass whose reservoirs would carry
 #                       less of the path-traced indirect light (luminance): nothing to cache
 GI_MAX_UNCACHED = 0.25  # AUTO: path tracing where more of the indirect light's second moment is in light the
-#   reservoirs cannot hold. A GI sample costs about 3x a path-traced one (benchmark_integrators.py), so GI must
+#   reservoirs cannot hold. A GI sample costs about 3x a path-traced one (scripts/bench.py integrators), so GI must
 #   remove over 2/3 of the indirect noise to win, and it never removes the uncached part's. Measured: the scenes
 #   where GI wins read 0.00 (rooms, many lights), those where it loses 0.39-0.94 (glass, glossy street)
 
@@ -72,7 +72,7 @@ def choose_world_method(lights, setting: str = "AUTO") -> tuple[str, str]:
     """(method, reason) for how resampled direct light treats the world: "RESAMPLED" (its samples in the ReSTIR DI
     reservoirs, world_points.py) or "LIGHT_SAMPLED" (one light sample per shaded point beside them). A reservoir
     keeps one sample for all its lights, so a world that shares the direct light with lamps or emitters adds the
-    choice between them to the noise (scripts/benchmark_world_reservoirs.py: a constant world with three lamps 3x
+    choice between them to the noise (scripts/bench.py world_reservoirs: a constant world with three lamps 3x
     the relMSE, an environment image with three lamps even to 2x worse); an environment image that is the only
     light gains from reuse (1.1-1.6x over light sampling at equal time, 2.5-3.8x over the world light-sampled
     beside the reservoirs)."""

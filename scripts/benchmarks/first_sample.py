@@ -7,18 +7,15 @@ world (constant background), edges (silhouettes and the cube's edges: a luminanc
 the K images over the per-image one: 1/K where every seed draws independent, unbiased samples; 1 where the error
 is the same for every seed (a seed-independent sample position: aliasing that no average over seeds removes).
 
-    .venv/bin/python scripts/benchmark_first_sample.py [--seeds 8]   # -> docs/results/default_cube/first_sample.json
+    .venv/bin/python scripts/bench.py first_sample [--seeds 8]   # -> docs/results/default_cube/first_sample.json
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
-import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import numpy as np  # noqa: E402
 
@@ -65,8 +62,7 @@ def main():
         out["engines"][engine] = rows
         print(engine, json.dumps(rows), flush=True)
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "first_sample.json"), "w") as f:
-        json.dump(out, f, indent=1)
+    write_json(os.path.join(args.out, "first_sample.json"), out)
 
 
 if __name__ == "__main__":

@@ -1,18 +1,15 @@
 """Peak memory and time of one 1920x1080 ReSTIR DI + ReSTIR GI frame of the demo scene (target: RSS under 4 GB).
 
-Prints and writes docs/results/memory_1080p.json. Usage: python scripts/benchmark_memory_1080p.py
+Prints and writes docs/results/memory_1080p.json. Usage: python scripts/bench.py memory_1080p
 """
 from __future__ import annotations
 
 import json
 import os
 import resource
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 
@@ -38,8 +35,7 @@ def main():
     out = {"resolution": [1920, 1080], "method": "ReSTIR DI + ReSTIR GI (defaults), 1 spp, 1 bounce",
            "seconds": time.perf_counter() - t0, "peak_rss_mb": peak_mb(), "rss_before_render_mb": before}
     path = os.path.join(ROOT, "docs", "results", "memory_1080p.json")
-    with open(path, "w") as f:
-        json.dump(out, f, indent=2)
+    write_json(path, out, indent=2)
     print(json.dumps(out, indent=2))
 
 

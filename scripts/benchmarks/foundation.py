@@ -1,7 +1,7 @@
 """Foundation benchmark: export speed, Embree wrapper overhead, reference path tracer frame time.
 
 Prints the figures and writes docs/results/foundation_benchmark.json and .png.
-Usage: python scripts/benchmark_foundation.py [--quick]
+Usage: python scripts/bench.py foundation [--quick]
 """
 from __future__ import annotations
 
@@ -9,12 +9,9 @@ import argparse
 import json
 import os
 import platform
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -141,8 +138,7 @@ def main():
                          bench_frame(scene, 1, 0, repeat, integrator="RESTIR", direct_method="RIS"),
                          bench_frame(scene, 1, 0, repeat, integrator="RESTIR", direct_method="RESTIR")]
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "foundation_benchmark.json"), "w") as f:
-        json.dump(results, f, indent=2)
+    write_json(os.path.join(args.out, "foundation_benchmark.json"), results, indent=2)
     chart(results, os.path.join(args.out, "foundation_benchmark.png"))
     print(json.dumps(results, indent=2))
 

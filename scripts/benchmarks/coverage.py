@@ -1,7 +1,7 @@
 """Pixel coverage: relMSE of Combined versus time with 1, 4 and 16 camera rays per pixel for the emission seen
 directly (the lighting shaded at one of them), against cached Cycles references (1024 spp).
 
-    .venv/bin/python scripts/benchmark_coverage.py          # -> docs/results/coverage/coverage.{json,png}
+    .venv/bin/python scripts/bench.py coverage          # -> docs/results/coverage/coverage.{json,png}
 
 Each point: one still at 1, 2, 4 or 8 samples, relMSE averaged over repetitions with different seeds, the
 renderer's own time (median). Direct light only (max_bounces 0), the engine's default direct method (AUTO).
@@ -9,14 +9,10 @@ renderer's own time (median). Direct light only (max_bounces 0), the engine's de
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -63,9 +59,8 @@ def main():
                 print(f"{row['scene']:<18} coverage {cov:2d} spp {spp}: relMSE {row['rel_mse']:.4f} "
                       f"{row['seconds']:.3f}s ({row['method']})", flush=True)
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "coverage.json"), "w") as f:
-        json.dump({"size": args.size, "reps": args.reps, "created": time.strftime("%Y-%m-%d"), "rows": rows}, f,
-                  indent=1)
+    write_json(os.path.join(args.out, "coverage.json"), {"size": args.size, "reps": args.reps,
+                                                         "created": time.strftime("%Y-%m-%d"), "rows": rows})
     chart(rows, os.path.join(args.out, "coverage.png"))
 
 

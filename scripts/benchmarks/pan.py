@@ -2,7 +2,7 @@
 and without temporal reuse, one sample per frame with the history carried as in `blender -a`, against Cycles
 at equal time, direct light only.
 
-    .venv/bin/python scripts/benchmark_pan.py --size medium     # -> docs/results/pan/pan-medium.{json,png}
+    .venv/bin/python scripts/bench.py pan --size medium     # -> docs/results/pan/pan-medium.{json,png}
 
 Every frame is rendered through the engine (bpy.ops.render.render: export, motion vectors, history), scored
 against a cached Cycles reference of that frame (--reference-spp). Cycles renders the steady frames (the last
@@ -12,14 +12,10 @@ The ratio Cycles relMSE / ours at equal time is what the ReSTIR DI issue targets
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import numpy as np  # noqa: E402
 
@@ -109,8 +105,7 @@ def main():
               f"(surfaces {r['cycles_over_ours_surfaces']:.2f})", flush=True)
     os.makedirs(args.out, exist_ok=True)
     name = f"pan-{args.size}"
-    with open(os.path.join(args.out, name + ".json"), "w") as f:
-        json.dump(result, f, indent=1)
+    write_json(os.path.join(args.out, name + ".json"), result)
     chart(result, os.path.join(args.out, name + ".png"))
 
 

@@ -2,7 +2,7 @@
 navigation budget's resolution divider), and the update after an edit (material colour, lamp power, object
 move, mesh edit) by export level, with the renderer's rebuild.
 
-    .venv/bin/python scripts/benchmark_viewport.py     # -> docs/results/viewport/viewport.{json,png}
+    .venv/bin/python scripts/bench.py viewport     # -> docs/results/viewport/viewport.{json,png}
 
 The session is driven as Blender drives it (no GPU: view_draw's texture upload is not timed).
 """
@@ -10,14 +10,10 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import os
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -133,8 +129,7 @@ def main():
             print(f"subdivision {subdivision} ({rows[0]['triangles']} triangles) {r['edit']:<22} {r['level']:<9} "
                   f"export {1000 * r['export']:7.1f} ms  renderer {1000 * r['build']:7.1f} ms", flush=True)
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "viewport.json"), "w") as f:
-        json.dump(out, f, indent=1)
+    write_json(os.path.join(args.out, "viewport.json"), out)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -6,18 +6,14 @@ Cycles reference (surfaces only: Combined - Emission, see docs/EVALUATION.md). T
 frames to act on, so this is where it shows; the still charts cannot show it.
 
 Prints per-frame relMSE and time; writes docs/results/restir_di/ablation.json and .png.
-Usage: python scripts/ablation_restir_di.py [--frames 8] [--out DIR]
+Usage: python scripts/bench.py ablation_restir_di [--frames 8] [--out DIR]
 """
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -73,8 +69,7 @@ def main():
         print(f"{v['label']:40s} steady relMSE {v['steady_relmse']:.3f}  "
               f"x{v['efficiency_vs_path']:.1f} vs path at equal time")
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "ablation.json"), "w") as fh:
-        json.dump(out, fh, indent=1)
+    write_json(os.path.join(args.out, "ablation.json"), out)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

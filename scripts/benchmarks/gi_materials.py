@@ -1,6 +1,6 @@
 """ReSTIR GI on glossy materials and with the alternative target function.
 
-    .venv/bin/python scripts/benchmark_gi_materials.py          # -> docs/results/restir_gi/{roughness,target}.{json,png}
+    .venv/bin/python scripts/bench.py gi_materials          # -> docs/results/restir_gi/{roughness,target}.{json,png}
 
 roughness: a closed room lit by a panel on its floor (the floor sees only bounced light), floor roughness 0.05 .. 1
 as a dielectric (f0 0.04) and as a metal; relMSE of the indirect light against the path tracer at 1024 samples, for
@@ -11,16 +11,11 @@ and lum(Lo) G, relMSE of Combined against the harness's Cycles reference.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
-sys.path.insert(0, os.path.join(ROOT, "tests"))
 
 from harness.metrics import rel_mse  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
@@ -64,8 +59,7 @@ def roughness(out, ref_spp, spp):
                   f"  equal time path/GI {row['equal_time_path_over_gi']:.1f}  GI mean {row['bias_gi']:+.2%}",
                   flush=True)
         result["runs"][kind] = rows
-    with open(os.path.join(out, "roughness.json"), "w") as f:
-        json.dump(result, f, indent=1)
+    write_json(os.path.join(out, "roughness.json"), result)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -111,8 +105,7 @@ def target(out, size, ref_spp):
             pts.append((time.perf_counter() - t0, rel_mse(r.passes["Combined"][..., :3], ref)))
             print(f"target {kind:<9} {spp} spp: {pts[-1][0]:.2f}s relMSE {pts[-1][1]:.4f}", flush=True)
         result["runs"][kind] = pts
-    with open(os.path.join(out, "target.json"), "w") as f:
-        json.dump(result, f, indent=1)
+    write_json(os.path.join(out, "target.json"), result)
 
 
 def main():

@@ -1,7 +1,7 @@
 """Blender's factory startup scene (the default cube, its point light, the grey world) as a new user renders it:
 relMSE of Combined versus wall time, ours (defaults) against Cycles, at 320x180 with 4 bounces.
 
-    .venv/bin/python scripts/benchmark_default_cube.py      # -> docs/results/default_cube/default_cube.{json,png}
+    .venv/bin/python scripts/bench.py default_cube      # -> docs/results/default_cube/default_cube.{json,png}
 
 Reference: Cycles at 1024 spp (cached). Every point: one still through bpy.ops.render.render (export included),
 median wall time of the repetitions and their mean relMSE. Our converged image (256 spp) is scored too: what
@@ -10,14 +10,10 @@ remains there is bias of the material model (the Principled BSDF, the materials 
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import numpy as np  # noqa: E402
 
@@ -75,8 +71,7 @@ def main():
         out.setdefault("cycles_over_ours", {})[key] = ratios
         print(f"{key}: Cycles relMSE / ours at equal time " + " ".join("-" if r is None else f"{r:.2f}" for r in ratios), flush=True)
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "default_cube.json"), "w") as f:
-        json.dump(out, f, indent=1)
+    write_json(os.path.join(args.out, "default_cube.json"), out)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -1,7 +1,7 @@
 """ReSTIR GI against path-traced indirect light and Cycles: stills (interior_gi) and a camera pan through the same
 room (interior_gi_pan), one bounce, error versus wall time.
 
-    .venv/bin/python scripts/benchmark_restir_gi.py --size large       # -> docs/results/restir_gi/*.{json,png}
+    .venv/bin/python scripts/bench.py restir_gi --size large       # -> docs/results/restir_gi/*.{json,png}
 
 Stills: every method renders interior_gi at a ladder of sample counts (each point a fresh render through the
 engine: export, BVH, passes); relMSE of Combined against a cached Cycles reference (--reference-spp); the
@@ -13,14 +13,10 @@ is interpolated to our time per frame. Direct light is the engine's Auto choice 
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import numpy as np  # noqa: E402
 
@@ -80,8 +76,7 @@ def stills(size, ref_spp, out):
         m["cycles_over_ours"] = [ladder_at(cyc, w) / e for w, e, _c in m["points"]]
         print(f"{key:<10} equal time: path/ours " + " ".join(f"{r:.1f}" for r in m["path_over_ours"])
               + " | Cycles/ours " + " ".join(f"{r:.2f}" for r in m["cycles_over_ours"]), flush=True)
-    with open(os.path.join(out, f"stills-{size}.json"), "w") as f:
-        json.dump(result, f, indent=1)
+    write_json(os.path.join(out, f"stills-{size}.json"), result)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -142,8 +137,7 @@ def animation(size, ref_spp, out):
                                              / r["rel_mse"][f - 1] for f in steady]))
         print(f"{key:<16} steady frames at equal time: Cycles/ours {r['cycles_over_ours']:.2f}, "
               f"path/ours {r['path_over_ours']:.1f}", flush=True)
-    with open(os.path.join(out, f"pan-{size}.json"), "w") as f:
-        json.dump(result, f, indent=1)
+    write_json(os.path.join(out, f"pan-{size}.json"), result)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

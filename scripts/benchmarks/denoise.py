@@ -5,17 +5,16 @@ ours at 1..16 samples without and with the Denoise option (the compositor's Deno
 Denoising Albedo / Normal passes), and Cycles at 1..16 samples with its own Open Image Denoise; relMSE of each image
 against Cycles at 1024 samples, and the wall time of the whole render (export, render, compositing).
 
-    .venv/bin/python scripts/benchmark_denoise.py      # -> docs/results/denoise/denoise.{json,png}
+    .venv/bin/python scripts/bench.py denoise      # -> docs/results/denoise/denoise.{json,png}
 """
 from __future__ import annotations
 
-import json
 import os
 import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 for p in (ROOT, os.path.join(ROOT, "scripts"), os.path.join(ROOT, "tests")):
     sys.path.insert(0, p)
 
@@ -76,8 +75,7 @@ def main():
         runs["Cycles denoised (OIDN)"].append({"spp": spp, "seconds": s, "rel_mse": rel_mse(img, ref)})
         print(f"{spp:3d} spp: " + "  ".join(f"{k} {v[-1]['rel_mse']:.4f} ({v[-1]['seconds']:.2f}s)"
                                              for k, v in runs.items()), flush=True)
-    with open(os.path.join(OUT, "denoise.json"), "w") as f:
-        json.dump({"size": SIZE, "reference_spp": REF_SPP, "runs": runs}, f, indent=1)
+    write_json(os.path.join(OUT, "denoise.json"), {"size": SIZE, "reference_spp": REF_SPP, "runs": runs})
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

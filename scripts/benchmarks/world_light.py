@@ -5,16 +5,15 @@ sun (the sky of the tests) and under a constant colour, 160x90, direct light onl
 at 2048 samples (same bpy). Ours: the path tracer at 1..32 samples with the world light-sampled (the default) and
 with that sampling switched off; relMSE of Combined against the reference and the render time (core, after export).
 
-    .venv/bin/python scripts/benchmark_world_light.py      # -> docs/results/world/world_light.{json,png}
+    .venv/bin/python scripts/bench.py world_light      # -> docs/results/world/world_light.{json,png}
 """
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 for p in (ROOT, os.path.join(ROOT, "scripts"), os.path.join(ROOT, "tests")):
     sys.path.insert(0, p)
 
@@ -84,8 +83,7 @@ def main():
             results.append(res)
             print(f"{kind:<8} bounces {bounces}: gain at equal time " + ", ".join(f"{g:.2f}" for g in gain),
                   flush=True)
-    with open(os.path.join(OUT, "world_light.json"), "w") as f:
-        json.dump({"size": SIZE, "reference_spp": REF_SPP, "runs": results}, f, indent=1)
+    write_json(os.path.join(OUT, "world_light.json"), {"size": SIZE, "reference_spp": REF_SPP, "runs": results})
     chart(results, os.path.join(OUT, "world_light.png"))
 
 

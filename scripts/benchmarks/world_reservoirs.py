@@ -9,19 +9,18 @@ stills, and the 4th frame of a 4-frame animation (static camera, 1 sample per fr
 relMSE of Combined against Cycles at 1024 samples; seconds: render_frame's time; efficiency 1 / (relMSE x seconds),
 relative to NEE.
 
-    .venv/bin/python scripts/benchmark_world_reservoirs.py   # -> docs/results/world/world_reservoirs.{json,png}
+    .venv/bin/python scripts/bench.py world_reservoirs   # -> docs/results/world/world_reservoirs.{json,png}
 """
 from __future__ import annotations
 
 import argparse
 import hashlib
 import inspect
-import json
 import os
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 for p in (ROOT, os.path.join(ROOT, "scripts"), os.path.join(ROOT, "tests")):
     sys.path.insert(0, p)
 
@@ -107,9 +106,10 @@ def main():
                     f"{k}: {v['rel_mse']:.3g}@{v['seconds']:.3f}s x{v['efficiency'] / base:.2f}"
                     for k, v in row["configs"].items()), flush=True)
                 rows.append(row)
-                with open(os.path.join(args.out, "world_reservoirs.json"), "w") as f:
-                    json.dump({"size": SIZE, "reps": args.reps, "reference_spp": args.reference_spp,
-                               "created": time.strftime("%Y-%m-%d"), "rows": rows}, f, indent=1)
+                write_json(os.path.join(args.out, "world_reservoirs.json"), {"size": SIZE, "reps": args.reps,
+                                                                             "reference_spp": args.reference_spp,
+                                                                             "created": time.strftime("%Y-%m-%d"),
+                                                                             "rows": rows})
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

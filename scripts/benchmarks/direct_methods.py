@@ -9,22 +9,18 @@ Every method here is unbiased (ReSTIR in its default unbiased mode), so the one 
 repetitions fails here: a pixel that sees a tiny bright emitter in one repetition of eight reads the same
 relative variance whatever its coverage.)
 
-    .venv/bin/python scripts/benchmark_direct_methods.py            # -> docs/results/direct_methods/
-    .venv/bin/python scripts/benchmark_direct_methods.py --size tiny --reps 3   # a quick look
+    .venv/bin/python scripts/bench.py direct_methods            # -> docs/results/direct_methods/
+    .venv/bin/python scripts/bench.py direct_methods --size tiny --reps 3   # a quick look
 
 The AUTO direct method (restir_engine/core/method_choice.py) was chosen from these numbers (docs/RESULTS.md).
 """
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -106,9 +102,8 @@ def main():
                     f"{effs[k] / effs['LIGHT_SAMPLING']:.2f})" for k in METHODS), flush=True)
                 results.append(row)
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "direct_methods.json"), "w") as f:
-        json.dump({"size": args.size, "reps": args.reps, "created": time.strftime("%Y-%m-%d"), "rows": results}, f,
-                  indent=1)
+    write_json(os.path.join(args.out, "direct_methods.json"), {"size": args.size, "reps": args.reps,
+                                                               "created": time.strftime("%Y-%m-%d"), "rows": results})
     chart(results, os.path.join(args.out, "direct_methods.png"))
 
 

@@ -13,7 +13,7 @@ this shared 2-core machine vary by ±15 % from frame to frame; the fastest is th
 Prints a table and writes docs/results/stages/stages.json and stages.png (stacked bars per run). With
 ``--label before`` the figures are saved as stages_before.json instead (the yardstick an optimisation is
 compared against; the chart then shows both). Usage:
-  python scripts/benchmark_stages.py [--frames 4] [--label after|before] [--out DIR] [--only NAME]
+  python scripts/bench.py stages [--frames 4] [--label after|before] [--out DIR] [--only NAME]
 """
 from __future__ import annotations
 
@@ -25,9 +25,7 @@ import platform
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -175,8 +173,7 @@ def main():
                 continue
             sweep[n] = {str(tp): run(f"{n} @{tp}", s, kw, args.frames, tp)["frame_s"] for tp in (4096, 16384, 32768, 65536, 131072)}
         os.makedirs(args.out, exist_ok=True)
-        with open(os.path.join(args.out, "tile_sweep.json"), "w") as f:
-            json.dump(sweep, f, indent=1)
+        write_json(os.path.join(args.out, "tile_sweep.json"), sweep)
         return
     os.makedirs(args.out, exist_ok=True)
     warm_up()
@@ -185,8 +182,7 @@ def main():
             "python": platform.python_version(), "numpy": np.__version__, "bpy": bpy.app.version_string,
             "date": time.strftime("%Y-%m-%d")}
     name = "stages_before.json" if args.label == "before" else "stages.json"
-    with open(os.path.join(args.out, name), "w") as f:
-        json.dump({"meta": meta, "runs": results}, f, indent=1)
+    write_json(os.path.join(args.out, name), {"meta": meta, "runs": results})
     if args.label == "after":
         before_path = os.path.join(args.out, "stages_before.json")
         before = {}

@@ -9,23 +9,18 @@ scene, to choose the automatic indirect method from: the path-traced indirect li
 variance (from the repetitions' spread, against the reference) and of its light, and the share of the indirect
 light ReSTIR GI's reservoirs carry (the renderer's own statistic).
 
-    .venv/bin/python scripts/benchmark_integrators.py                 # -> docs/results/integrators/
-    .venv/bin/python scripts/benchmark_integrators.py --size tiny --reps 2 --scenes cornell-default
+    .venv/bin/python scripts/bench.py integrators                 # -> docs/results/integrators/
+    .venv/bin/python scripts/bench.py integrators --size tiny --reps 2 --scenes cornell-default
 
 The AUTO indirect method (restir_engine/core/method_choice.py) was chosen from these numbers (docs/RESULTS.md).
 """
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-sys.path.insert(0, os.path.join(ROOT, "tests"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -137,9 +132,8 @@ def main():
                       f"of the variance, {pt['light_indirect']:.2f} of the light; GI share {share}; "
                       f"auto {row['configs'].get('AUTO', {}).get('indirect_method')}", flush=True)
             results.append(row)
-            with open(json_path, "w") as f:
-                json.dump({"size": args.size, "reps": args.reps, "bounces": args.bounces,
-                           "created": time.strftime("%Y-%m-%d"), "rows": results}, f, indent=1)
+            write_json(json_path, {"size": args.size, "reps": args.reps, "bounces": args.bounces,
+                                   "created": time.strftime("%Y-%m-%d"), "rows": results})
     chart(results, os.path.join(args.out, "integrators.png"))
 
 

@@ -6,16 +6,15 @@ partly through a 2 cm glass pane (a window), 160x90, 4 bounces.
 Reference: Cycles at 2048 samples (same bpy). Pixels are split by what the camera ray through the pixel centre
 hits first (a glass closure or not).
 
-    .venv/bin/python scripts/benchmark_glass.py      # -> docs/results/materials/glass.{json,png}
+    .venv/bin/python scripts/bench.py glass      # -> docs/results/materials/glass.{json,png}
 """
 from __future__ import annotations
 
-import json
 import os
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 for p in (ROOT, os.path.join(ROOT, "scripts"), os.path.join(ROOT, "tests")):
     sys.path.insert(0, p)
 
@@ -62,8 +61,7 @@ def main():
     for key, window in (("spheres", False), ("window", True)):
         out["scenes"][key] = measure(window)
     os.makedirs(OUT, exist_ok=True)
-    with open(os.path.join(OUT, "glass.json"), "w") as f:
-        json.dump(out, f, indent=1)
+    write_json(os.path.join(OUT, "glass.json"), out)
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

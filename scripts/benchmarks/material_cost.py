@@ -1,7 +1,7 @@
 """What the material model costs: frame time of the path tracer and of ReSTIR DI on the demo room (Principled
 materials only) and the many_lights street, and the share of the CPU time spent evaluating materials.
 
-Runs the same frames as scripts/benchmark_stages.py (640x360, 1 sample per frame, steady frames of a sequence,
+Runs the same frames as scripts/bench.py stages (640x360, 1 sample per frame, steady frames of a sequence,
 fastest kept; the material share of that frame and the median over the steady frames are reported). The
 material share is measured with per-thread CPU clocks (time.thread_time) around the material
 code — building per-hit parameters (SurfaceParams.take/of_table/gather and the row gathers on first use, Mix
@@ -12,7 +12,7 @@ of those functions there is wrapped); ``--frames-only`` skips the clocks (their 
 
 Writes docs/results/materials/cost.json (cost_before.json / cost_start.json with --label before / start) and
 cost.png with every series that exists. Usage:
-  python scripts/benchmark_material_cost.py [--frames 5] [--label after|start|before] [--frames-only] [--out DIR]
+  python scripts/bench.py material_cost [--frames 5] [--label after|start|before] [--frames-only] [--out DIR]
 """
 from __future__ import annotations
 
@@ -20,17 +20,14 @@ import argparse
 import functools
 import json
 import os
-import sys
 import threading
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 
-from benchmark_stages import blend_path, warm_up  # noqa: E402
+from benchmarks.stages import blend_path, warm_up  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 
@@ -179,8 +176,7 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     data = {"label": args.label, "runs": runs, "cores": os.cpu_count(), "date": time.strftime("%Y-%m-%d")}
     path = os.path.join(args.out, {k: f for k, f, _l in SERIES}[args.label])
-    with open(path, "w") as f:
-        json.dump(data, f, indent=1)
+    write_json(path, data)
     chart(args.out, os.path.join(args.out, "cost.png"))
     print("wrote", path)
 

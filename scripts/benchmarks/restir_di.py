@@ -8,20 +8,16 @@
    OFF; the AUTO rule's choice at each size.
 
 Prints the figures and writes docs/results/restir_di/benchmark.json and .png.
-Usage: python scripts/benchmark_restir_di.py [--quick] [--out DIR]
+Usage: python scripts/bench.py restir_di [--quick] [--out DIR]
 """
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
-import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from benchmarks.common import ROOT, write_json  # noqa: E402, F401
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
@@ -132,8 +128,7 @@ def main():
     result = {"machine": {"python": platform.python_version(), "cpus": os.cpu_count(), "numpy": np.__version__},
               "date": time.strftime("%Y-%m-%d"), "growth": growth(variants), "tiles": tiles(sizes)}
     os.makedirs(args.out, exist_ok=True)
-    with open(os.path.join(args.out, "benchmark.json"), "w") as f:
-        json.dump(result, f, indent=1)
+    write_json(os.path.join(args.out, "benchmark.json"), result)
     chart(result, os.path.join(args.out, "benchmark.png"))
     g = result["growth"]
     print(f"pass time growth {g[0]['variant']} -> {g[-1]['variant']}: {g[-1]['pass_s'] / g[0]['pass_s']:.2f}x; "

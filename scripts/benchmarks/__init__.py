@@ -1,0 +1,1 @@
+"""The benchmark cases of scripts/bench.py: one module per case, each with ``main()`` reading its arguments."""
