@@ -12,6 +12,11 @@ venv=$(scripts/setup_venv.sh "$ver")
 cache=${WHEEL_CACHE:-.cache/wheels}
 mkdir -p "$cache"
 stage=dist/stage/restir_engine
+mkdir -p dist
+if command -v flock >/dev/null; then  # one build at a time (the test suites of both Pythons may run at once)
+  exec 9>dist/.build.lock
+  flock 9
+fi
 rm -rf dist/stage && mkdir -p "$stage/wheels"
 cp -r restir_engine/. "$stage/"
 find "$stage" -name __pycache__ -prune -exec rm -rf {} +

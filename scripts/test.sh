@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Run the test suite (headless, through the bpy module) on every supported Blender found here: Blender 5.2 LTS
 # (Python 3.13, .venv313) when a Python 3.13 exists (PATH or pyenv's versions folder), and Blender 5.0
-# (Python 3.11, .venv). Each venv is pinned and cached. Extra arguments go to pytest. Fails if either run fails.
+# (Python 3.11, .venv). Each venv is pinned and cached. The two suites run at the same time (each is mostly one
+# interpreter's work; together they use the cores); their outputs are printed one after the other. Extra arguments
+# go to pytest (e.g. -m "not slow", -m cycles). Fails if either run fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 versions=()
@@ -11,10 +13,26 @@ else
   echo "Python 3.13 not found: Blender 5.2 LTS (bpy 5.2.3) is not tested here, only Blender 5.0 (Python 3.11)"
 fi
 versions+=(3.11)
-status=0
+venvs=()
 for ver in "${versions[@]}"; do
-  venv=$(scripts/setup_venv.sh "$ver")
-  echo "== Python $ver, bpy $("$venv/bin/python" -c 'import importlib.metadata as m; print(m.version("bpy"))')"
-  "$venv/bin/python" -m pytest -q tests "$@" || status=1
+  venvs+=("$(scripts/setup_venv.sh "$ver")")  # one at a time: the first set-up downloads
+done
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
+pids=()
+for i in "${!versions[@]}"; do
+  venv=${venvs[$i]}
+  ( echo "== Python ${versions[$i]}, bpy $("$venv/bin/python" -c 'import importlib.metadata as m; print(m.version("bpy"))')"
+    start=$SECONDS
+    rc=0
+    "$venv/bin/python" -m pytest -q -p no:cacheprovider tests "$@" || rc=$?
+    echo "== Python ${versions[$i]}: exit $rc after $((SECONDS - start)) s"
+    exit $rc ) > "$logs/$i.log" 2>&1 &
+  pids+=($!)
+done
+status=0
+for i in "${!versions[@]}"; do
+  wait "${pids[$i]}" || status=1
+  cat "$logs/$i.log"
 done
 exit $status

@@ -5,7 +5,7 @@ by the code *before* the core was restructured (commit 0e74da9, generated with
 ``python tests/regression.py``): for each of SEEDS seeds, the mean of the lit surfaces (Direct + Indirect) over a 4 x 4 grid of
 blocks, plus the whole-image means of Emission, Direct and Indirect (64 x 48 pixels). A change that keeps the
 estimators (only their random-number consumption and speed may change) must agree with it within noise:
-Welch z-scores of independent repetitions (tests/test_regression_images.py).
+Welch z-scores of independent repetitions (tests/core/test_regression_images.py).
 
 Regenerate the baseline only when a change is *meant* to change the converged image (a material model fix,
 say), with the code before that change, and say so in the commit: the test guards speed work, which must not.

@@ -3,7 +3,7 @@
 The batched image must be the same estimator as one sample per pass: the samples' sums go to the right pixels
 (exact checks on what has no variance: alpha, the world seen directly, the sample count) and the lit surfaces
 agree with unbatched renders within noise (Welch z-scores of block means over independent seeds, as
-tests/test_regression_images.py).
+tests/core/test_regression_images.py).
 """
 import dataclasses
 

@@ -6,7 +6,7 @@ BSDFs; a Diffuse BSDF; a half-metal; a white and a black dielectric) lit by an a
 a floor of four materials seen at grazing angles by a low camera. Each side renders 16 independent seeds (Cycles'
 from the stored reference, tests/cycles_reference.py); per
 sphere (its pixels only) or per floor cell the means are compared with Welch z-scores, with the bound of
-tests/test_cycles_accuracy.py: |ours - Cycles| < 5 SE + 0.5 % of Cycles (two-sided p ≈ 2e-5 per cell at
+tests/cycles/test_cycles_accuracy.py: |ours - Cycles| < 5 SE + 0.5 % of Cycles (two-sided p ≈ 2e-5 per cell at
 the SE bound; the margin is 4x tighter than the 2 % the materials issue asks for).
 
 Power: the cells that isolate a lobe (diffuse, the layered diffuse of a white dielectric, the dielectric specular

@@ -185,7 +185,7 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
         # crosses first): the BSDF technique's density of a light point is then p_b wherever the MIS weights use
         # it. Only emitter hits would give it density 0 behind an occluder, and a sample reused from a pixel that
         # sees its light occluded to one that sees it would be underweighted (a floor seen through slats under a
-        # large emitter read 6.5 % dark: tests/test_restir_stability.py). Shading tests visibility.
+        # large emitter read 6.5 % dark: tests/restir/test_restir_stability.py). Shading tests visibility.
         candidates = []
         if ctx.emit_accel is not None:
             eh = ctx.emit_accel.intersect(o, d)
@@ -194,7 +194,7 @@ def initial_ris(ctx, surf, terms, rng: np.random.Generator, cfg: CandidateSettin
             # every ray yields the world's point in its direction, occluded or not: the BSDF technique's density of
             # world points is then p_b everywhere, as the MIS weights assume. (Taking only the rays that escape
             # would give it density 0 behind geometry: a sample reused from a pixel that sees it occluded to one
-            # that sees it would be underweighted, 1.5 % dark in tests/test_world_light.py.) Shading tests
+            # that sees it would be underweighted, 1.5 % dark in tests/core/test_world_light.py.) Shading tests
             # visibility as for any light point.
             eb1, eb2 = env.exit_coords(o, d)
             candidates.append((np.full(len(live), lights.env_index), eb1, eb2, True))
