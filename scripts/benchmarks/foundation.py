@@ -17,7 +17,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
-from restir_engine.core.geometry import camera as camera_mod# noqa: E402
+from restir_engine.core.geometry import camera as camera_mod  # noqa: E402
 from restir_engine.core.geometry.accel import Accel  # noqa: E402
 from restir_engine.core.parallel.pool import thread_count  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402

@@ -22,8 +22,8 @@ import bpy  # noqa: E402
 import restir_engine  # noqa: E402
 from bpy_scenes import configure_cycles, render_passes, world_scene  # noqa: E402
 from harness.metrics import interpolate_loglog, rel_mse  # noqa: E402
-from restir_engine.core.integrators import context_cache# noqa: E402
-from restir_engine.core.integrators import pathtracer# noqa: E402
+from restir_engine.core.integrators import context_cache  # noqa: E402
+from restir_engine.core.lights.world import World  # noqa: E402
 from restir_engine.core.renderer import RenderSettings, render_frame  # noqa: E402
 from restir_engine.export import export_scene  # noqa: E402
 
@@ -40,13 +40,13 @@ def reference(kind, bounces):
 
 
 def ladder(core_scene, bounces, sampled: bool, ref):
-    orig = pathtracer.World.__init__
+    orig = World.__init__
 
     def patched(self, *a, **k):
         orig(self, *a, **k)
         if not sampled:
             self.sampled = False
-    pathtracer.World.__init__ = patched
+    World.__init__ = patched
     context_cache.clear()
     try:
         render_frame(core_scene, RenderSettings(integrator="PATH", max_bounces=bounces, samples=1, seed=99))
@@ -57,7 +57,7 @@ def ladder(core_scene, bounces, sampled: bool, ref):
             rows.append({"spp": spp, "seconds": time.perf_counter() - t0,
                          "rel_mse": rel_mse(r.passes["Combined"][..., :3], ref)})
     finally:
-        pathtracer.World.__init__ = orig
+        World.__init__ = orig
         context_cache.clear()
     return rows
 

@@ -279,10 +279,10 @@ def test_still_view_refines_in_sample_batches_as_f12(addon, monkeypatch):
     batches, costs = [], []
     original = FrameRenderer.sample_pass
 
-    def counted(self, progress=None, should_stop=None, batch=1):
+    def counted(self, progress=None, should_stop=None, batch=1, **kwargs):
         batches.append(batch)
         costs.append(session._cost)
-        return original(self, progress, should_stop, batch)
+        return original(self, progress, should_stop, batch, **kwargs)
 
     monkeypatch.setattr(FrameRenderer, "sample_pass", counted)
     session = ViewportSession(lambda: None, budget=0.0, max_samples=8)

@@ -78,19 +78,19 @@ def test_importance_sampling_beats_bsdf_sampling_on_a_sun():
     scene.world_image = sun_sky()
     on = render_frame(scene, RenderSettings(integrator="PATH", max_bounces=0, samples=1, seed=1))
     img_on = on.passes["Combined"][..., 0]
-    from restir_engine.core.integrators import pathtracer
-    orig = pathtracer.World.__init__
+    from restir_engine.core.lights.world import World
+    orig = World.__init__
 
     def unsampled(self, *a, **k):
         orig(self, *a, **k)
         self.sampled = False
-    pathtracer.World.__init__ = unsampled
+    World.__init__ = unsampled
     try:
         from restir_engine.core.integrators import context_cache
         context_cache.clear()
         off = render_frame(scene, RenderSettings(integrator="PATH", max_bounces=0, samples=1, seed=1))
     finally:
-        pathtracer.World.__init__ = orig
+        World.__init__ = orig
         context_cache.clear()
     img_off = off.passes["Combined"][..., 0]
     assert abs(img_off.mean() / img_on.mean() - 1) < 0.5  # the same light, both noisy estimates of it
