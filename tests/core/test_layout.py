@@ -10,7 +10,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 CORE = os.path.join(ROOT, "restir_engine", "core")
 ARCHITECTURE = open(os.path.join(ROOT, "docs", "ARCHITECTURE.md")).read()
 # ARCHITECTURE.md, "Folders and import ranks"
-RANKS = {"scene": 0, "sampling": 0, "profile": 0, "parallel": 0, "geometry": 1, "materials": 2, "lights": 2,
+RANKS = {"scene": 0, "sampling": 0, "profile": 0, "parallel": 0, "modes": 0, "geometry": 1, "materials": 2, "lights": 2,
          "restir": 3, "integrators": 3, "pipeline": 4, "renderer": 4}
 
 

@@ -25,6 +25,8 @@ Indirect light (measured in the first sample pass of every frame, from the path-
 """
 from __future__ import annotations
 
+from ..modes import WorldMethod, values
+
 FEW_LIGHTS = 8  # light entries (emissive triangles, lamps; a point/spot sphere is one) counted as "a few"
 GI_MIN_SHARE = 0.05   # ReSTIR GI (even when set by the user) is skipped in a pass whose reservoirs would carry
 #                       less of the path-traced indirect light (luminance): nothing to cache
@@ -65,7 +67,7 @@ def choose_direct_method(lights, reservoir_passes: bool = False, max_bounces: in
     return "RESTIR", f"{count} area light{plural}, direct light only: resampling pays"
 
 
-WORLD_METHODS = ("AUTO", "RESAMPLED", "LIGHT_SAMPLED")
+WORLD_METHODS = values(WorldMethod)
 
 
 def choose_world_method(lights, setting: str = "AUTO") -> tuple[str, str]:

@@ -25,8 +25,8 @@ import numpy as np
 from ..geometry.accel import offset_origin, shadow_rays
 from ..lights.table import emitted_radiance, spot_factor
 from ..materials.bsdf import diffuse_f, eval_view, sample_bsdf
-from ..materials.params import SurfaceParams
 from ..materials.glass import DELTA_PDF, sample_glass
+from ..materials.params import SurfaceParams
 from ..materials.surface import Surface
 from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
 from .trace_context import TraceContext

@@ -11,8 +11,8 @@ from ..lights.table import LightTable, triangle_geometry
 from ..lights.world import World
 from ..lights.world_points import WorldSphere
 from ..materials import microfacet_tables
-from ..materials.params import SurfaceParams
 from ..materials.cutout import Cutout
+from ..materials.params import SurfaceParams
 from ..scene import Scene
 
 

@@ -15,7 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-TILE_MODES = ("AUTO", "ON", "OFF")
+from ..modes import LightTiles, values
+
+TILE_MODES = values(LightTiles)
 BLOCK = 16              # pixels per side of a screen block sharing one tile
 AUTO_FACTOR = 8.0       # AUTO: use tiles when candidates per pass exceed this many times the tile points
 

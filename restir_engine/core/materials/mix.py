@@ -29,7 +29,8 @@ def hash_uniform(prim: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def pick_components(mats, mat: np.ndarray, rows: np.ndarray, xi: np.ndarray, uv: np.ndarray | None):
     """For hits ``rows`` (k,) on mixed materials ``mat[rows]``: the picked component material (k,) and the BSDF scale
-    W (k,) (0 where every weight is 0; 1 for renormalized mixes, whose transparent share is a cut-out). ``xi`` (k,) uniforms; ``uv`` (k, 2) the hits' UVs (None: no textures)."""
+    W (k,) (0 where every weight is 0; 1 for renormalized mixes, whose transparent share is a cut-out). ``xi`` (k,)
+    uniforms; ``uv`` (k, 2) the hits' UVs (None: no textures)."""
     m = mat[rows]
     first, count = mats.mix_first[m], mats.mix_count[m]
     width = int(count.max())

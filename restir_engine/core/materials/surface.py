@@ -9,10 +9,10 @@ import numpy as np
 
 from ..sampling import barycentric, cols, dot, norm, orthonormal_basis
 from .bsdf import ViewTerms
-from .params import SurfaceParams
 from .glass import GLASS_SALT
 from .microfacet_tables import lerp_rows, mu_index
 from .mix import hash_uniform, pick_components
+from .params import SurfaceParams
 from .textures import apply_texture, gradient, sample
 
 

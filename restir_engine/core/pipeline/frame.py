@@ -22,6 +22,7 @@ import numpy as np
 from ..integrators import pathtracer, trace_context
 from ..integrators.context_cache import context_for, fingerprint
 from ..integrators.method_choice import GI_MIN_SHARE
+from ..modes import DirectMethod, Integrator
 from ..parallel.tasks import Progress, Stopped
 from ..profile import NullClock
 from ..restir import di, gi
@@ -76,7 +77,7 @@ class FrameRenderer:
                                                     trace_context.build_context)
         self.indirect = IndirectChoice(settings, bounces, methods.gi_auto(settings), self.ctx)
         self.gi = None  # gi.GISettings when the indirect light is resampled
-        if settings.integrator == "RESTIR":
+        if settings.integrator == Integrator.RESTIR:
             cam = scene.camera
             self.spatial = methods.spatial_settings(settings, cam)
             if methods.gi_possible(settings):
@@ -272,9 +273,9 @@ class FrameRenderer:
         first_with_history = st.temporal_reuse and s == 0 and hist is not None
         return PassPlan(
             seed=st.seed, frame=st.frame, sample=s, batch=max(1, int(batch)), resampled=resampled,
-            reusing=self.method == "RESTIR", temporal=first_with_history and hist.res is not None, gi=gi_on,
+            reusing=self.method == DirectMethod.RESTIR, temporal=first_with_history and hist.res is not None, gi=gi_on,
             gi_temporal=first_with_history and hist.gi_res is not None, probe=probe,
-            glass_chains=st.integrator == "RESTIR" and (resampled or gi_on), world_resampled=world_resampled,
+            glass_chains=st.integrator == Integrator.RESTIR and (resampled or gi_on), world_resampled=world_resampled,
             continuing=pathtracer.needs_continuation(ctx, resampled, world_resampled), strata=self.coverage,
             candidates=candidates, light_tiles=bool(resampled and ctx.lights.tri_alias is not None
                                                     and candidates.tile_settings.wanted(w * h,
@@ -289,7 +290,7 @@ class FrameRenderer:
         before = self._indirect_seen
         self._indirect_seen = self.indirect.method
         self.reuse_stats.update(diagnostics)
-        if self.indirect.method != before and self.settings.direct_method == "AUTO":
+        if self.indirect.method != before and self.settings.direct_method == DirectMethod.AUTO:
             self._choose_direct()
 
     def _sample_pass(self, progress, should_stop, batch: int, cap) -> int:
@@ -432,7 +433,8 @@ def frame_stats(fr: FrameRenderer, scene: Scene, clock) -> dict:
              "context_reused": fr.context_reused, "coverage_samples": fr.coverage,
              "direct_method": fr.method, "direct_reason": fr.direct.reason,
              "world_method": fr.direct.world_method, "world_reason": fr.direct.world_reason,
-             "spatial_radius": fr.spatial.radius if fr.method == "RESTIR" else None, "reuse": dict(fr.reuse_stats),
+             "spatial_radius": fr.spatial.radius if fr.method == DirectMethod.RESTIR else None,
+             "reuse": dict(fr.reuse_stats),
              "coverage_reason": fr.coverage_reason,
              # Auto: the latest choice; otherwise ReSTIR GI unless every pass kept the path-traced light
              "indirect_method": ("OFF" if ctx.max_bounces == 0 else "PATH" if fr.gi is None else fr.indirect_method

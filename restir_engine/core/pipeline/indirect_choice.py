@@ -14,6 +14,7 @@ import numpy as np
 from ..integrators import camera_paths, pathtracer
 from ..integrators.method_choice import choose_indirect_method
 from ..materials.params import luminance_rows
+from ..modes import IndirectMethod, Integrator
 from ..restir.target import WIDTH
 from ..sampling import STREAM_PROBE, rng
 
@@ -48,18 +49,18 @@ class IndirectChoice:
     def __init__(self, st, n_bounces: int, auto: bool, ctx):
         self.ctx, self.frame, self.auto = ctx, st.frame, auto
         self.measure = (None, PROBE_FRAMES)
-        self.method = "PATH" if n_bounces > 0 else "OFF"
-        self.reason = "path tracer" if st.integrator == "PATH" else "no bounces" if n_bounces == 0 else \
+        self.method = IndirectMethod.PATH if n_bounces > 0 else IndirectMethod.OFF
+        self.reason = "path tracer" if st.integrator == Integrator.PATH else "no bounces" if n_bounces == 0 else \
             "set by the user"
-        if st.integrator == "RESTIR" and n_bounces > 0 and st.indirect_method != "PATH":
-            self.method = "RESTIR_GI"
+        if st.integrator == Integrator.RESTIR and n_bounces > 0 and st.indirect_method != IndirectMethod.PATH:
+            self.method = IndirectMethod.RESTIR_GI
             if auto:
                 self.reason = "not measured yet: the first pass measures"
                 rec = ctx.measured.get("auto_indirect")
                 if rec is not None and rec["frame"] == st.frame - 1:
                     self.method, self.reason = rec["choice"]
                     self.measure = (rec["sums"], rec["since"])
-            elif st.indirect_method == "AUTO":
+            elif st.indirect_method == IndirectMethod.AUTO:
                 self.reason = "a GI reservoir pass is enabled"
 
     @property

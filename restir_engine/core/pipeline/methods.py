@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 from ..integrators.method_choice import choose_direct_method, choose_world_method
 from ..lights.tiles import TileSettings
+from ..modes import DirectMethod, IndirectMethod, Integrator, WorldMethod
 from ..restir import di, gi, reuse
 
 GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's (docs/RESULTS.md, "ReSTIR GI")
@@ -17,18 +18,19 @@ GI_RADIUS_FACTOR = 0.75  # the automatic GI spatial radius against DI's (docs/RE
 
 def bounces(st) -> int:
     """Bounces the paths take: max_bounces, or 0 where the ReSTIR integrator's indirect light is off."""
-    return 0 if st.integrator == "RESTIR" and st.indirect_method == "OFF" else int(st.max_bounces)
+    return 0 if st.integrator == Integrator.RESTIR and st.indirect_method == IndirectMethod.OFF else int(st.max_bounces)
 
 
 def gi_possible(st) -> bool:
     """Whether ReSTIR GI may run for settings ``st`` (any object with RenderSettings' field names): the ReSTIR
     integrator with Indirect Method ReSTIR GI or Auto and at least one bounce."""
-    return st.integrator == "RESTIR" and st.indirect_method in ("RESTIR_GI", "AUTO") and bounces(st) > 0
+    return st.integrator == Integrator.RESTIR and st.indirect_method in (IndirectMethod.RESTIR_GI, IndirectMethod.AUTO) \
+        and bounces(st) > 0
 
 
 def gi_auto(st) -> bool:
     """Whether the Auto indirect method measures and chooses (not when a GI reservoir pass is wanted: then GI runs)."""
-    return st.integrator == "RESTIR" and st.indirect_method == "AUTO" and bounces(st) > 0 and \
+    return st.integrator == Integrator.RESTIR and st.indirect_method == IndirectMethod.AUTO and bounces(st) > 0 and \
         not st.gi_reservoir_passes
 
 
@@ -51,19 +53,19 @@ class DirectChoice:
 def choose_direct(st, lights, n_bounces: int, gi_takes_indirect: bool) -> DirectChoice:
     """The direct method for settings ``st`` and light table ``lights`` (AUTO: method_choice.choose_direct_method,
     knowing whether ReSTIR GI takes the indirect light)."""
-    if st.integrator != "RESTIR":
-        return DirectChoice("PATH", "path tracer", None, "LIGHT_SAMPLED", "the direct light is not resampled")
+    if st.integrator != Integrator.RESTIR:
+        return DirectChoice("PATH", "path tracer", None, WorldMethod.LIGHT_SAMPLED, "the direct light is not resampled")
     method, reason = st.direct_method, "set by the user"
-    if method == "AUTO":
+    if method == DirectMethod.AUTO:
         method, reason = choose_direct_method(lights, st.reservoir_passes, n_bounces, gi_takes_indirect)
-    if method not in ("RIS", "RESTIR"):
-        return DirectChoice(method, reason, None, "LIGHT_SAMPLED", "the direct light is not resampled")
+    if method not in (DirectMethod.RIS, DirectMethod.RESTIR):
+        return DirectChoice(method, reason, None, WorldMethod.LIGHT_SAMPLED, "the direct light is not resampled")
     world_method, world_reason = choose_world_method(lights, st.world_method)
-    if world_method == "RESAMPLED" and st.world_candidates <= 0:
-        world_method, world_reason = "LIGHT_SAMPLED", "World Candidates is 0"
+    if world_method == WorldMethod.RESAMPLED and st.world_candidates <= 0:
+        world_method, world_reason = WorldMethod.LIGHT_SAMPLED, "World Candidates is 0"
     candidates = di.CandidateSettings(method, max(0, st.light_candidates), max(0, st.bsdf_candidates),
                                       tile_settings(st),
-                                      world_candidates=max(0, st.world_candidates) if world_method == "RESAMPLED"
+                                      world_candidates=max(0, st.world_candidates) if world_method == WorldMethod.RESAMPLED
                                       else 0)
     return DirectChoice(method, reason, candidates, world_method, world_reason)
 
@@ -88,12 +90,13 @@ def gi_settings(st, camera) -> tuple[gi.GISettings, reuse.SpatialSettings]:
 def resamples_direct(st) -> bool:
     """Whether the direct light may come from reservoirs (RIS or ReSTIR; Auto resamples where it pays or a reservoir
     pass is asked for)."""
-    return st.integrator == "RESTIR" and st.direct_method in ("AUTO", "RIS", "RESTIR")
+    return st.integrator == Integrator.RESTIR and st.direct_method in (DirectMethod.AUTO, DirectMethod.RIS,
+                                                                      DirectMethod.RESTIR)
 
 
 def reuses_direct(st) -> bool:
     """Whether the DI reservoirs may be reused over frames and pixels (ReSTIR, or Auto choosing it)."""
-    return st.integrator == "RESTIR" and st.direct_method in ("RESTIR", "AUTO")
+    return st.integrator == Integrator.RESTIR and st.direct_method in (DirectMethod.RESTIR, DirectMethod.AUTO)
 
 
 def keeps_history(st) -> bool:

@@ -13,10 +13,10 @@ import dataclasses
 
 import numpy as np
 
+from ..parallel.tasks import run_job
 from ..restir import gi, reuse
 from ..restir.boiling import boiling_filter
 from ..sampling import STREAM_GI_SPATIAL, STREAM_GI_TEMPORAL, STREAM_SPATIAL, STREAM_TEMPORAL
-from ..parallel.tasks import run_job
 from .runner import PassRunner
 
 

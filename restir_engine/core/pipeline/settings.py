@@ -10,12 +10,13 @@ from dataclasses import dataclass
 
 from ..integrators.method_choice import WORLD_METHODS
 from ..lights.tiles import TILE_MODES, TileSettings
+from ..modes import Integrator, LightSampler, values
 from ..restir import di, gi, reuse
 from ..restir.boiling import THRESHOLD as BOILING_THRESHOLD
 from .work import CHUNK_PIXELS
 
-INTEGRATORS = ("PATH", "RESTIR")
-LIGHT_SAMPLERS = ("SPATIAL", "POWER")
+INTEGRATORS = values(Integrator)
+LIGHT_SAMPLERS = values(LightSampler)
 
 
 @dataclass

@@ -35,11 +35,12 @@ from ..integrators.pathtracer import lamp_hits, sample_rays
 from ..lights.tiles import PackedPoints, TileSettings, light_points, sample_points
 from ..materials.bsdf import eval_view, view_terms
 from ..materials.params import luminance_rows
+from ..modes import DirectMethod, values
 from ..sampling import cols, dot, finite, to_local, uniform_ints, vmax
 from .reservoir import Reservoirs, Stream
 from .target import FramePoints, with_spots
 
-DIRECT_METHODS = ("AUTO", "LIGHT_SAMPLING", "RIS", "RESTIR")  # AUTO: core/integrators/method_choice.py
+DIRECT_METHODS = values(DirectMethod)  # AUTO: core/integrators/method_choice.py
 CANDIDATE_BLOCK = 65536  # candidate x surface elements evaluated per pass over memory (256 kB per float32 array)
 
 

@@ -1,9 +1,9 @@
 """The G-buffer of one sample pass: the primary-hit surfaces of the window, compact.
 
 Surface i (only pixels whose camera ray hit something) lies at window pixel pix[i] (row-major, row 0 at the
-bottom); ``slot`` maps a pixel back to its surface (-1: nothing hit). Per surface: planar depth along the camera axis (scene units), material and instance indices, the target
-function's packed terms (target.ShadingTerms, (target.WIDTH, n)) and their shading-normal rows ``normals`` (3, n)
-for similarity tests."""
+bottom); ``slot`` maps a pixel back to its surface (-1: nothing hit). Per surface: planar depth along the camera
+axis (scene units), material and instance indices, the target function's packed terms (target.ShadingTerms,
+(target.WIDTH, n)) and their shading-normal rows ``normals`` (3, n) for similarity tests."""
 from __future__ import annotations
 
 import numpy as np

@@ -38,11 +38,12 @@ import numpy as np
 from ..geometry.accel import shadow_rays
 from ..lights.tiles import PackedPoints
 from ..materials.bsdf import diffuse_f, eval_view
+from ..modes import IndirectMethod, values
 from ..sampling import cols, dot, finite, norm, to_local, vmax
 from .reservoir import Reservoirs
 from .target import LUM as _LUM
 
-INDIRECT_METHODS = ("AUTO", "OFF", "PATH", "RESTIR_GI")  # AUTO: core/integrators/method_choice.py
+INDIRECT_METHODS = values(IndirectMethod)  # AUTO: core/integrators/method_choice.py
 GI_TARGETS = ("INTEGRAND", "RADIANCE")  # p̂ = lum(f · Lo) |cos θ1| G  or  lum(Lo) G (compared in docs/RESULTS.md)
 JACOBIAN_LIMIT = 10.0  # biased mode: shifts whose |J| is outside [1/10, 10] are rejected (as RTXDI's sample app)
 

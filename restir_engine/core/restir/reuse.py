@@ -25,11 +25,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..modes import BiasCorrection, values
 from .reservoir import Reservoirs, Stream
 
 DEPTH_TOLERANCE = 0.1    # relative planar-depth difference above which a neighbour is rejected
 NORMAL_COS = 0.906       # cos 25°: shading normals further apart are rejected
-BIAS_CORRECTIONS = ("NONE", "UNBIASED")
+BIAS_CORRECTIONS = values(BiasCorrection)
 
 
 def similar(depth_ref: np.ndarray, depth: np.ndarray, ns_ref: np.ndarray, ns: np.ndarray) -> np.ndarray:
