@@ -23,7 +23,7 @@ from ..integrators import pathtracer, trace_context
 from ..integrators.context_cache import context_for, fingerprint
 from ..integrators.method_choice import GI_MIN_SHARE
 from ..modes import DirectMethod, Integrator
-from ..parallel.tasks import Progress, Stopped
+from ..parallel.tasks import Progress, Stopped, spans
 from ..profile import NullClock
 from ..restir import di, gi
 from ..restir.history import TemporalHistory
@@ -38,7 +38,7 @@ from .indirect_choice import IndirectChoice, ratios
 from .plan import PassPlan
 from .runner import PassRunner
 from .settings import RenderSettings, validate
-from .work import make_chunks, place
+from .work import frame_reservoirs, hand_back, make_chunks, place
 
 MAX_BATCH = 8  # samples one pass renders at most (FrameRenderer.batch_size)
 
@@ -99,7 +99,6 @@ class FrameRenderer:
 
     # -- methods ------------------------------------------------------------------------------------
     def _choose_direct(self) -> None:
-        self._indirect_seen = self.indirect.method  # the indirect method this choice knew of
         self.direct = methods.choose_direct(self.settings, self.ctx.lights, self.ctx.max_bounces,
                                             self.indirect.method == "RESTIR_GI")
 
@@ -284,12 +283,11 @@ class FrameRenderer:
     def _make_gi(self, surf, first, block, filled: bool = False):
         return paths.gi_initial(self.gi, self.gi_space, surf, first, block, filled)
 
-    def _measured(self, diagnostics: dict) -> None:
-        """Auto indirect chose again (IndirectChoice.update): the Auto direct method follows when its premise (GI
-        or not) changed; it applies from the next pass on."""
-        before = self._indirect_seen
-        self._indirect_seen = self.indirect.method
-        self.reuse_stats.update(diagnostics)
+    def _measured(self, sums) -> None:
+        """Auto indirect chooses again from the measured ``sums`` (IndirectChoice.update); the Auto direct method
+        follows when its premise (GI or not) changed; both apply from the next pass on."""
+        before = self.indirect.method
+        self.reuse_stats.update(self.indirect.update(sums))
         if self.indirect.method != before and self.settings.direct_method == DirectMethod.AUTO:
             self._choose_direct()
 
@@ -298,7 +296,7 @@ class FrameRenderer:
         st, ctx, clock = self.settings, self.ctx, self.clock
         plan = self._plan(batch, cap)
         _x0, _y0, w, h = ctx.scene.camera.window
-        chunks = make_chunks(PassRunner(plan, None, clock, st.tile_pixels).spans(w * h), plan.batch)
+        chunks = make_chunks(spans(w * h, st.tile_pixels), plan.batch)
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
         chunk_stages = 4 + int(plan.resampled) + (int(self.spatial.passes) + 1 if plan.reusing else 0) + \
             (int(self.gi.passes) + 1 if plan.gi else 0)
@@ -333,26 +331,18 @@ class FrameRenderer:
                 gb = primary.gbuffer(ctx, chunks, terms if plan.reusing else gi_terms)
         if plan.reusing:
             with run.stage("gbuffer"):
-                res = di.DIReservoirs.empty(len(gb))
-                for c in chunks:
-                    res.assign(c.surfaces, c.res)
-                    c.res = None  # the frame's array holds them now
+                res = frame_reservoirs(chunks, "res", di.DIReservoirs, len(gb))
             res, dropped = reuse.reuse_di(run, st, ctx, self.space, self.spatial, gb, res, self.prev_history,
                                           self.reuse_stats)
             self.boiling_dropped += dropped
-            for c in chunks:
-                c.res = res.take(c.surfaces)
+            hand_back(chunks, "res", res)
         if gi_reused:
             with run.stage("gbuffer"):
                 gb_gi = gb.with_terms(ShadingTerms(gi_terms))
-                gi_res = gi.GIReservoirs.empty(len(gb))
-                for c in chunks:
-                    gi_res.assign(c.surfaces, c.gi_res)
-                    c.gi_res = None
+                gi_res = frame_reservoirs(chunks, "gi_res", gi.GIReservoirs, len(gb))
             gi_res, gi_history = reuse.reuse_gi(run, st, ctx, self.gi, self.gi_space, self.gi_spatial, gb_gi, gi_res,
                                                 self.prev_history, self.reuse_stats)
-            for c in chunks:
-                c.gi_res = gi_res.take(c.surfaces)
+            hand_back(chunks, "gi_res", gi_res)
         if plan.sample == 0 and gb is not None:
             self._keep_history(gb, res, gb_gi, gi_history, gi_reused)
         unbiased = st.bias_correction == "UNBIASED"
@@ -374,7 +364,7 @@ class FrameRenderer:
         share, uncached = ratios(sums)
         self.reuse_stats["gi_share"], self.reuse_stats["gi_uncached"] = share, uncached
         if self.gi_auto:
-            self._measured(self.indirect.update(sums))  # for the next passes
+            self._measured(sums)  # for the next passes
         elif share < GI_MIN_SHARE:
             gi_on = False
         if not gi_on:

@@ -79,12 +79,12 @@ class IndirectChoice:
         self.remember()
         return probe
 
-    def probe(self, ctx, seed: int, may_hit, gi_initial) -> dict:
+    def probe(self, ctx, seed: int, may_hit, gi_initial) -> np.ndarray:
         """Nothing measured yet (a still, a first frame): camera paths of up to PROBE_BOUNCES bounces through one
         pixel in PROBE_PIXELS, at most PROBE_MAX of them, on their own random stream (the frame's passes are
         independent of it: the image stays unbiased and deterministic), measure what the GI reservoirs would carry.
-        ``gi_initial(surf, first, block)`` makes GI's initial samples (paths.gi_initial). Returns :meth:`update`'s
-        result."""
+        ``gi_initial(surf, first, block)`` makes GI's initial samples (paths.gi_initial). Returns the measured
+        sums for :meth:`update`."""
         x0, y0, w, h = ctx.scene.camera.window
         r = rng(seed, self.frame, 0, STREAM_PROBE)
         pix = r.integers(0, w * h, max(1, min((w * h) // PROBE_PIXELS, PROBE_MAX)))
@@ -99,7 +99,7 @@ class IndirectChoice:
             _glossy, _res, rest = gi_initial(surf, out.first, np.empty((WIDTH, len(surf)), np.float32))
             sums = share_sums(out.indirect, rest)
         self.measure = (None, 1)  # measured now: no periodic probe in this frame's first pass
-        return self.update(sums)
+        return sums
 
     def update(self, sums: np.ndarray) -> dict:
         """Add a pass's measured sums and choose again for the next passes. Returns the decayed measurement's

@@ -52,3 +52,19 @@ def place(chunks: list[Chunk]) -> int:
         c.first = first
         first += len(c.hits.rows)
     return first
+
+
+def frame_reservoirs(chunks: list[Chunk], field: str, kind, n: int):
+    """The chunks' reservoirs in ``field`` ("res" or "gi_res") as one frame-wide ``kind`` array of the frame's n
+    surfaces (the reuse stages' input); the chunks let go of theirs."""
+    res = kind.empty(n)
+    for c in chunks:
+        res.assign(c.surfaces, getattr(c, field))
+        setattr(c, field, None)  # the frame's array holds them now
+    return res
+
+
+def hand_back(chunks: list[Chunk], field: str, res) -> None:
+    """Each chunk's rows of the frame-wide reservoirs ``res`` into its ``field`` (for shading and the film)."""
+    for c in chunks:
+        setattr(c, field, res.take(c.surfaces))
