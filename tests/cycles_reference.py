@@ -49,12 +49,7 @@ def _floats(values, digits: int = 6) -> list:
 
 def _socket_value(sock):
     value = getattr(sock, "default_value", None)
-    if value is None:
-        return None
-    try:
-        return _floats(value)
-    except (TypeError, ValueError):
-        return str(value)
+    return None if value is None else _value(value)
 
 
 _NODE_PROPS = ("blend_type", "data_type", "operation", "interpolation", "extension", "projection", "distribution",

@@ -89,17 +89,32 @@ def _last_box(layout, headline, text):
     box.label(text=text)
 
 
+def _spatial_reuse(layout, s, last, prefix: str) -> None:
+    """The Spatial Reuse settings of DI (``prefix`` "") or GI ("gi_"), with the last render's automatic radius."""
+    col = layout.column(align=True, heading="Spatial Reuse")
+    col.prop(s, prefix + "spatial_neighbors")
+    col.prop(s, prefix + "spatial_radius")
+    radius = last.get(prefix + "spatial_radius") if last else None
+    if getattr(s, prefix + "spatial_radius") == 0 and radius:
+        col.label(text=f"Auto radius in the last render: {radius:.1f} px")
+    col.prop(s, prefix + "spatial_passes")
+
+
 def _title(method: str) -> str:
     return method.replace("_", " ").title()
 
 
-class RESTIR_PT_sampling_direct(RestirPanel, bpy.types.Panel):
-    bl_label = "Direct Light"
-    bl_parent_id = "RESTIR_PT_sampling"
+class RestirIntegratorPanel(RestirPanel):
+    """A sub-panel of settings the ReSTIR integrator reads (hidden for the path tracer)."""
 
     @classmethod
     def poll(cls, context):
         return super().poll(context) and context.scene.restir.integrator == "RESTIR"
+
+
+class RESTIR_PT_sampling_direct(RestirIntegratorPanel, bpy.types.Panel):
+    bl_label = "Direct Light"
+    bl_parent_id = "RESTIR_PT_sampling"
 
     def draw(self, context):
         layout = self.split_layout()
@@ -151,12 +166,7 @@ class RESTIR_PT_sampling_reuse(RestirPanel, bpy.types.Panel):
         sub.active = s.temporal_reuse
         sub.prop(s, "confidence_cap")
         sub.prop(s, "preroll_frames")
-        col = layout.column(align=True, heading="Spatial Reuse")
-        col.prop(s, "spatial_neighbors")
-        col.prop(s, "spatial_radius")
-        if s.spatial_radius == 0 and last and last.get("spatial_radius"):
-            col.label(text=f"Auto radius in the last render: {last['spatial_radius']:.1f} px")
-        col.prop(s, "spatial_passes")
+        _spatial_reuse(layout, s, last, "")
         layout.prop(s, "bias_correction")
         col = layout.column(align=True, heading="Boiling Filter")
         col.active = s.bias_correction == "NONE"  # biased: the unbiased mode never applies it
@@ -167,13 +177,9 @@ class RESTIR_PT_sampling_reuse(RestirPanel, bpy.types.Panel):
         sub.prop(s, "boiling_threshold")
 
 
-class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
+class RESTIR_PT_sampling_indirect(RestirIntegratorPanel, bpy.types.Panel):
     bl_label = "Indirect"
     bl_parent_id = "RESTIR_PT_sampling"
-
-    @classmethod
-    def poll(cls, context):
-        return super().poll(context) and context.scene.restir.integrator == "RESTIR"
 
     def draw(self, context):
         layout = self.split_layout()
@@ -199,12 +205,7 @@ class RESTIR_PT_sampling_indirect(RestirPanel, bpy.types.Panel):
         col.active = s.temporal_reuse
         col.prop(s, "gi_confidence_cap")
         col.prop(s, "gi_max_age")
-        col = layout.column(align=True, heading="Spatial Reuse")
-        col.prop(s, "gi_spatial_neighbors")
-        col.prop(s, "gi_spatial_radius")
-        if s.gi_spatial_radius == 0 and last and last.get("gi_spatial_radius"):
-            col.label(text=f"Auto radius in the last render: {last['gi_spatial_radius']:.1f} px")
-        col.prop(s, "gi_spatial_passes")
+        _spatial_reuse(layout, s, last, "gi_")
         layout.prop(s, "gi_roughness_threshold")
 
 
