@@ -76,38 +76,11 @@ def test_presets_set_the_settings(addon):
     assert (s.integrator, s.samples) == ("PATH", 256)
 
 
-class _Layout:
-    """Stands in for a UILayout: records prop() calls and checks the properties exist."""
-
-    def __init__(self, seen):
-        object.__setattr__(self, "seen", seen)
-
-    def __setattr__(self, name, value):
-        pass
-
-    def prop(self, data, name, **_kw):
-        assert hasattr(data, name), name
-        self.seen.append(name)
-
-    def operator(self, *_a, **_kw):
-        return type("Op", (), {})()
-
-    def __getattr__(self, name):  # row(), column(), ...
-        return lambda *a, **k: _Layout(self.seen)
-
-
 def test_panels_draw_every_setting(addon):
-    from restir_engine.ui import panels
+    from panel_drawing import drawn_properties
     scene = bpy.context.scene
     scene.restir.integrator, scene.restir.direct_method = "RESTIR", "RESTIR"
-    seen = []
-
-    class Ctx:
-        engine = "RESTIR"
-    Ctx.scene, Ctx.view_layer = scene, bpy.context.view_layer
-    for cls in panels.PANELS:
-        holder = type("Holder", (), {"layout": _Layout(seen), "split_layout": panels.RestirPanel.split_layout})()
-        cls.draw(holder, Ctx)
+    seen = [name for _data, name in drawn_properties(scene, bpy.context.view_layer)]
     for name in ("samples", "seed", "max_bounces", "light_candidates", "temporal_reuse", "confidence_cap",
                  "preroll_frames", "spatial_neighbors", "bias_correction", "use_pass_reservoir_m", "use_pass_vector"):
         assert name in seen, name
@@ -157,6 +130,7 @@ def test_panels_draw_with_the_last_render_choices(addon):
 def test_viewport_render_pass_selector(addon):
     """The 3D view's shading settings carry the viewport pass (every documented pass is selectable) and the
     Shading popover's panel draws it for Rendered shading with this engine only."""
+    from panel_drawing import RecordingLayout
     from restir_engine.ui import panels
     from restir_engine.viewport import VIEWPORT_PASSES
     space = next(a.spaces[0] for s in bpy.data.screens for a in s.areas if a.type == "VIEW_3D")
@@ -171,9 +145,9 @@ def test_viewport_render_pass_selector(addon):
         space_data = space
     shading.type = "RENDERED"
     assert panels.RESTIR_PT_viewport_render_pass.poll(Ctx)
-    holder = type("Holder", (), {"layout": _Layout(seen)})()
+    holder = type("Holder", (), {"layout": RecordingLayout(seen)})()
     panels.RESTIR_PT_viewport_render_pass.draw(holder, Ctx)
-    assert seen == ["render_pass"]
+    assert [name for _data, name in seen] == ["render_pass"]
     Ctx.engine = "CYCLES"
     assert not panels.RESTIR_PT_viewport_render_pass.poll(Ctx)
     shading.type = "SOLID"

@@ -83,30 +83,10 @@ def test_presets_name_table_fields(addon):
 def test_panels_draw_every_setting(addon):
     """Each scene setting is drawn by some panel (its draw or draw_header), for the ReSTIR integrator with ReSTIR
     direct light (where every sub-panel shows)."""
-    from restir_engine.ui import panels
+    from panel_drawing import drawn_properties
     scene = bpy.context.scene
     scene.restir.integrator, scene.restir.direct_method, scene.restir.indirect_method = "RESTIR", "RESTIR", "AUTO"
-    seen = set()
-
-    class Layout:
-        def __getattr__(self, name):
-            def call(*args, **kwargs):
-                if name == "prop" and args and args[0] == scene.restir:
-                    seen.add(args[1])
-                return Layout()
-            return call
-
-        def __setattr__(self, name, value):
-            pass
-
-    class Ctx:
-        engine = "RESTIR"
-    Ctx.scene, Ctx.view_layer = scene, bpy.context.view_layer
-    for cls in panels.PANELS:
-        holder = type("Holder", (), {"layout": Layout(), "split_layout": panels.RestirPanel.split_layout})()
-        cls.draw(holder, Ctx)
-        if hasattr(cls, "draw_header"):
-            cls.draw_header(holder, Ctx)
+    seen = {name for data, name in drawn_properties(scene, bpy.context.view_layer) if data == scene.restir}
     assert {f.name for f in _fields()} - seen == set()
 
 
