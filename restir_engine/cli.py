@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import signal
 import sys
 
 
@@ -66,6 +67,9 @@ def _set_format(scene, fmt: str):
 
 def main(argv=None) -> int:
     args = parse(sys.argv[1:] if argv is None else argv)
+    if os.path.isdir(args.blend):
+        print(f"error: {args.blend} is a folder, not a .blend file", file=sys.stderr)
+        return 1
     if not os.path.isfile(args.blend):
         print(f"error: no such file: {args.blend}", file=sys.stderr)
         return 1
@@ -126,15 +130,64 @@ def main(argv=None) -> int:
     if scene.camera is None:
         print("error: the scene has no active camera; add one (Scene Properties > Camera)", file=sys.stderr)
         return 1
+    _stop_on_interrupt()
     try:
-        bpy.ops.render.render(animation=True)
+        if args.render_frame is not None and not scene.render.is_movie_format:
+            _render_still(bpy, scene, args.render_frame)
+        else:
+            _render_animation(bpy, scene)
     except RuntimeError as exc:
         print(f"error: render failed: {exc}", file=sys.stderr)
         return 1
-    for frame in range(scene.frame_start, scene.frame_end + 1, max(1, scene.frame_step)):
-        print("Saved:", scene.render.frame_path(frame=frame))
     return 0
 
 
+EXIT_INTERRUPTED = 130  # the shell's status for a process stopped by Ctrl+C (128 + SIGINT)
+
+
+def _stop_on_interrupt() -> None:
+    """Ctrl+C stops the job at once with status 130, writing nothing more: the frame being rendered is not saved
+    and no later frame starts. (Blender, left to Python's default, swallows the KeyboardInterrupt inside the
+    render callback, saves the unfinished frame and renders on, and the process exits 0.)"""
+    def stop(_signum, _frame):
+        os.write(2, b"error: interrupted (Ctrl+C): the frame being rendered was not saved\n")
+        os._exit(EXIT_INTERRUPTED)
+    signal.signal(signal.SIGINT, stop)
+
+
+def _render_still(bpy, scene, frame: int) -> None:
+    """Render one frame as Blender's F12 does (no preroll: docs/USAGE.md) and save it under the name an
+    animation render gives that frame (``render.frame_path``)."""
+    scene.frame_set(frame)
+    bpy.ops.render.render(write_still=False)
+    path = scene.render.frame_path(frame=frame)
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    bpy.data.images["Render Result"].save_render(filepath=path, scene=scene)
+    print("Saved:", path, flush=True)
+
+
+def _render_animation(bpy, scene) -> None:
+    """Render the frame range through Blender's animation path, printing each frame's file once it is written."""
+    def saved(scene_written, *_args):
+        print("Saved:", scene_written.render.frame_path(frame=scene_written.frame_current), flush=True)
+    bpy.app.handlers.render_write.append(saved)
+    try:
+        bpy.ops.render.render(animation=True)
+    finally:
+        bpy.app.handlers.render_write.remove(saved)
+
+def run(argv=None) -> None:
+    """``main`` as a process: exit with its status straight after the output is flushed, without Blender's
+    teardown (it writes nothing a render needs, and the bpy 4.5 module deadlocks in it: its delayed-close thread
+    waits on a condition variable that a static destructor destroys)."""
+    try:
+        code = main(argv)
+    except SystemExit as exc:  # argparse's errors
+        code = exc.code if isinstance(exc.code, int) else 1
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run()

@@ -64,6 +64,15 @@ def scene_problems(core_scene, light_count: int) -> list[str]:
     return problems
 
 
+def _black_passes(scene, view_layer, window) -> dict:
+    """Every enabled pass of a frame that sees nothing: zero, and the Depth of nothing hit (1e10, as Cycles)."""
+    _x0, _y0, w, h = window
+    images = {}
+    for _name, chans, _ctype, _enabled, core_name in pass_table.enabled_passes(scene, view_layer):
+        images[core_name] = np.full((h, w, len(chans)), 1e10 if core_name == "Depth" else 0.0, np.float32)
+    return images
+
+
 def _viewport_pass(context) -> str:
     """The pass the 3D view shows (View3DShading.restir.render_pass)."""
     shading = getattr(getattr(context, "space_data", None), "shading", None)
@@ -135,6 +144,10 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, msg)
         if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
             self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
+        if core_scene.camera.blind:  # a camera scaled to zero sees nothing: a black frame, no history
+            self._write(_black_passes(scene, view_layer, core_scene.camera.window), core_scene.camera.window,
+                        scene, view_layer)
+            return
         wants_vector = view_layer.use_pass_vector
         if wants_vector or wants_temporal:
             self.update_stats("ReSTIR", "Evaluating neighbouring frames for motion")

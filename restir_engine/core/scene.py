@@ -210,6 +210,7 @@ class Camera:
     width, height: full render resolution in pixels (after the percentage)
     window: (x0, y0, w, h) pixel rectangle to render, y0 counted from the bottom row (border/crop)
     clip_start, clip_end: camera clipping distances in scene units
+    blind: the camera object is scaled to zero and has no orientation; it sees nothing (a black frame)
     """
 
     cam_to_world: np.ndarray
@@ -220,6 +221,7 @@ class Camera:
     ortho: bool = False
     clip_start: float = 0.1
     clip_end: float = 1000.0
+    blind: bool = False
 
 
 @dataclass
@@ -243,10 +245,31 @@ class Motion:
         if len(other) == 0:  # no instances: nothing moves
             return points.astype(np.float32)
         instance = np.clip(instance, 0, len(other) - 1)
-        xform = np.einsum("nij,njk->nik", other, np.linalg.inv(self.current))[instance]  # other · current⁻¹
+        xform = np.einsum("nij,njk->nik", other, affine_inverse(self.current))[instance]  # other · current⁻¹
         p = points.astype(np.float64)
         out = np.einsum("nij,jn->in", xform[:, :3, :3], p) + xform[:, :3, 3].T
         return out.astype(np.float32)
+
+
+def affine_inverse(m: np.ndarray) -> np.ndarray:
+    """Inverses of affine matrices (k, 4, 4) that tolerate singular ones: an object scaled to zero on some axis
+    (how animators hide objects) gets the pseudo-inverse of its linear part, which takes its points back to the
+    object's surviving axes (to its origin when scaled to zero on all), so they move with the object."""
+    m = np.asarray(m, np.float64)
+    lin = m[:, :3, :3]
+    det = np.linalg.det(lin)
+    scale = np.maximum(np.abs(lin).max(axis=(1, 2)), 1e-300)
+    regular = np.abs(det) > 1e-12 * scale ** 3
+    inv_lin = np.empty_like(lin)
+    if regular.any():
+        inv_lin[regular] = np.linalg.inv(lin[regular])
+    if not regular.all():
+        inv_lin[~regular] = np.linalg.pinv(lin[~regular])
+    out = np.zeros_like(m)
+    out[:, :3, :3] = inv_lin
+    out[:, :3, 3] = -np.einsum("nij,nj->ni", inv_lin, m[:, :3, 3])
+    out[:, 3, 3] = 1.0
+    return out
 
 
 @dataclass

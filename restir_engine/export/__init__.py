@@ -10,6 +10,7 @@ import numpy as np
 
 from ..core.scene import Motion, Scene
 from .camera import ExportError, export_camera
+from .limits import clamped_radiance
 from .lights import export_lamps
 from .materials import MaterialRegistry
 from .meshes import export_geometry, instance_matrices
@@ -35,6 +36,8 @@ def neighbour_frames(engine, depsgraph, scene_out: Scene, camera_override=None, 
         try:
             cam = export_camera(depsgraph, camera_override, [])
         except ExportError:
+            cam = None
+        if cam is not None and cam.blind:  # no orientation then: no motion to measure against it
             cam = None
         found[which] = (arr, cam)
     engine.frame_set(frame, subframe=0.0)
@@ -68,5 +71,8 @@ def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warn
     ``registry``) around ``geometry``."""
     lamps = export_lamps(depsgraph, registry, warnings)
     world, world_image, world_rotation = export_world(depsgraph.scene, warnings)
+    world = clamped_radiance(world, "World", warnings).astype(np.float32)
+    if world_image is not None:
+        world_image = clamped_radiance(world_image, "World texture", warnings).astype(np.float32)
     return Scene(geometry=geometry, materials=registry.table(), lamps=lamps, camera=camera,
                  world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings)

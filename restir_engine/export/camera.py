@@ -55,12 +55,14 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
             warnings.append(f"Camera '{cam_obj.name}': panoramic cameras are not supported; rendered as perspective")
         if data.dof.use_dof:
             warnings.append(f"Camera '{cam_obj.name}': depth of field is not supported; rendered as a pinhole")
-    c2w = np.array(cam_obj.matrix_world, dtype=np.float64)
-    # normalize axes: a scaled camera object must not scale rays
-    for k in range(3):
-        n = np.linalg.norm(c2w[:3, k])
-        if n > 0:
-            c2w[:3, k] /= n
+    c2w, blind = _orthonormal_camera_matrix(np.array(cam_obj.matrix_world, dtype=np.float64))
+    if blind:
+        warnings.append(f"Camera '{cam_obj.name}' is scaled to zero on two or more axes: it has no orientation "
+                        "and sees nothing, so the frame is black (as in Cycles)")
+    if ortho and float(cam_obj.data.ortho_scale) <= 0.0:
+        warnings.append(f"Camera '{cam_obj.name}': an orthographic scale of 0 sends every pixel's ray from the same "
+                        "point, so the image is one colour; set Orthographic Scale above 0")
+    proj = _well_conditioned_depth(proj, ortho, clip_start, clip_end)
     try:
         ndc_to_cam = np.linalg.inv(proj)
     except np.linalg.LinAlgError as exc:
@@ -69,4 +71,39 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
         raise ExportError(f"Camera '{cam_obj.name}' has a non-finite transform")
     return Camera(cam_to_world=c2w, ndc_to_cam=ndc_to_cam, width=width, height=height,
                   window=border_window(render, width, height), ortho=ortho,
-                  clip_start=clip_start, clip_end=clip_end)
+                  clip_start=clip_start, clip_end=clip_end, blind=blind)
+
+
+def _orthonormal_camera_matrix(m: np.ndarray) -> tuple[np.ndarray, bool]:
+    """(camera matrix with unit axes, whether its orientation is lost). A scaled camera object must not scale
+    rays, so each axis is normalized; one axis scaled to zero is rebuilt from the other two (right-handed, as a
+    camera frame is); with two or three at zero the orientation is gone (the identity stands in, flagged)."""
+    m = m.copy()
+    lengths = np.linalg.norm(m[:3, :3], axis=0)
+    usable = lengths > 1e-12 * max(1.0, float(np.abs(m[:3, 3]).max()))
+    for k in np.flatnonzero(usable):
+        m[:3, k] /= lengths[k]
+    if usable.sum() == 2:
+        k = int(np.flatnonzero(~usable)[0])
+        m[:3, k] = np.cross(m[:3, (k + 1) % 3], m[:3, (k + 2) % 3])
+        m[:3, k] /= np.linalg.norm(m[:3, k])
+    elif usable.sum() < 2:
+        m[:3, :3] = np.eye(3)
+        return m, True
+    return m, False
+
+
+def _well_conditioned_depth(proj: np.ndarray, ortho: bool, near: float, far: float) -> np.ndarray:
+    """``proj`` with its depth rows rebuilt in float64 from the clip range. Blender hands the projection over in
+    float32, where -(far + near) / (far - near) rounds to -1 once near/far is below about 1e-7 (a Clip Start of
+    1e-6, what typing 0 stores) and the inverse then puts the near plane at infinity; OpenGL's depth mapping
+    (NDC z = -1 at the near plane, +1 at the far plane) written in float64 keeps it finite down to Blender's
+    minimum."""
+    if not (0.0 < near < far) or not np.isfinite(far):
+        return proj
+    proj = proj.copy()
+    if ortho:
+        proj[2, :] = (0.0, 0.0, -2.0 / (far - near), -(far + near) / (far - near))
+    elif abs(proj[3, 2] + 1.0) < 1e-6 and abs(proj[3, 3]) < 1e-6:  # the usual perspective w = -z
+        proj[2, 2:] = (-(far + near) / (far - near), -2.0 * far * near / (far - near))
+    return proj

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.scene import Lamps, TriangleSet
+from .limits import clamped_radiance
 
 DISK_SEGMENTS = 48
 SPHERE_LEVEL = 1  # 80 proxy triangles per point/spot light (hits are then found on the true sphere)
@@ -107,12 +108,17 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
         if not np.isfinite(m).all() or not np.isfinite(power).all():
             warnings.append(f"Light '{obj.name}' has a non-finite transform or power and was skipped")
             continue
+        if power.min() < 0:
+            warnings.append(f"Light '{obj.name}' has negative power: subtracting light is not supported (Cycles "
+                            "subtracts it); its negative part was left out")
+            power = np.maximum(power, 0.0)
         if power.max() <= 0:
             continue
         visible = bool(getattr(obj, "visible_camera", True))
         if light.type == "SUN":
             axis = m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-30)
-            suns.append((axis, np.cos(min(float(light.angle), np.pi) / 2), power))
+            suns.append((axis, np.cos(min(float(light.angle), np.pi) / 2),
+                         clamped_radiance(power, f"Sun '{obj.name}' irradiance", warnings)))
             continue
         if light.type == "AREA":
             local = _area_shape(light)

@@ -8,17 +8,70 @@ naming the material and the reason.
 """
 from __future__ import annotations
 
+import os
+import stat
+
 import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
 from ..core.materials.textures import NearestImage
+from .limits import clamped_radiance
+
+# Mix/Add shader levels followed; deeper nests (Blender allows any) are cut off with a warning
+MAX_MIX_DEPTH = 256
 
 MAGENTA = (1.0, 0.0, 1.0)
 
 
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
+
+
+_SRGB_BYTE_TABLE = srgb_to_linear(np.arange(256, dtype=np.float64) / 255.0)
+
+
+def srgb_bytes_to_linear(c: np.ndarray) -> np.ndarray:
+    """srgb_to_linear of an 8-bit image's pixels (Blender hands them over as k/255): one table lookup each."""
+    return _SRGB_BYTE_TABLE[np.rint(np.clip(c, 0.0, 1.0) * 255.0).astype(np.uint8)]
+
+
+class TextureCache:
+    """Textures read from image files, kept across exports (frames of an animation, viewport edits) while the file
+    is unchanged: keyed by its path, modification time and size and by how the pixels are used. Packed, generated
+    and edited (unsaved) images are read afresh each time. Holds at most ``max_bytes``, least recently used out."""
+
+    def __init__(self, max_bytes: int = 2 << 30):
+        self.max_bytes = max_bytes
+        self.items: dict = {}
+
+    @staticmethod
+    def key(image, use: tuple):
+        if image.source != "FILE" or image.packed_file is not None or image.is_dirty:
+            return None
+        import bpy
+        path = bpy.path.abspath(image.filepath, library=image.library)
+        try:
+            st = os.stat(path)
+        except OSError:
+            return None
+        return (path, st.st_mtime_ns, st.st_size, image.colorspace_settings.name, image.alpha_mode, use[1:])
+
+    def get(self, key):
+        if key is None or key not in self.items:
+            return None
+        self.items[key] = self.items.pop(key)  # most recently used last
+        return self.items[key]
+
+    def put(self, key, data: np.ndarray) -> None:
+        if key is None or data.nbytes > self.max_bytes:
+            return
+        self.items[key] = data
+        while sum(a.nbytes for a in self.items.values()) > self.max_bytes:
+            del self.items[next(iter(self.items))]
+
+
+_TEXTURES = TextureCache()
 
 
 
@@ -66,6 +119,10 @@ class MaterialRegistry:
         return any(textured(self.rows[i]) for i in indices)
 
     def table(self) -> MaterialTable:
+        for row in self.rows:
+            if "emission" in row:
+                row["emission"] = tuple(clamped_radiance(row["emission"], f"Material '{row.get('name', '?')}' "
+                                                         "emission", self.warnings).tolist())
         return MaterialTable.build(self.rows, self.textures)
 
     # -- conversion ---------------------------------------------------------------------
@@ -313,31 +370,47 @@ class MaterialRegistry:
 
     def _flatten(self, material, node, depth: int, weight: float, tex: int, sign: float) -> list:
         """[(row, weight, factor texture, sign)]: the leaves of a Mix/Add tree with the products of their constant
-        weights; sign +1 weighs a leaf by the factor texture t, -1 by 1 - t (0: no texture). One textured factor
-        per leaf is supported; deeper ones use their socket's value (reported)."""
+        weights, a leaf reached along several paths once with the sum of their weights; sign +1 weighs a leaf by the
+        factor texture t, -1 by 1 - t (0: no texture). One textured factor per leaf is supported; deeper ones use
+        their socket's value (reported)."""
+        leaves = self._mix_leaves(material, node, weight, tex, sign, {}, 0)
+        return [(self._shader(material, leaf, depth + 1), w, tx, sg) for leaf, w, tx, sg in leaves]
+
+    def _mix_leaves(self, material, node, weight: float, tex: int, sign: float, memo: dict, level: int) -> list:
+        """[(leaf node, weight, factor texture, sign)] under ``node``; ``memo`` holds each (node, texture, sign)'s
+        leaves at weight 1, so a tree that reuses a sub-mix costs its nodes, not its paths."""
         if node.type not in {"MIX_SHADER", "ADD_SHADER"}:
-            return [(self._shader(material, node, depth + 1), weight, tex, sign)]
-        if depth >= 8:
-            self._warn(material, "shader mixes nested deeper than 8 levels are cut off")
+            return [(node, weight, tex, sign)]
+        if level >= MAX_MIX_DEPTH:
+            self._warn(material, f"shader mixes nested deeper than {MAX_MIX_DEPTH} levels are cut off")
             return []
+        key = (node.name, tex, sign)
+        if key not in memo:
+            memo[key] = self._mix_children(material, node, tex, sign, memo, level)
+        return [(leaf, w * weight, tx, sg) for leaf, w, tx, sg in memo[key]]
+
+    def _mix_children(self, material, node, tex: int, sign: float, memo: dict, level: int) -> list:
         shaders = [s for s in node.inputs if s.type == "SHADER"]
         if node.type == "ADD_SHADER":
-            ws = [(weight, tex, sign)] * 2
+            ws = [(1.0, tex, sign)] * 2
         else:
             fac_socket = node.inputs["Fac"]
             fac_tex = self._factor_texture(material, fac_socket) if tex < 0 else -1
             if fac_tex >= 0:
-                ws = [(weight, fac_tex, -1.0), (weight, fac_tex, 1.0)]
+                ws = [(1.0, fac_tex, -1.0), (1.0, fac_tex, 1.0)]
             else:
                 if fac_socket.is_linked and tex >= 0:
                     self._warn(material, f"'{node.name}': a second textured Mix factor is approximated by its value")
                 fac = float(np.clip(self._float_input(material, fac_socket), 0, 1))
-                ws = [(weight * (1 - fac), tex, sign), (weight * fac, tex, sign)]
-        out = []
+                ws = [(1 - fac, tex, sign), (fac, tex, sign)]
+        merged: dict = {}  # a leaf reached along several paths: once, with the sum of their weights
         for socket, (w, tx, sg) in zip(shaders, ws):
             if socket.is_linked and w > 0:
-                out += self._flatten(material, socket.links[0].from_node, depth + 1, w, tx, sg)
-        return out
+                for leaf, lw, ltx, lsg in self._mix_leaves(material, socket.links[0].from_node, w, tx, sg, memo,
+                                                            level + 1):
+                    key = (leaf.name, ltx, lsg)
+                    merged[key] = (leaf, merged[key][1] + lw if key in merged else lw, ltx, lsg)
+        return list(merged.values())
 
     def _factor_texture(self, material, socket) -> int:
         """Texture index of an Image Texture driving a float socket (its Color as luminance, or its Alpha), or -1."""
@@ -361,7 +434,23 @@ class MaterialRegistry:
         key = (image.name_full, "alpha" if alpha else "luminance" if luminance else "rgb", closest)
         if key in self.texture_index:
             return self.texture_index[key]
-        w, h = image.size[:]
+        kept = _TEXTURES.key(image, key)
+        data = _TEXTURES.get(kept)
+        if data is None:
+            data = self._read_texture(material, image, alpha, luminance)
+            _TEXTURES.put(kept, data)
+        self.texture_index[key] = len(self.textures)
+        self.textures.append(data.view(NearestImage) if closest else data)
+        return self.texture_index[key]
+
+    def _read_texture(self, material, image, alpha: bool, luminance: bool) -> np.ndarray:
+        """The image's pixels as (h, w, 3) float32, scene-linear (magenta where it cannot be read)."""
+        unreadable = _unreadable_file(image)
+        if unreadable:  # asking Blender for its size would open it (a FIFO blocks the export for ever)
+            self._warn(material, f"image '{image.name}': {unreadable}; rendered magenta")
+            w = h = 0
+        else:
+            w, h = image.size[:]
         data = None
         if w > 0 and h > 0:
             try:
@@ -370,7 +459,9 @@ class MaterialRegistry:
                 data = buf.reshape(h, w, image.channels)
             except (RuntimeError, ValueError):
                 data = None
-        if data is None or data.size == 0:
+        if unreadable:
+            data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+        elif data is None or data.size == 0:
             self._warn(material, f"image '{image.name}' could not be loaded; rendered magenta")
             data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
         elif alpha:
@@ -381,17 +472,33 @@ class MaterialRegistry:
             rgb = data[..., :3] if ch >= 3 else np.repeat(data[..., :1], 3, axis=2)
             space = image.colorspace_settings.name
             if not image.is_float and space in {"sRGB", "sRGB EOTF"}:
-                rgb = srgb_to_linear(rgb)
+                rgb = srgb_bytes_to_linear(rgb)
             elif space not in {"sRGB", "sRGB EOTF", "Linear Rec.709", "Linear", "Non-Color", "Raw", "Linear CIE-XYZ E"} \
                     and not image.is_float:
                 self._warn(material, f"image '{image.name}' colour space '{space}' treated as sRGB")
-                rgb = srgb_to_linear(rgb)
+                rgb = srgb_bytes_to_linear(rgb)
             if luminance:  # Blender's implicit colour -> float conversion
                 rgb = np.repeat((rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32))[..., None], 3, axis=2)
             data = np.ascontiguousarray(rgb, dtype=np.float32)
-        self.texture_index[key] = len(self.textures)
-        self.textures.append(data.view(NearestImage) if closest else data)
-        return self.texture_index[key]
+        return data
+
+
+def _unreadable_file(image) -> str:
+    """Why the file an image would be loaded from is not one to open ('' when it is, or when the image is packed,
+    generated or a sequence/UDIM set whose files Blender resolves itself)."""
+    if image.source != "FILE" or image.packed_file is not None:
+        return ""
+    import bpy
+    path = bpy.path.abspath(image.filepath, library=image.library)
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return ""  # missing: Blender's own load fails and says so (the magenta warning below)
+    if stat.S_ISDIR(mode):
+        return f"'{path}' is a folder"
+    if not stat.S_ISREG(mode):
+        return f"'{path}' is not a regular file (a pipe or device)"
+    return ""
 
 
 def _has_bsdf(row: dict) -> bool:

@@ -189,7 +189,9 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
     with np.errstate(invalid="ignore", over="ignore"):
         area2 = np.linalg.norm(np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0]), axis=1)
     keep = finite & (area2 > 0) & np.isfinite(area2)
-    n_degenerate = int((finite & ~keep).sum())
+    # an object scaled to zero is how animators hide it: its triangles go without a word
+    hidden = np.repeat([not np.any(b[1][:3, :3]) for b in blocks], [len(b[0]["verts"]) for b in blocks])
+    n_degenerate = int((finite & ~keep & ~hidden).sum())
     if n_degenerate:
         warnings.append(f"{n_degenerate} zero-area triangles were skipped")
     if not keep.all():

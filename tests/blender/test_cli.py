@@ -80,3 +80,72 @@ def test_unknown_engine_corrupt_file_and_inverted_range_against_the_file(blend, 
     r = run_cli(str(blend), "-s", "4", "-e", "5", "-o", str(tmp_path / "m_####"), "-F", "PNG", "--samples", "1")
     assert r.returncode == 0, r.stderr  # a range above the file's: moved, not clamped
     assert (tmp_path / "m_0004.png").exists() and (tmp_path / "m_0005.png").exists()
+
+
+FRAMES_SEEN = ("--python-expr", "import bpy; bpy.app.handlers.frame_change_post.append("
+               "lambda sc, *a: print('frame set', sc.frame_current, flush=True))")
+
+
+def test_single_frame_never_prerolls_and_a_chunk_does(blend, tmp_path):
+    """docs/USAGE.md: ``-f N`` renders as F12 (no preroll); a chunk ``-s S -e E -a`` prerolls (positive control)."""
+    common = ("--python-expr", "import bpy; bpy.context.scene.restir.direct_method = 'RESTIR'", *FRAMES_SEEN,
+              "-o", str(tmp_path / "p_####"), "-F", "PNG")
+    r = run_cli(str(blend), *common, "-f", "5")
+    assert r.returncode == 0, r.stderr
+    # frame 4 is evaluated for the motion into frame 5; a preroll of 3 would render frames 2, 3 and 4
+    assert not any(f"frame set {f}" in r.stdout for f in (2, 3)), r.stdout
+    assert r.stdout.count("Saved:") == 1 and (tmp_path / "p_0005.png").exists()
+    r = run_cli(str(blend), *common, "-s", "5", "-e", "5", "-a")
+    assert r.returncode == 0, r.stderr
+    assert all(f"frame set {f}" in r.stdout for f in (2, 3)), r.stdout
+
+
+def test_ctrl_c_stops_the_job_writes_nothing_and_exits_130(blend, tmp_path):
+    """A farm must not count an interrupted frame as done: Ctrl+C during frame 2 of 3 leaves frame 1 saved,
+    no file for frames 2 and 3, exit status 130, within seconds."""
+    import signal
+    import time
+    out = tmp_path / "c_####"
+    proc = subprocess.Popen([sys.executable, "-m", "restir_engine", str(blend), "-o", str(out), "-F", "PNG",
+                             "-s", "1", "-e", "3", "-a", "--samples", "100"], cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        first = proc.stdout.readline()
+        while first and not first.startswith("Saved:"):
+            first = proc.stdout.readline()
+        assert first.startswith("Saved:") and first.strip().endswith("c_0001.png"), proc.stderr.read()
+        time.sleep(0.5)  # frame 2 is rendering now
+        proc.send_signal(signal.SIGINT)
+        t0 = time.perf_counter()
+        rest, err = proc.communicate(timeout=60)
+        stopped = time.perf_counter() - t0
+    finally:
+        proc.kill()
+    assert proc.returncode == 130, (rest, err)
+    assert "interrupted" in err and stopped < 5.0
+    assert (tmp_path / "c_0001.png").exists()
+    assert not (tmp_path / "c_0002.png").exists() and not (tmp_path / "c_0003.png").exists()
+    assert "Saved:" not in rest
+
+
+def test_a_texture_that_is_a_pipe_and_a_folder_given_as_the_file(blend, tmp_path):
+    """An image whose file is a FIFO would block the export for ever (Blender opens it to learn its size): the
+    render goes on with the texture magenta and a warning. A folder given as the .blend gets its own line."""
+    fifo = tmp_path / "pipe.png"
+    os.mkfifo(fifo)
+    image = bpy.data.images.new("Piped", 4, 4)
+    image.source = "FILE"
+    image.filepath = str(fifo)
+    material = bpy.data.materials["White"]
+    tex = material.node_tree.nodes.new("ShaderNodeTexImage")
+    tex.image = image
+    shader = next(n for n in material.node_tree.nodes if n.type in {"BSDF_DIFFUSE", "BSDF_PRINCIPLED"})
+    material.node_tree.links.new(tex.outputs["Color"], shader.inputs[0])
+    path = tmp_path / "piped.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    r = run_cli(str(path), "-f", "1", "-o", str(tmp_path / "pipe_####"), "-F", "PNG")
+    assert r.returncode == 0, r.stderr
+    assert "not a regular file" in r.stdout + r.stderr
+    assert (tmp_path / "pipe_0001.png").exists()
+    r = run_cli(str(tmp_path), "-f", "1")
+    assert r.returncode == 1 and r.stderr.strip() == f"error: {tmp_path} is a folder, not a .blend file"

@@ -106,3 +106,144 @@ def test_camera_inside_geometry_and_zero_size_light(addon):
     assert any("zero area" in w for w in s.warnings)
     p = render_passes(scene)
     assert np.isfinite(p["Combined"]).all()
+
+
+def _frames(scene, frames=(1, 2, 3)):
+    """Combined of each frame rendered in turn (each frame after the first reuses the one before)."""
+    out = []
+    for f in frames:
+        scene.frame_set(f)
+        out.append(render_passes(scene)["Combined"])
+    return out
+
+
+@pytest.mark.parametrize("scale", [(0, 0, 0), (1, 1, 0)], ids=["hidden", "flattened"])
+def test_an_object_scaled_to_zero_renders_with_temporal_history(addon, scale):
+    """Scaling to 0 is how animators hide objects: frames with history (motion of every instance) render,
+    without a warning for a hidden object's triangles."""
+    cornell = cornell_box("EMISSIVE", (24, 16))
+    configure_restir(cornell, 1, 1, direct_method="RESTIR")
+    bpy.ops.mesh.primitive_cube_add(size=0.3, location=(-0.4, 0.3, 0.3))
+    cube = bpy.context.active_object
+    cube.scale = scale
+    cube.keyframe_insert("location", frame=1)
+    cube.location.x += 0.2
+    cube.keyframe_insert("location", frame=3)
+    for img in _frames(cornell):
+        assert np.isfinite(img).all() and img[..., :3].mean() > 0
+    warnings = export().warnings
+    assert not any("zero-area" in w for w in warnings) if scale == (0, 0, 0) else True
+
+
+def test_motion_of_singular_instances_follows_the_object():
+    """scene.affine_inverse: the pseudo-inverse on singular instances, the inverse elsewhere."""
+    from restir_engine.core.scene import Motion, affine_inverse
+    regular = np.eye(4)
+    regular[:3, :3] = [[2, 0, 0], [0, 0, -3], [0, 1, 0]]
+    regular[:3, 3] = (1, 2, 3)
+    flat = np.diag([2.0, 1.0, 0.0, 1.0])
+    flat[:3, 3] = (0, 0, 5)
+    zero = np.zeros((4, 4))
+    zero[:, 3] = (4, 5, 6, 1)
+    inv = affine_inverse(np.stack([regular, flat, zero]))
+    assert np.allclose(inv[0] @ regular, np.eye(4))
+    moved = np.stack([regular, flat, zero]).copy()
+    moved[:, :3, 3] += (1.0, 0.0, 0.0)  # every instance one unit along x
+    motion = Motion(current=np.stack([regular, flat, zero]), prev=moved, next=moved)
+    pts = np.array([[1.0, 2.0, 4.0], [2.0, 3.0, 5.0], [3.0, 5.0, 6.0]])  # one point on each (columns)
+    then = motion.moved_points(pts, np.array([0, 1, 2]), "prev")
+    assert np.allclose(then, pts + np.array([[1.0], [0.0], [0.0]]), atol=1e-5)
+
+
+def test_a_camera_scaled_to_zero_gives_a_black_frame_with_a_warning(addon):
+    cornell = cornell_box("EMISSIVE", (16, 16))
+    configure_restir(cornell, 1, 1, direct_method="RESTIR")
+    cornell.camera.scale = (0, 0, 0)
+    for img in _frames(cornell, (1, 2)):
+        assert np.isfinite(img).all() and img.max() == 0
+    assert any("scaled to zero" in w for w in export().warnings)
+    cornell.camera.scale = (1, 0, 1)  # one axis lost: rebuilt from the other two, the same picture
+    flat = export().camera.cam_to_world
+    cornell.camera.scale = (1, 1, 1)
+    assert np.allclose(flat, export().camera.cam_to_world, atol=1e-6)
+
+
+def test_a_clip_start_at_blenders_minimum_renders_the_scene(addon):
+    """Typing 0 stores 1e-6: the near plane must stay finite (Blender's projection is float32), and the image
+    is the one a clip start of 1 cm gives with the same seed."""
+    import warnings as py_warnings
+    cornell = cornell_box("EMISSIVE", (16, 16))
+    configure_restir(cornell, 1, 1)
+    images = {}
+    for clip in (1e-6, 0.01):
+        cornell.camera.data.clip_start = clip
+        with py_warnings.catch_warnings():
+            py_warnings.simplefilter("error", RuntimeWarning)
+            images[clip] = render_passes(cornell)["Combined"]
+    assert images[1e-6][..., :3].mean() > 0.05
+    assert np.allclose(images[1e-6], images[0.01], rtol=1e-3, atol=1e-4)
+
+
+def _mix_chain(levels: int, fac: float, shared: bool):
+    """A material of ``levels`` nested Mix shaders: each mixes a grey Diffuse (A, weight 1 - fac) with the next
+    level (B, weight fac); with ``shared`` every Mix takes both inputs from the level below (a DAG of 2^levels
+    paths to one Diffuse)."""
+    m = bpy.data.materials.new(f"chain{levels}{shared}")
+    enable = getattr(m, "use_nodes", None)
+    if enable is not None and not m.node_tree:
+        m.use_nodes = True
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    nodes.remove(nodes["Principled BSDF"])
+    grey = nodes.new("ShaderNodeBsdfDiffuse")
+    grey.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1)
+    below = grey
+    for _ in range(levels):
+        mix = nodes.new("ShaderNodeMixShader")
+        mix.inputs["Fac"].default_value = fac
+        links.new((below if shared else grey).outputs[0], mix.inputs[1])
+        links.new(below.outputs[0], mix.inputs[2])
+        below = mix
+    links.new(below.outputs[0], nodes["Material Output"].inputs["Surface"])
+    return m
+
+
+@pytest.mark.parametrize("levels,shared", [(24, False), (40, True)], ids=["deep", "shared-40"])
+def test_deep_and_shared_mix_trees_keep_their_weight(addon, levels, shared):
+    """Cycles follows any depth: the flattened weights of a grey Diffuse mixed with itself sum to 1 (cut off at 8
+    levels, a 0.9 chain kept 1 - 0.9^8 = 57 % of it); a DAG of 2^40 paths exports at once, as one component."""
+    small_scene()
+    bpy.ops.mesh.primitive_cube_add()
+    bpy.context.active_object.data.materials.append(_mix_chain(levels, 0.9, shared))
+    t0 = time.perf_counter()
+    table = export().materials
+    assert time.perf_counter() - t0 < 10.0
+    row = int(np.flatnonzero(table.mix_count > 0)[0])
+    first, count = table.mix_first[row], table.mix_count[row]
+    assert count == 1
+    assert abs(float(table.mix_weight[first:first + count].sum()) - 1.0) < 1e-5
+
+
+def test_extreme_emission_is_clamped_and_negative_lamps_named(addon):
+    """Radiance of 1e38 would overflow float32 sums (the emitter rendered black): clamped to export.limits'
+    maximum with a warning, the emitter seen at that radiance; a lamp of negative power is named, not dropped
+    silently."""
+    from restir_engine.export.limits import MAX_RADIANCE
+    cornell = cornell_box("EMISSIVE", (16, 16))
+    configure_restir(cornell, 1, 1)
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(0, 0.3, 0.8))
+    m = bpy.data.materials.new("Blinding")
+    nodes = m.node_tree.nodes if m.node_tree else (setattr(m, "use_nodes", True) or m.node_tree.nodes)
+    nodes["Principled BSDF"].inputs["Emission Color"].default_value = (1, 1, 1, 1)
+    nodes["Principled BSDF"].inputs["Emission Strength"].default_value = 1e38
+    bpy.context.active_object.data.materials.append(m)
+    lamp = bpy.data.lights.new("Negative", "POINT")
+    lamp.energy = -50.0
+    obj = bpy.data.objects.new("Negative", lamp)
+    obj.location = (0, 0, 1.0)
+    cornell.collection.objects.link(obj)
+    warnings = export().warnings
+    assert any("Blinding" in w and "clamped" in w for w in warnings)
+    assert any("Negative" in w and "negative power" in w for w in warnings)
+    img = render_passes(cornell)["Combined"][..., :3].astype(np.float64)
+    assert np.isfinite(img).all()
+    assert img.max() == pytest.approx(MAX_RADIANCE, rel=1e-3)  # the emitter's pixels, not black

@@ -6,6 +6,8 @@ import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
+import numpy as np
+
 _POOL: ThreadPoolExecutor | None = None
 
 
@@ -31,5 +33,21 @@ def pool() -> ThreadPoolExecutor:
     """The process-wide worker pool (one thread per core)."""
     global _POOL
     if _POOL is None:
-        _POOL = ThreadPoolExecutor(max_workers=thread_count(), thread_name_prefix="restir")
+        _POOL = ThreadPoolExecutor(max_workers=thread_count(), thread_name_prefix="restir",
+                                   initializer=_quiet_thread)
     return _POOL
+
+
+QUIET = dict(over="ignore", invalid="ignore", divide="ignore")
+
+
+def quiet_float_errors():
+    """A context in which NumPy's overflow, invalid and divide warnings stay silent: a frame's stages turn
+    non-finite values into zeros themselves (sampling.finite, the film), and scenes with extreme values would
+    otherwise fill stderr with one line per operation. The pool's threads run so always (NumPy's error state is
+    per thread)."""
+    return np.errstate(**QUIET)
+
+
+def _quiet_thread() -> None:
+    np.seterr(**QUIET)

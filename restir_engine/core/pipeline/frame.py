@@ -23,6 +23,7 @@ from ..integrators import pathtracer, trace_context
 from ..integrators.context_cache import context_for, fingerprint
 from ..integrators.method_choice import GI_MIN_SHARE
 from ..modes import DirectMethod, Integrator
+from ..parallel.pool import quiet_float_errors
 from ..parallel.tasks import Progress, Stopped, spans
 from ..profile import NullClock
 from ..restir import di, gi
@@ -222,9 +223,12 @@ class FrameRenderer:
                     ) -> bool:
         """Render the next sample pass (one path per pixel; ``batch`` per pixel where the pass can) into the film,
         with at most ``light_candidate_cap`` light candidates (viewport navigation). Returns False, keeping the film
-        unchanged, when ``should_stop`` asked to stop part-way."""
+        unchanged, when ``should_stop`` asked to stop part-way. Floating-point overflow from extreme scene values
+        (radiance near export.limits.MAX_RADIANCE times a sharp BSDF) is not reported per operation: the film keeps
+        only finite values (parallel.pool.quiet_float_errors)."""
         try:
-            done = self._sample_pass(progress, should_stop, batch, light_candidate_cap)
+            with quiet_float_errors():
+                done = self._sample_pass(progress, should_stop, batch, light_candidate_cap)
         except Stopped:
             return False
         self.film.samples += done

@@ -29,7 +29,8 @@ PROBE_MAX = 2048  # ... and at most this many paths
 def share_sums(indirect: np.ndarray, rest: np.ndarray) -> np.ndarray:
     """(4,) over surfaces: luminance sums of the path-traced indirect light (3, n) and of the part the GI reservoirs
     carry (indirect - rest); sums of squares of the indirect light and of ``rest``, the part they do not carry."""
-    lum_all, lum_rest = luminance_rows(indirect), luminance_rows(rest)
+    lum_all = luminance_rows(indirect).astype(np.float64)  # squares of bright light overflow float32
+    lum_rest = luminance_rows(rest).astype(np.float64)
     total = float(lum_all.sum())
     return np.array([total, total - float(lum_rest.sum()), float(np.dot(lum_all, lum_all)),
                      float(np.dot(lum_rest, lum_rest))])
