@@ -8,7 +8,7 @@ import bpy
 import numpy as np
 
 from . import passes as pass_table
-from .core.pipeline import methods
+from .core.pipeline import memory, methods
 from .core.renderer import Cancelled, RenderSettings, render_frame
 from .export import ExportError, export_scene, neighbour_frames
 from .properties import scene_settings_to_core
@@ -144,6 +144,14 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, msg)
         if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
             self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
+        estimate = memory.frame_estimate(core_scene, settings)
+        refusal, caution = memory.memory_problem(estimate, memory.available_memory())
+        if refusal:  # refused before any work, rather than failing part-way or taking all of the machine's memory
+            self.report({"ERROR"}, refusal)
+            self.error_set(refusal)
+            return
+        if caution:
+            self.report({"WARNING"}, caution)
         if core_scene.camera.blind:  # a camera scaled to zero sees nothing: a black frame, no history
             self._write(_black_passes(scene, view_layer, core_scene.camera.window), core_scene.camera.window,
                         scene, view_layer)
@@ -162,6 +170,12 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             result = render_frame(core_scene, settings, progress=progress, should_stop=self.test_break,
                                   history=history)
         except Cancelled:
+            return
+        except MemoryError:
+            message = (f"ReSTIR ran out of memory (this frame was estimated at {memory.gigabytes(estimate.low)} to "
+                       f"{memory.gigabytes(estimate.high)}): lower the resolution or use the Path Tracing integrator")
+            self.report({"ERROR"}, message)
+            self.error_set(message)
             return
         if result.history is not None and not result.cancelled:
             _TEMPORAL_HISTORY[key] = (scene.frame_current, result.history)

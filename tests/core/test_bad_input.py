@@ -247,3 +247,100 @@ def test_extreme_emission_is_clamped_and_negative_lamps_named(addon):
     img = render_passes(cornell)["Combined"][..., :3].astype(np.float64)
     assert np.isfinite(img).all()
     assert img.max() == pytest.approx(MAX_RADIANCE, rel=1e-3)  # the emitter's pixels, not black
+
+
+def test_a_frame_that_cannot_fit_is_refused_before_any_work(addon, monkeypatch):
+    """The engine estimates a frame's peak memory (core/pipeline/memory.py) and refuses, with the estimate and the
+    free memory, where even Auto's cheapest choice cannot fit; where only its dearest cannot, it warns and renders."""
+    from restir_engine.core.pipeline import memory
+    from restir_engine.engine import settings_from_scene, with_data_passes
+
+    def settings():  # what the engine renders with
+        return with_data_passes(settings_from_scene(cornell), bpy.context.view_layer)
+    cornell = cornell_box("EMISSIVE", (64, 48))
+    configure_restir(cornell, 1, 1)  # Auto direct and indirect methods: a range
+    est = memory.frame_estimate(export(), settings())
+    assert est.low < est.high
+    monkeypatch.setattr(memory, "available_memory", lambda: est.low - 1)
+    with pytest.raises(RuntimeError, match=r"needs about .* GB of memory .* is free"):
+        render_passes(cornell)
+    monkeypatch.setattr(memory, "available_memory", lambda: (est.low + est.high) // 2)
+    img = render_passes(cornell)["Combined"]
+    assert np.isfinite(img).all() and img[..., :3].mean() > 0
+    monkeypatch.setattr(memory, "available_memory", lambda: est.low - 1)
+    cornell.restir.integrator = "PATH"  # what the refusal suggests: fits
+    assert memory.frame_estimate(export(), settings()).high < est.low
+    assert np.isfinite(render_passes(cornell)["Combined"]).all()
+
+
+def test_the_memory_estimate_orders_the_methods():
+    from restir_engine.core.pipeline import memory
+    from restir_engine.core.renderer import RenderSettings
+    path = memory.per_pixel_range(RenderSettings(integrator="PATH"))
+    di = memory.per_pixel_range(RenderSettings(integrator="RESTIR", direct_method="RESTIR", indirect_method="PATH"))
+    both = memory.per_pixel_range(RenderSettings(integrator="RESTIR", direct_method="RESTIR",
+                                                 indirect_method="RESTIR_GI"))
+    auto = memory.per_pixel_range(RenderSettings(integrator="RESTIR", direct_method="AUTO", indirect_method="AUTO"))
+    assert path[0] == path[1] < di[0] == di[1] < both[0] == both[1]
+    assert auto[0] < auto[1] == both[1]
+
+
+def _fuzzed_scene(rng):
+    """A Cornell box with a random handful of the bad inputs above combined."""
+    cornell = cornell_box("EMISSIVE", (32, 24))
+    configure_restir(cornell, 1, int(rng.integers(0, 3)), direct_method=str(rng.choice(["AUTO", "RESTIR", "RIS"])),
+                     indirect_method=str(rng.choice(["AUTO", "PATH", "RESTIR_GI"])))
+    picks = rng.choice(9, size=int(rng.integers(1, 5)), replace=False)
+    for pick in picks:
+        if pick == 0:  # an object scaled to zero, animated
+            bpy.ops.mesh.primitive_cube_add(size=0.3, location=(0.2, 0.3, 0.3))
+            bpy.context.active_object.scale = (0, 0, 0) if rng.random() < 0.5 else (1, 0, 1)
+        elif pick == 1:
+            nan = _mesh([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)], "nan")
+            nan.data.vertices[int(rng.integers(0, 3))].co = (float("nan"), float("inf"), 0)
+        elif pick == 2:
+            strength = float(10.0 ** rng.uniform(20, 38))
+            bpy.data.materials["Lamp"].node_tree.nodes["Emission"].inputs["Strength"].default_value = strength
+        elif pick == 3:
+            cornell.camera.scale = tuple(float(v) for v in rng.choice([0.0, 1.0], 3))
+        elif pick == 4:
+            cornell.camera.data.clip_start = 1e-6
+        elif pick == 5:
+            cornell.camera.data.type = "ORTHO"
+            cornell.camera.data.ortho_scale = float(rng.choice([0.0, 2.0]))
+        elif pick == 6:  # a missing texture on the floor's colour
+            image = bpy.data.images.new("Missing", 4, 4)
+            image.source = "FILE"
+            image.filepath = "/nonexistent/texture.png"
+            white = bpy.data.materials["White"]
+            tex = white.node_tree.nodes.new("ShaderNodeTexImage")
+            tex.image = image
+            shader = next(n for n in white.node_tree.nodes if n.type == "BSDF_DIFFUSE")
+            white.node_tree.links.new(tex.outputs["Color"], shader.inputs["Color"])
+        elif pick == 7:
+            bpy.ops.mesh.primitive_cube_add(size=0.4, location=(-0.3, 0.4, 0.3))
+            bpy.context.active_object.data.materials.append(_mix_chain(int(rng.integers(9, 30)), 0.7, True))
+        elif pick == 8:
+            lamp = bpy.data.lights.new("Negative", "POINT")
+            lamp.energy = -float(rng.uniform(1, 100))
+            obj = bpy.data.objects.new("Negative", lamp)
+            obj.location = (0, 0, 1.2)
+            cornell.collection.objects.link(obj)
+    return cornell, sorted(int(p) for p in picks)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_fuzzed_bad_scenes_render_finite_or_fail_in_one_line(addon, seed):
+    """20 random combinations of the bad inputs above, two frames each (the second with history): every pass is
+    finite, or the render fails with one clear line."""
+    cornell, picks = _fuzzed_scene(np.random.default_rng(seed))
+    for frame in (1, 2):
+        cornell.frame_set(frame)
+        try:
+            passes = render_passes(cornell)
+        except RuntimeError as exc:
+            lines = [ln for ln in str(exc).strip().splitlines() if ln.strip()]
+            assert len(lines) == 1 and "Traceback" not in str(exc), (picks, str(exc))
+            continue
+        for name, img in passes.items():
+            assert np.isfinite(img).all(), (picks, name)

@@ -1,0 +1,110 @@
+"""A frame's peak memory, estimated before any work from its resolution, settings and scene, and the memory free
+to hold it.
+
+Bytes per pixel (of the camera window) of a frame's peak, including the history it keeps for the next frame, by
+what runs; upper bounds of what scripts/benchmarks/memory.py measures (tracemalloc peaks of the core, two frames
+with history). Where a setting is Auto, the frame's own choice decides: the estimate is then a range (the cheapest
+and the dearest method Auto may pick). The scene adds its arrays, its textures and Embree's BVH.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+from ..modes import DirectMethod, IndirectMethod, Integrator
+from . import methods
+
+BASE = 400        # camera paths, film, passes: the path tracer or light sampling with path-traced indirect light
+DENOISE_DATA = 72  # the denoising data (albedo and normal accumulators, float64, and their passes)
+DIRECT_REUSE = 720  # DI reservoirs, their target terms and G-buffer, this frame's and the history's
+GI = 800          # GI reservoirs, their target terms and G-buffer, this frame's and the history's
+FIXED = 64 << 20  # bytes that do not grow with the image (tables, pools, the pool's threads)
+BVH_PER_TRIANGLE = 160  # Embree's BVH (outside NumPy)
+
+
+@dataclass(frozen=True)
+class MemoryEstimate:
+    """Peak bytes of a frame: ``low`` where Auto picks the cheapest methods, ``high`` the dearest (equal without
+    Auto); ``pixels`` of the window and ``scene`` bytes (arrays, textures, BVH) included in both."""
+
+    low: int
+    high: int
+    pixels: int
+    scene: int
+
+
+def frame_estimate(scene, settings) -> MemoryEstimate:
+    """The peak memory of rendering ``scene`` (core Scene) with ``settings`` (RenderSettings)."""
+    _x0, _y0, w, h = scene.camera.window
+    pixels = int(w) * int(h)
+    low, high = per_pixel_range(settings)
+    scene_bytes = scene_size(scene)
+    return MemoryEstimate(FIXED + scene_bytes + low * pixels, FIXED + scene_bytes + high * pixels, pixels,
+                          scene_bytes)
+
+
+def per_pixel_range(st) -> tuple[int, int]:
+    """(low, high) bytes per pixel for settings ``st``."""
+    low = high = BASE + (DENOISE_DATA if st.denoise_data else 0)
+    if st.integrator != Integrator.RESTIR:
+        return low, high
+    direct = st.direct_method
+    if direct in (DirectMethod.RESTIR, DirectMethod.RIS) or st.reservoir_passes:
+        low += DIRECT_REUSE
+        high += DIRECT_REUSE
+    elif direct == DirectMethod.AUTO:
+        high += DIRECT_REUSE
+    if methods.gi_possible(st):
+        if st.indirect_method == IndirectMethod.RESTIR_GI or st.gi_reservoir_passes:
+            low += GI
+            high += GI
+        elif methods.gi_auto(st):  # the probe's own cost is part of GI's; choosing path tracing costs nothing more
+            high += GI
+    return low, high
+
+
+def scene_size(scene) -> int:
+    """Bytes of the scene's arrays and textures and of its BVH."""
+    g = scene.geometry
+    arrays = sum(a.nbytes for a in (g.verts, g.normals, g.material, g.uvs, getattr(g, "instance", None),
+                                    getattr(g, "tangents", None)) if a is not None)
+    textures = sum(t.nbytes for t in scene.materials.textures)
+    world = scene.world_image.nbytes if scene.world_image is not None else 0
+    return int(arrays + textures + world + BVH_PER_TRIANGLE * len(g.verts))
+
+
+def available_memory() -> int | None:
+    """Bytes the system can give this process now without swapping (Linux: MemAvailable; elsewhere the physical
+    memory), or None where it cannot be read."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def gigabytes(n: int) -> str:
+    return f"{n / 2 ** 30:.1f} GB"
+
+
+def memory_problem(estimate: MemoryEstimate, free: int | None) -> tuple[str, str]:
+    """(refusal, warning): why the frame cannot be rendered in ``free`` bytes ('' when it can), and a warning where
+    only the dearest choice of Auto would not fit ('' when all fit or nothing is known)."""
+    if free is None:
+        return "", ""
+    if estimate.low > free:
+        return (f"This frame needs about {gigabytes(estimate.low)} of memory ({estimate.pixels} pixels at "
+                f"{(estimate.low - FIXED - estimate.scene) // max(estimate.pixels, 1)} bytes each, scene "
+                f"{gigabytes(estimate.scene)}) but {gigabytes(free)} is free: lower the resolution (Output > Format), "
+                "render a border region, or use the Path Tracing integrator (about "
+                f"{BASE} bytes per pixel)"), ""
+    if estimate.high > free:
+        return "", (f"This frame may need up to {gigabytes(estimate.high)} of memory if Auto picks ReSTIR, and "
+                    f"{gigabytes(free)} is free; set the Direct and Indirect Methods to avoid running out")
+    return "", ""
