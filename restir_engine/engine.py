@@ -145,7 +145,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
             self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
         estimate = memory.frame_estimate(core_scene, settings)
-        refusal, caution = memory.memory_problem(estimate, memory.available_memory())
+        refusal, caution = memory.memory_problem(estimate, memory.available_memory(), settings)
         if refusal:  # refused before any work, rather than failing part-way or taking all of the machine's memory
             self.report({"ERROR"}, refusal)
             self.error_set(refusal)
@@ -172,8 +172,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         except Cancelled:
             return
         except MemoryError:
-            message = (f"ReSTIR ran out of memory (this frame was estimated at {memory.gigabytes(estimate.low)} to "
-                       f"{memory.gigabytes(estimate.high)}): lower the resolution or use the Path Tracing integrator")
+            message = (f"ReSTIR ran out of memory (this frame was estimated at {memory.size_text(estimate.low)} to "
+                       f"{memory.size_text(estimate.high)}): lower the resolution or use the Path Tracing integrator")
             self.report({"ERROR"}, message)
             self.error_set(message)
             return

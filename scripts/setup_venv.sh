@@ -2,6 +2,8 @@
 # Create or reuse a pinned virtualenv (re-installed when its requirements change) and print its folder:
 #   scripts/setup_venv.sh 3.11   -> .venv     from requirements.txt        (bpy 5.0.1, numpy 1.26.4)
 #   scripts/setup_venv.sh 3.13   -> .venv313  from requirements-py313.txt  (bpy 5.2.3 LTS, numpy 2.x)
+#   scripts/setup_venv.sh bpy45  -> .venv-bpy45 from requirements-bpy45.txt (bpy 4.5 LTS on Python 3.11: smoke test)
+#   scripts/setup_venv.sh bpy42  -> .venv-bpy42 from requirements-bpy42.txt (bpy 4.2 LTS on Python 3.11: smoke test)
 # The Python comes from scripts/find_python.sh ($PYTHON overrides it). Default: 3.11.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,7 +11,9 @@ ver=${1:-3.11}
 case "$ver" in
   3.11) venv=.venv; req=requirements.txt ;;
   3.13) venv=.venv313; req=requirements-py313.txt ;;
-  *) echo "setup_venv.sh: unknown Python version '$ver' (3.11 or 3.13)" >&2; exit 2 ;;
+  bpy45) venv=.venv-bpy45; req=requirements-bpy45.txt; ver=3.11 ;;
+  bpy42) venv=.venv-bpy42; req=requirements-bpy42.txt; ver=3.11 ;;
+  *) echo "setup_venv.sh: unknown version '$ver' (3.11, 3.13, bpy45 or bpy42)" >&2; exit 2 ;;
 esac
 stamp=$venv/.requirements.sha256
 want=$(sha256sum "$req" | cut -d' ' -f1)

@@ -3,7 +3,8 @@
 # (Python 3.13, .venv313) when a Python 3.13 exists (PATH or pyenv's versions folder), and Blender 5.0
 # (Python 3.11, .venv). Each venv is pinned and cached. The two suites run at the same time (each is mostly one
 # interpreter's work; together they use the cores); their outputs are printed one after the other. Extra arguments
-# go to pytest (e.g. -m "not slow", -m cycles). Fails if either run fails.
+# go to pytest (e.g. -m "not slow", -m cycles). Then the smoke test on Blender 4.2 LTS and 4.5 LTS
+# (scripts/test_lts.sh; skipped when pytest arguments are given). Fails if any run fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 versions=()
@@ -35,4 +36,7 @@ for i in "${!versions[@]}"; do
   wait "${pids[$i]}" || status=1
   cat "$logs/$i.log"
 done
+if [ "$#" -eq 0 ]; then
+  scripts/test_lts.sh || status=1
+fi
 exit $status

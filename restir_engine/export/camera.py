@@ -66,6 +66,9 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
     try:
         ndc_to_cam = np.linalg.inv(proj)
     except np.linalg.LinAlgError as exc:
+        if ortho and float(cam_obj.data.ortho_scale) <= 0.0:
+            raise ExportError(f"Camera '{cam_obj.name}' has an orthographic scale of 0: set Orthographic Scale "
+                              "above 0") from exc
         raise ExportError(f"Camera '{cam_obj.name}' has a degenerate projection (zero focal length or size?)") from exc
     if not np.isfinite(c2w).all() or not np.isfinite(ndc_to_cam).all():
         raise ExportError(f"Camera '{cam_obj.name}' has a non-finite transform")

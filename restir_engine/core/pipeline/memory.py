@@ -89,22 +89,28 @@ def available_memory() -> int | None:
         return None
 
 
-def gigabytes(n: int) -> str:
-    return f"{n / 2 ** 30:.1f} GB"
+def size_text(n: int) -> str:
+    """Bytes as a user reads them: MB below a gigabyte, else GB with one decimal."""
+    return f"{n / 2 ** 20:.0f} MB" if n < 2 ** 30 else f"{n / 2 ** 30:.1f} GB"
 
 
-def memory_problem(estimate: MemoryEstimate, free: int | None) -> tuple[str, str]:
+def memory_problem(estimate: MemoryEstimate, free: int | None, settings=None) -> tuple[str, str]:
     """(refusal, warning): why the frame cannot be rendered in ``free`` bytes ('' when it can), and a warning where
-    only the dearest choice of Auto would not fit ('' when all fit or nothing is known)."""
+    only the dearest choice of Auto would not fit ('' when all fit or nothing is known). The refusal suggests the
+    path tracer where it needs less than the frame's settings (``settings``: their denoising data counts)."""
     if free is None:
         return "", ""
+    per_pixel = (estimate.low - FIXED - estimate.scene) // max(estimate.pixels, 1)
     if estimate.low > free:
-        return (f"This frame needs about {gigabytes(estimate.low)} of memory ({estimate.pixels} pixels at "
-                f"{(estimate.low - FIXED - estimate.scene) // max(estimate.pixels, 1)} bytes each, scene "
-                f"{gigabytes(estimate.scene)}) but {gigabytes(free)} is free: lower the resolution (Output > Format), "
-                "render a border region, or use the Path Tracing integrator (about "
-                f"{BASE} bytes per pixel)"), ""
+        path_tracer = BASE + (DENOISE_DATA if settings is not None and settings.denoise_data else 0)
+        cheaper = per_pixel > path_tracer
+        advice = "lower the resolution (Output > Format) or render a border region"
+        if cheaper:
+            advice += f", or use the Path Tracing integrator (about {BASE} bytes per pixel)"
+        return (f"This frame needs about {size_text(estimate.low)} of memory ({estimate.pixels} pixels at "
+                f"{per_pixel} bytes each, scene {size_text(estimate.scene)}) but {size_text(free)} is free: "
+                f"{advice}"), ""
     if estimate.high > free:
-        return "", (f"This frame may need up to {gigabytes(estimate.high)} of memory if Auto picks ReSTIR, and "
-                    f"{gigabytes(free)} is free; set the Direct and Indirect Methods to avoid running out")
+        return "", (f"This frame may need up to {size_text(estimate.high)} of memory if Auto picks ReSTIR, and "
+                    f"{size_text(free)} is free; set the Direct and Indirect Methods to avoid running out")
     return "", ""
