@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from concurrent.futures import FIRST_COMPLETED, wait
 
-from .pool import pool, thread_count
+from .pool import pool
 
 STOP_POLL_SECONDS = 0.02  # how often a running stage asks should_stop (the viewport's latency to a new view)
 
@@ -51,13 +51,18 @@ def map_tasks(fn, items, stop: Progress) -> list:
     return out
 
 
+BALANCE = 8  # a frame of several chunks has a multiple of this many (whole rounds on 1, 2, 4 or 8 threads)
+
+
 def chunk_size(n: int, target: int) -> int:
-    """Items per chunk near ``target`` such that the chunk count is a multiple of the pool's threads (7 chunks
-    on 2 threads leave one core idle for the last one)."""
+    """Items per chunk near ``target``. A frame of more than one chunk has a multiple of BALANCE chunks, so the pool's
+    threads finish together (7 chunks on 2 threads leave one core idle for the last one). The split depends on n
+    and target alone, never on the thread count: each chunk draws from its own random stream, so the same seed
+    gives the same image on any number of cores."""
     target = max(64, int(target))
-    threads = thread_count()
     count = max(1, -(-n // target))
-    count = -(-count // threads) * threads
+    if count > 1:
+        count = -(-count // BALANCE) * BALANCE
     return max(64, -(-n // count))
 
 
