@@ -73,6 +73,13 @@ def _black_passes(scene, view_layer, window) -> dict:
     return images
 
 
+def apply_threads(render) -> None:
+    """Blender's Render Properties > Performance > Threads (``render.threads_mode``, ``render.threads``): Auto uses
+    every logical core, Fixed that many threads."""
+    from .core.parallel.pool import set_thread_count
+    set_thread_count(int(render.threads) if render.threads_mode == "FIXED" else None)
+
+
 def _viewport_pass(context) -> str:
     """The pass the 3D view shows (View3DShading.restir.render_pass)."""
     shading = getattr(getattr(context, "space_data", None), "shading", None)
@@ -121,6 +128,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         t0 = time.perf_counter()
+        apply_threads(scene.render)
         settings = with_data_passes(settings_from_scene(scene), view_layer)
         # AUTO may resolve to ReSTIR (known once the scene is exported): keep and preroll its history too
         wants_temporal = methods.keeps_history(settings)
@@ -228,6 +236,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         from .export.incremental import SceneExporter, update_level
         from .viewport import ViewportSession
         scene = depsgraph.scene
+        apply_threads(scene.render)
         if self._viewport is None:
             self._viewport = ViewportSession(self.tag_redraw)
             self._exporter = SceneExporter()

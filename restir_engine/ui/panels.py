@@ -238,6 +238,19 @@ class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):
         layout.prop(context.scene.render, "film_transparent")
 
 
+class RESTIR_PT_performance(RestirPanel, bpy.types.Panel):
+    bl_label = "Performance"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.split_layout()
+        render = context.scene.render
+        layout.prop(render, "threads_mode")
+        row = layout.row()
+        row.enabled = render.threads_mode == "FIXED"
+        row.prop(render, "threads")
+
+
 class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
     bl_label = "Passes"
     bl_context = "view_layer"
@@ -288,7 +301,7 @@ class RESTIR_PT_viewport_render_pass(bpy.types.Panel):
 
 
 PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_direct, RESTIR_PT_sampling_reuse, RESTIR_PT_sampling_indirect,
-          RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths,
+          RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths, RESTIR_PT_performance,
           RESTIR_PT_passes)  # Render Properties
 VIEW_PANELS = (RESTIR_PT_viewport_render_pass,)  # the 3D view's header popovers
 

@@ -29,6 +29,7 @@ def test_one_and_several_threads_give_the_same_image(settings, monkeypatch):
         images.append(_render(settings))
         assert pool_mod.pool()._max_workers == threads
         pool_mod.pool().shutdown()
+        monkeypatch.setattr(pool_mod, "_POOL", None)
     monkeypatch.setattr(pool_mod, "_POOL", None)
     for other in images[1:]:
         for name in ("Combined", "Direct", "Indirect"):

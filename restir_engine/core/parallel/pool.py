@@ -9,10 +9,23 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 _POOL: ThreadPoolExecutor | None = None
+_THREADS: int | None = None  # set_thread_count's; None = every logical core
 
 
 def thread_count() -> int:
-    return max(1, os.cpu_count() or 1)
+    """Threads of the pool: the count set by :func:`set_thread_count`, else every logical core."""
+    return max(1, _THREADS if _THREADS else (os.cpu_count() or 1))
+
+
+def set_thread_count(threads: int | None) -> None:
+    """Use ``threads`` threads from the next stage on (None or 0: every logical core, as Blender's Auto). The
+    pool is replaced when its size changes; images do not depend on it (parallel/tasks.chunk_size). The old pool
+    is left to finish what it was given, not shut down: a viewport worker may still be handing it a stage's
+    tasks (its idle threads end with the interpreter)."""
+    global _THREADS, _POOL
+    _THREADS = int(threads) if threads else None
+    if _POOL is not None and _POOL._max_workers != thread_count():
+        _POOL = None
 
 
 def in_worker() -> bool:
