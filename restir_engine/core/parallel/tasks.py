@@ -51,18 +51,17 @@ def map_tasks(fn, items, stop: Progress) -> list:
     return out
 
 
-BALANCE = 8  # a frame of several chunks has a multiple of this many (whole rounds on 1, 2, 4 or 8 threads)
+BALANCE = 2  # a frame has a multiple of this many chunks (two threads finish together)
 
 
 def chunk_size(n: int, target: int) -> int:
-    """Items per chunk near ``target``. A frame of more than one chunk has a multiple of BALANCE chunks, so the pool's
-    threads finish together (7 chunks on 2 threads leave one core idle for the last one). The split depends on n
-    and target alone, never on the thread count: each chunk draws from its own random stream, so the same seed
-    gives the same image on any number of cores."""
+    """Items per chunk near ``target``, in a multiple of BALANCE chunks, so that the pool's threads finish together
+    (7 chunks on 2 threads leave one core idle for the last one). The split depends on n and target alone, never
+    on the thread count: each chunk draws from its own random stream, so the same seed gives the same image on any
+    number of cores."""
     target = max(64, int(target))
     count = max(1, -(-n // target))
-    if count > 1:
-        count = -(-count // BALANCE) * BALANCE
+    count = -(-count // BALANCE) * BALANCE
     return max(64, -(-n // count))
 
 
