@@ -73,27 +73,35 @@ def test_floor_under_the_world_matches_the_irradiance(kind):
 
 def test_importance_sampling_beats_bsdf_sampling_on_a_sun():
     """With the sun-like spot, the environment's light sample makes the floor's per-pixel variance at least 10x
-    lower than BSDF sampling alone would (measured by turning the world's sampling off)."""
-    scene = plane_under_world(albedo=0.5, world=1.0, width=16)
-    scene.world_image = sun_sky()
-    on = render_frame(scene, RenderSettings(integrator="PATH", max_bounces=0, samples=1, seed=1))
-    img_on = on.passes["Combined"][..., 0]
-    from restir_engine.core.lights.world import World
-    orig = World.__init__
+    lower than BSDF sampling alone would (measured by turning the world's sampling off; 54-78x over 8 seeds). Both
+    estimate the same light: their means over the 256 pixels of 256 samples agree within Z_MAX standard errors
+    (about 5 % of the mean each, BSDF sampling hitting the sun a few hundred times; the exact irradiance is checked
+    against an independent reference above)."""
+    from restir_engine.core.integrators import context_cache
+    from stats import MARGIN, Z_MAX
 
-    def unsampled(self, *a, **k):
-        orig(self, *a, **k)
-        self.sampled = False
-    World.__init__ = unsampled
-    try:
-        from restir_engine.core.integrators import context_cache
-        context_cache.clear()
-        off = render_frame(scene, RenderSettings(integrator="PATH", max_bounces=0, samples=1, seed=1))
-    finally:
-        World.__init__ = orig
-        context_cache.clear()
-    img_off = off.passes["Combined"][..., 0]
-    assert abs(img_off.mean() / img_on.mean() - 1) < 0.5  # the same light, both noisy estimates of it
+    def render(sampled: bool) -> np.ndarray:
+        scene = plane_under_world(albedo=0.5, world=1.0, width=16)
+        scene.world_image = sun_sky()
+        orig = World.__init__
+
+        def unsampled(self, *a, **k):
+            orig(self, *a, **k)
+            self.sampled = False
+        if not sampled:
+            World.__init__ = unsampled
+        try:
+            context_cache.clear()
+            out = render_frame(scene, RenderSettings(integrator="PATH", max_bounces=0, samples=256, seed=1))
+        finally:
+            World.__init__ = orig
+            context_cache.clear()
+        return out.passes["Combined"][..., 0].astype(np.float64)
+
+    img_on, img_off = render(True), render(False)
+    se = np.sqrt(img_on.var(ddof=1) / img_on.size + img_off.var(ddof=1) / img_off.size)
+    assert abs(img_off.mean() - img_on.mean()) <= Z_MAX * se + MARGIN * img_on.mean(), \
+        (img_off.mean(), img_on.mean(), se)
     assert img_off.var() > 10 * img_on.var(), (img_off.var(), img_on.var())
 
 
