@@ -71,30 +71,6 @@ def main() -> int:
     return 1 if failed else 0
 
 
-INSTALL = """
-import os, sys
-import bpy
-zip_path, out = sys.argv[-2], sys.argv[-1]
-bpy.ops.wm.read_factory_settings(use_empty=True)
-bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
-mod = next(m for name, m in sys.modules.items() if name.endswith(".restir_engine"))
-scene = bpy.context.scene
-bpy.ops.mesh.primitive_plane_add(size=4)
-bpy.ops.object.light_add(type="POINT", location=(0, 0, 2))
-bpy.context.active_object.data.energy = 200
-bpy.ops.object.camera_add(location=(0, -4, 3), rotation=(0.9, 0, 0))
-scene.camera = bpy.context.active_object
-scene.render.engine = "RESTIR"
-scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 32, 24, 100
-scene.restir.samples = 2
-scene.render.filepath = out
-scene.render.image_settings.file_format = "PNG"
-bpy.ops.render.render(write_still=True)
-print("MODULE", mod.__file__, flush=True)
-os._exit(0 if os.path.exists(out) else 1)
-"""
-
-
 def check_extension(tmp: str) -> None:
     """The zip scripts/build_extension.sh builds installs into a throw-away user folder and renders from there."""
     zips = glob.glob(os.path.join(ROOT, "dist", "restir_engine-*-linux_x64.zip"))
@@ -105,21 +81,14 @@ def check_extension(tmp: str) -> None:
         if not zips:
             check("extension builds", False, b.stderr[-500:])
             return
-    script = os.path.join(tmp, "install.py")
-    with open(script, "w") as f:
-        f.write(INSTALL)
-    out = os.path.join(tmp, "installed.png")
-    env = dict(os.environ, BLENDER_USER_RESOURCES=os.path.join(tmp, "user"), PYTHONPATH="")
+    from extension_install import install_and_render
     try:
-        p = subprocess.run([sys.executable, script, zips[0], out], capture_output=True, text=True, env=env, cwd=tmp,
-                           timeout=600)
+        result = install_and_render(sys.executable, zips[0], tmp)
     except subprocess.TimeoutExpired:
         check("extension installs and renders", False, "timed out")
         return
-    module = next((ln.split(" ", 1)[1] for ln in p.stdout.splitlines() if ln.startswith("MODULE")), "")
-    check("extension installs and renders", p.returncode == 0 and os.path.exists(out) and ROOT not in module,
-          (p.stdout + p.stderr)[-800:])
-
+    check("extension installs and renders", result.returncode == 0 and result.rendered and
+          result.module.startswith(os.path.join(tmp, "user")), result.output[-800:])
 
 if __name__ == "__main__":
     try:

@@ -7,36 +7,12 @@ import glob
 import os
 import subprocess
 import sys
-import textwrap
 
 import bpy
 import pytest
+from extension_install import install_and_render
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-INSTALL_AND_RENDER = textwrap.dedent("""
-    import os, sys
-    import bpy
-    zip_path, out = sys.argv[-2], sys.argv[-1]
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
-    mod = next(m for name, m in sys.modules.items() if name.endswith(".restir_engine"))
-    print("MODULE", mod.__file__)
-    scene = bpy.context.scene
-    bpy.ops.mesh.primitive_plane_add(size=4)
-    bpy.ops.object.light_add(type="POINT", location=(0, 0, 2))
-    bpy.context.active_object.data.energy = 200
-    bpy.ops.object.camera_add(location=(0, -4, 3), rotation=(0.9, 0, 0))
-    scene.camera = bpy.context.active_object
-    scene.render.engine = "RESTIR"
-    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 32, 24, 100
-    scene.restir.samples = 2
-    scene.render.filepath = out
-    scene.render.image_settings.file_format = "PNG"
-    bpy.ops.render.render(write_still=True)
-    print("RENDERED", os.path.exists(out))
-""")
-
 
 def test_built_extension_validates_installs_and_renders(tmp_path):
     r = subprocess.run(["bash", os.path.join(ROOT, "scripts", "build_extension.sh")], capture_output=True, text=True,
@@ -50,13 +26,7 @@ def test_built_extension_validates_installs_and_renders(tmp_path):
     ext = glob.glob(os.path.join(scripts, "addons_core", "bl_pkg", "cli", "blender_ext.py"))
     v = subprocess.run([sys.executable, ext[0], "validate", zips[0]], capture_output=True, text=True, check=False)
     assert v.returncode == 0, v.stdout + v.stderr
-    script = tmp_path / "install.py"
-    script.write_text(INSTALL_AND_RENDER)
-    env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"), PYTHONPATH="")
-    out = tmp_path / "frame.png"
-    p = subprocess.run([sys.executable, str(script), zips[0], str(out)], capture_output=True, text=True, env=env,
-                       cwd=str(tmp_path), check=False, timeout=600)
-    assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
-    module = next(line.split(" ", 1)[1] for line in p.stdout.splitlines() if line.startswith("MODULE"))
-    assert module.startswith(str(tmp_path / "user")), module  # the installed copy, not the checkout
-    assert "RENDERED True" in p.stdout and out.exists()
+    result = install_and_render(sys.executable, zips[0], str(tmp_path))
+    assert result.returncode == 0, result.output[-6000:]
+    assert result.module.startswith(str(tmp_path / "user")), result.module  # the installed copy, not the checkout
+    assert result.rendered
