@@ -8,73 +8,18 @@ naming the material and the reason.
 """
 from __future__ import annotations
 
-import os
-import stat
-
 import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
 from ..core.materials.textures import NearestImage
+from .images import TEXTURES, srgb_bytes_to_linear, unreadable_file
 from .limits import clamped_radiance
 
 # Mix/Add shader levels followed; deeper nests (Blender allows any) are cut off with a warning
 MAX_MIX_DEPTH = 256
 
 MAGENTA = (1.0, 0.0, 1.0)
-
-
-def srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
-
-
-_SRGB_BYTE_TABLE = srgb_to_linear(np.arange(256, dtype=np.float64) / 255.0)
-
-
-def srgb_bytes_to_linear(c: np.ndarray) -> np.ndarray:
-    """srgb_to_linear of an 8-bit image's pixels (Blender hands them over as k/255): one table lookup each."""
-    return _SRGB_BYTE_TABLE[np.rint(np.clip(c, 0.0, 1.0) * 255.0).astype(np.uint8)]
-
-
-class TextureCache:
-    """Textures read from image files, kept across exports (frames of an animation, viewport edits) while the file
-    is unchanged: keyed by its path, modification time and size and by how the pixels are used. Packed, generated
-    and edited (unsaved) images are read afresh each time. Holds at most ``max_bytes``, least recently used out."""
-
-    def __init__(self, max_bytes: int = 2 << 30):
-        self.max_bytes = max_bytes
-        self.items: dict = {}
-
-    @staticmethod
-    def key(image, use: tuple):
-        if image.source != "FILE" or image.packed_file is not None or image.is_dirty:
-            return None
-        import bpy
-        path = bpy.path.abspath(image.filepath, library=image.library)
-        try:
-            st = os.stat(path)
-        except OSError:
-            return None
-        return (path, st.st_mtime_ns, st.st_size, image.colorspace_settings.name, image.alpha_mode, use[1:])
-
-    def get(self, key):
-        if key is None or key not in self.items:
-            return None
-        self.items[key] = self.items.pop(key)  # most recently used last
-        return self.items[key]
-
-    def put(self, key, data: np.ndarray) -> None:
-        if key is None or data.nbytes > self.max_bytes:
-            return
-        self.items[key] = data
-        while sum(a.nbytes for a in self.items.values()) > self.max_bytes:
-            del self.items[next(iter(self.items))]
-
-
-_TEXTURES = TextureCache()
-
-
-
 
 
 class MaterialRegistry:
@@ -434,18 +379,18 @@ class MaterialRegistry:
         key = (image.name_full, "alpha" if alpha else "luminance" if luminance else "rgb", closest)
         if key in self.texture_index:
             return self.texture_index[key]
-        kept = _TEXTURES.key(image, key)
-        data = _TEXTURES.get(kept)
+        kept = TEXTURES.key(image, key)
+        data = TEXTURES.get(kept)
         if data is None:
             data = self._read_texture(material, image, alpha, luminance)
-            _TEXTURES.put(kept, data)
+            TEXTURES.put(kept, data)
         self.texture_index[key] = len(self.textures)
         self.textures.append(data.view(NearestImage) if closest else data)
         return self.texture_index[key]
 
     def _read_texture(self, material, image, alpha: bool, luminance: bool) -> np.ndarray:
         """The image's pixels as (h, w, 3) float32, scene-linear (magenta where it cannot be read)."""
-        unreadable = _unreadable_file(image)
+        unreadable = unreadable_file(image)
         if unreadable:  # asking Blender for its size would open it (a FIFO blocks the export for ever)
             self._warn(material, f"image '{image.name}': {unreadable}; rendered magenta")
             w = h = 0
@@ -481,24 +426,6 @@ class MaterialRegistry:
                 rgb = np.repeat((rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32))[..., None], 3, axis=2)
             data = np.ascontiguousarray(rgb, dtype=np.float32)
         return data
-
-
-def _unreadable_file(image) -> str:
-    """Why the file an image would be loaded from is not one to open ('' when it is, or when the image is packed,
-    generated or a sequence/UDIM set whose files Blender resolves itself)."""
-    if image.source != "FILE" or image.packed_file is not None:
-        return ""
-    import bpy
-    path = bpy.path.abspath(image.filepath, library=image.library)
-    try:
-        mode = os.stat(path).st_mode
-    except OSError:
-        return ""  # missing: Blender's own load fails and says so (the magenta warning below)
-    if stat.S_ISDIR(mode):
-        return f"'{path}' is a folder"
-    if not stat.S_ISREG(mode):
-        return f"'{path}' is not a regular file (a pipe or device)"
-    return ""
 
 
 def _has_bsdf(row: dict) -> bool:
