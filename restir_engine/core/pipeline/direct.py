@@ -12,18 +12,21 @@ from ..restir import di
 from ..restir.target import ShadingTerms
 from ..sampling import STREAM_INITIAL, STREAM_TILES
 from .plan import PassPlan
-from .work import Chunk
+from .work import Chunk, own
 
 
-def with_light_tiles(ctx, plan: PassPlan, chunks: list[Chunk], sampler: str) -> di.CandidateSettings:
+def with_light_tiles(ctx, plan: PassPlan, chunks: list[Chunk], sampler: str, team) -> di.CandidateSettings:
     """The plan's candidates with this pass's light tiles: per 16x16 block by the blocks' surface positions
-    (``sampler`` "SPATIAL", lights/blocks.py) or by power alone ("POWER", lights/tiles.py)."""
+    (``sampler`` "SPATIAL", lights/blocks.py; the team's processes write their chunks' positions) or by power
+    alone ("POWER", lights/tiles.py)."""
     _x0, _y0, w, h = ctx.scene.camera.window
     r_tiles = plan.rng(STREAM_TILES)
     if sampler == "SPATIAL":
-        pos = np.full((3, w * h), np.nan, np.float32)
-        for c in chunks:
+        pos = team.empty((3, w * h), np.float32)
+        for c in own(chunks, team):
+            pos[:, c.pixels[:len(c.pixels) // c.batch]] = np.nan  # a chunk's pixels: its span (batch 1 here)
             pos[:, c.pixels[c.hits.rows]] = c.hits.surf.p
+        team.barrier()
         tiles = BlockLightTiles(ctx.lights, pos.reshape(3, h, w), w, h, r_tiles)
     else:
         tiles = LightTiles(ctx.lights, plan.candidates.tile_settings, w, h, r_tiles)

@@ -44,17 +44,25 @@ class BufferPool:
 BUFFERS = BufferPool()
 
 
-class Film:
-    """The accumulators of one camera window (w x h) and the sample count they hold."""
+def film_keys(gi: bool, denoise_data: bool) -> list[tuple[str, int]]:
+    """(accumulator key, channels) of a film, in allocation order (1: an (h, w) array)."""
+    keys = [("emit", 3), ("direct", 3), ("indirect", 3), ("alpha", 1), ("res_m", 1), ("res_w", 1)]
+    if gi:
+        keys += [("gi_m", 1), ("gi_w", 1)]
+    if denoise_data:
+        keys += [("albedo", 3), ("dnormal", 3)]
+    return keys
 
-    def __init__(self, w: int, h: int, gi: bool, denoise_data: bool):
-        z = BUFFERS.zeros
-        self.acc = {"emit": z((h, w, 3)), "direct": z((h, w, 3)), "indirect": z((h, w, 3)), "alpha": z((h, w)),
-                    "res_m": z((h, w)), "res_w": z((h, w))}
-        if gi:
-            self.acc["gi_m"], self.acc["gi_w"] = z((h, w)), z((h, w))
-        if denoise_data:
-            self.acc["albedo"], self.acc["dnormal"] = z((h, w, 3)), z((h, w, 3))
+
+class Film:
+    """The accumulators of one camera window (w x h) and the sample count they hold. ``zeros(shape)`` gives the
+    accumulators (default: the buffer pool's; a team's film passes views of one zero-filled shared segment, and
+    then nothing returns to the pool)."""
+
+    def __init__(self, w: int, h: int, gi: bool, denoise_data: bool, zeros=None):
+        self.pooled = zeros is None
+        z = zeros or BUFFERS.zeros
+        self.acc = {key: z((h, w, c) if c > 1 else (h, w)) for key, c in film_keys(gi, denoise_data)}
         self.samples = 0
 
     def has(self, key: str) -> bool:
@@ -62,8 +70,9 @@ class Film:
 
     def release(self) -> None:
         """Hand the accumulators back to the pool (this film cannot accumulate any more)."""
-        for a in self.acc.values():
-            BUFFERS.put(a)
+        if self.pooled:
+            for a in self.acc.values():
+                BUFFERS.put(a)
         self.acc = {}
 
     def accumulate(self, chunks, resampled: bool, world_to_cam: np.ndarray, stop) -> None:

@@ -25,6 +25,7 @@ from ..integrators.method_choice import GI_MIN_SHARE
 from ..modes import DirectMethod, Integrator
 from ..parallel.pool import quiet_float_errors
 from ..parallel.tasks import Progress, Stopped, spans
+from ..parallel.team import Solo
 from ..profile import NullClock
 from ..restir import di, gi
 from ..restir.history import TemporalHistory
@@ -39,7 +40,7 @@ from .indirect_choice import IndirectChoice, ratios
 from .plan import PassPlan
 from .runner import PassRunner
 from .settings import RenderSettings, validate
-from .work import frame_reservoirs, hand_back, make_chunks, place
+from .work import frame_reservoirs, hand_back, make_chunks, own, place
 
 MAX_BATCH = 8  # samples one pass renders at most (FrameRenderer.batch_size)
 
@@ -68,11 +69,15 @@ class FrameRenderer:
     with :meth:`move_camera` (geometry and lights stay built).
     """
 
-    def __init__(self, scene: Scene, settings: RenderSettings, history=None, clock=None):
+    def __init__(self, scene: Scene, settings: RenderSettings, history=None, clock=None, team=None,
+                 film_zeros=None):
         validate(settings)
         t0 = time.perf_counter()
         self.settings = settings
         self.clock = clock or NullClock()
+        # the processes rendering this frame's passes together (parallel/team.py; Solo: this one alone), and the
+        # film's accumulators where they are shared (Film's ``zeros``)
+        self.team, self.film_zeros = team or Solo(), film_zeros
         bounces = methods.bounces(settings)
         self.ctx, self.context_reused = context_for(scene, bounces, settings.film_transparent,
                                                     trace_context.build_context)
@@ -170,7 +175,7 @@ class FrameRenderer:
                                          coverage_mod.lamp_mask(self.ctx, camera))
         _x0, _y0, w, h = camera.window
         self.release()
-        self.film = Film(w, h, self.gi is not None, self.settings.denoise_data)
+        self.film = Film(w, h, self.gi is not None, self.settings.denoise_data, self.film_zeros)
         self._surfaces_per_chunk = None  # surfaces per chunk and sample in the last pass (batch_size)
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
         self.gi_skipped = 0  # samples whose pass kept path-traced indirect light (GI_MIN_SHARE)
@@ -230,6 +235,8 @@ class FrameRenderer:
             with quiet_float_errors():
                 done = self._sample_pass(progress, should_stop, batch, light_candidate_cap)
         except Stopped:
+            if self.team.size > 1:
+                self.team.abort()  # the other processes of the team stop at their next barrier
             return False
         self.film.samples += done
         return True
@@ -297,30 +304,33 @@ class FrameRenderer:
 
     def _sample_pass(self, progress, should_stop, batch: int, cap) -> int:
         """One pass of ``plan.batch`` samples through the stages. Returns the samples rendered."""
-        st, ctx, clock = self.settings, self.ctx, self.clock
+        st, ctx, clock, team = self.settings, self.ctx, self.clock, self.team
         plan = self._plan(batch, cap)
+        team.begin_pass(first=plan.sample == 0)
         _x0, _y0, w, h = ctx.scene.camera.window
         chunks = make_chunks(spans(w * h, st.tile_pixels), plan.batch)
+        mine = own(chunks, team)  # the chunks this process computes (all of them when it renders alone)
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
         chunk_stages = 4 + int(plan.resampled) + (int(self.spatial.passes) + 1 if plan.reusing else 0) + \
             (int(self.gi.passes) + 1 if plan.gi else 0)
-        run = PassRunner(plan, Progress(progress, should_stop, len(chunks) * chunk_stages), clock, st.tile_pixels)
+        run = PassRunner(plan, Progress(progress, should_stop, len(mine) * chunk_stages), clock, st.tile_pixels,
+                         team)
 
         with run.stage("primary"):
             run.map(lambda c: primary.primary(ctx, plan, self.masks, c), chunks)
-            n_surf = place(chunks)
+            n_surf = place(chunks, team)
             self._surfaces_per_chunk = n_surf / (len(chunks) * plan.batch)
         candidates = plan.candidates
         if plan.resampled:
             self.reuse_stats["light_candidates"] = candidates.light_candidates
         if plan.light_tiles:
             with run.stage("initial"):
-                candidates = direct.with_light_tiles(ctx, plan, chunks, st.light_sampler)
+                candidates = direct.with_light_tiles(ctx, plan, chunks, st.light_sampler, team)
             self.used_tiles = True
         # the frame's target terms, one (WIDTH, surfaces) block the chunks write into (reuse gathers from it)
-        terms = np.empty((WIDTH, n_surf), np.float32) if plan.resampled else None
+        terms = team.empty((WIDTH, n_surf), np.float32) if plan.resampled else None
         # ReSTIR GI's target terms: the same, with the specular lobe off at glossy primary surfaces
-        gi_terms = np.empty((WIDTH, n_surf), np.float32) if plan.gi or plan.probe else None
+        gi_terms = team.empty((WIDTH, n_surf), np.float32) if plan.gi or plan.probe else None
         if plan.resampled:
             with run.stage("initial"):
                 run.map(lambda c: direct.initial(ctx, plan, candidates, terms, c), chunks)
@@ -332,29 +342,31 @@ class FrameRenderer:
         gb = res = gi_res = gb_gi = gi_history = None
         if plan.reusing or gi_reused:
             with run.stage("gbuffer"):
-                gb = primary.gbuffer(ctx, chunks, terms if plan.reusing else gi_terms)
+                gb = primary.gbuffer(ctx, chunks, terms if plan.reusing else gi_terms, team)
         if plan.reusing:
             with run.stage("gbuffer"):
-                res = frame_reservoirs(chunks, "res", di.DIReservoirs, len(gb))
+                res = frame_reservoirs(chunks, "res", di.DIReservoirs, len(gb), team)
             res, dropped = reuse.reuse_di(run, st, ctx, self.space, self.spatial, gb, res, self.prev_history,
                                           self.reuse_stats)
             self.boiling_dropped += dropped
-            hand_back(chunks, "res", res)
+            hand_back(mine, "res", res)
         if gi_reused:
             with run.stage("gbuffer"):
                 gb_gi = gb.with_terms(ShadingTerms(gi_terms))
-                gi_res = frame_reservoirs(chunks, "gi_res", gi.GIReservoirs, len(gb))
+                gi_res = frame_reservoirs(chunks, "gi_res", gi.GIReservoirs, len(gb), team)
             gi_res, gi_history = reuse.reuse_gi(run, st, ctx, self.gi, self.gi_space, self.gi_spatial, gb_gi, gi_res,
                                                 self.prev_history, self.reuse_stats)
-            hand_back(chunks, "gi_res", gi_res)
+            hand_back(mine, "gi_res", gi_res)
         if plan.sample == 0 and gb is not None:
             self._keep_history(gb, res, gb_gi, gi_history, gi_reused)
         unbiased = st.bias_correction == "UNBIASED"
         with run.stage("shade"):
             run.map(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c), chunks)
+        team.barrier()  # every process shaded its chunks: from here on the pass is not stopped (the film takes
+        run.stop.should_stop = None  # all of it or, stopped before, none)
         with run.stage("passes"):
             world_to_cam = np.ascontiguousarray(ctx.scene.camera.cam_to_world[:3, :3].T, dtype=np.float32)
-            self.film.accumulate(chunks, plan.resampled, world_to_cam, run.stop)
+            self.film.accumulate(mine, plan.resampled, world_to_cam, run.stop)
         return plan.batch
 
     def _gi_outcome(self, plan: PassPlan, chunks) -> bool:
@@ -364,7 +376,8 @@ class FrameRenderer:
         gi_on = plan.gi
         if not (plan.gi or plan.probe):
             return gi_on
-        sums = np.sum([c.gi_share for c in chunks], axis=0)
+        team = self.team
+        sums = team.table({c.index: c.gi_share for c in own(chunks, team)}, len(chunks), 4).sum(axis=0)
         share, uncached = ratios(sums)
         self.reuse_stats["gi_share"], self.reuse_stats["gi_uncached"] = share, uncached
         if self.gi_auto:
@@ -372,7 +385,7 @@ class FrameRenderer:
         elif share < GI_MIN_SHARE:
             gi_on = False
         if not gi_on:
-            paths.keep_path_traced(chunks)
+            paths.keep_path_traced(own(chunks, team))
         for c in chunks:
             c.path_indirect = None
         return gi_on

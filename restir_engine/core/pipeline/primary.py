@@ -16,7 +16,7 @@ from ..restir.gbuffer import GBuffer
 from ..restir.target import ShadingTerms
 from ..sampling import STREAM_CAMERA, STREAM_CHAIN, STREAM_PIXEL_OFFSET, pass_jitter
 from .plan import PassPlan
-from .work import Chunk
+from .work import Chunk, own
 
 
 class CameraMasks:
@@ -68,17 +68,23 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
 
 
-def gbuffer(ctx, chunks: list[Chunk], terms: np.ndarray) -> GBuffer:
+def gbuffer(ctx, chunks: list[Chunk], terms: np.ndarray, team) -> GBuffer:
     """The frame's G-buffer from the chunks' primary hits (surfaces in chunk order) over the target terms
-    ``terms`` (WIDTH, surfaces), whose rows 0-2 are the surfaces' positions."""
+    ``terms`` (WIDTH, surfaces), whose rows 0-2 are the surfaces' positions: each process writes the rows of the
+    chunks it owns into the team's buffers (complete after its barrier)."""
     cam = ctx.scene.camera
     _x0, _y0, w, h = cam.window
-    surfs = [c.hits.surf for c in chunks]
-    rel = terms[0:3] - camera_mod.position(cam)[:, None]
-    fwd = camera_mod.forward(cam)
-    depth = fwd[0] * rel[0] + fwd[1] * rel[1] + fwd[2] * rel[2]  # planar depth along the camera axis
-    inst = ctx.scene.geometry.instance
-    prim = np.concatenate([sf.prim for sf in surfs])
-    return GBuffer(np.concatenate([c.pixels[c.hits.rows] for c in chunks]), w, h, depth.astype(np.float32),
-                   inst[prim] if inst is not None else np.zeros(len(prim), np.int32),
-                   np.concatenate([sf.mat for sf in surfs]), ShadingTerms(terms))
+    n = terms.shape[1]
+    pix, depth = team.empty(n, np.int64), team.empty(n, np.float32)
+    inst, mat = team.empty(n, np.int32), team.empty(n, np.int32)
+    origin, fwd = camera_mod.position(cam)[:, None], camera_mod.forward(cam)
+    instance = ctx.scene.geometry.instance
+    for c in own(chunks, team):
+        sl, surf = c.surfaces, c.hits.surf
+        rel = terms[0:3, sl] - origin
+        depth[sl] = fwd[0] * rel[0] + fwd[1] * rel[1] + fwd[2] * rel[2]  # planar depth along the camera axis
+        pix[sl] = c.pixels[c.hits.rows]
+        inst[sl] = instance[surf.prim] if instance is not None else 0
+        mat[sl] = surf.mat
+    team.barrier()
+    return GBuffer(pix, w, h, depth, inst, mat, ShadingTerms(terms))

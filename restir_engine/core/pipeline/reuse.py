@@ -31,7 +31,7 @@ def temporal(run: PassRunner, space, gb, res, hist, motion, cap, stream, possibl
         del prepared, now  # released with the jobs once merged
         parts = run.map(run_job(reuse.temporal_reuse), jobs)
         del jobs
-        return space.kind.gather(parts, len(gb))
+        return run.gather(space.kind, parts, len(gb))
 
 
 def spatial(run: PassRunner, space, gb, res, cfg, stream, stage):
@@ -43,7 +43,7 @@ def spatial(run: PassRunner, space, gb, res, cfg, stream, stage):
         del prepared  # released with the jobs once merged
         parts = run.map(run_job(reuse.spatial_reuse), jobs)
         del jobs
-        return space.kind.gather(parts, len(gb))
+        return run.gather(space.kind, parts, len(gb))
 
 
 def reuse_di(run: PassRunner, st, ctx, space, spatial_cfg, gb, res, hist, stats: dict):
@@ -57,15 +57,17 @@ def reuse_di(run: PassRunner, st, ctx, space, spatial_cfg, gb, res, hist, stats:
         possible = None if had is None else (lambda rows, res=res: had[np.maximum(res.light[rows], 0)])
         res = temporal(run, space, gb, res, hist, motion, st.confidence_cap, STREAM_TEMPORAL, possible,
                        st.bias_correction, "temporal")
-        # every fresh reservoir has M = 1 and a merged history adds at least 1: M > 1.5 = history accepted
-        stats["temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
-        stats["temporal_mean_M"] = float(res.M.mean()) if len(res.M) else 0.0
+        if run.team.leader:  # every fresh reservoir has M = 1 and a merged history adds at least 1
+            stats["temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
+            stats["temporal_mean_M"] = float(res.M.mean()) if len(res.M) else 0.0
     if st.boiling_filter and st.bias_correction == "NONE":  # biased by design: never in the unbiased mode
         with run.stage("boiling"):
-            dropped = int(boiling_filter(res, gb.pix, gb.width, gb.height, st.boiling_threshold).sum())
+            if run.team.leader:  # whole 16x16 blocks, in place: one process filters, the others wait
+                dropped = int(boiling_filter(res, gb.pix, gb.width, gb.height, st.boiling_threshold).sum())
+            run.team.barrier()
     for k in range(spatial_cfg.passes if spatial_cfg.neighbors else 0):
         res = spatial(run, space, gb, res, spatial_cfg, STREAM_SPATIAL + k, "spatial")
-    if len(res.M):
+    if len(res.M) and run.team.leader:
         stats["final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
     return res, dropped
 
@@ -79,6 +81,7 @@ def gi_visible(run: PassRunner, ctx, gb, res, unbiased: bool, stage):
         # slices: each task's reservoirs and terms are views, cleared in place
         run.map(lambda rows: gi.clear_occluded(ctx.geom_accel, gb.terms.take(rows), res.take(rows)),
                 run.spans(len(gb)))
+        run.team.barrier()
     return res
 
 
@@ -92,13 +95,14 @@ def reuse_gi(run: PassRunner, st, ctx, gi_cfg, gi_space, gi_spatial, gb, res, hi
         view = dataclasses.replace(hist, gbuf=hist.gbuf.with_terms(hist.gi_terms), res=hist.gi_res)
         res = temporal(run, gi_space, gb, res, view, motion, gi_cfg.confidence_cap, STREAM_GI_TEMPORAL, None,
                        st.bias_correction, "gi_temporal")
-        stats["gi_temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
+        if run.team.leader:
+            stats["gi_temporal_accepted"] = float((res.M > 1.5).mean()) if len(res.M) else 0.0
         res = gi_visible(run, ctx, gb, res, unbiased, "gi_temporal")
     history = res
     for k in range(gi_cfg.passes if gi_cfg.neighbors else 0):
         res = spatial(run, gi_space, gb, res, gi_spatial, STREAM_GI_SPATIAL + k, "gi_spatial")
         res = gi_visible(run, ctx, gb, res, unbiased, "gi_spatial")
-    if len(res.M):
+    if len(res.M) and run.team.leader:
         stats["gi_final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
     return res, history
 

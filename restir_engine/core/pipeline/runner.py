@@ -1,20 +1,37 @@
-"""How a sample pass runs its stages: tasks on the pool with progress and cancellation, spans of the frame's
-surfaces for the whole-image stages, the stage clock."""
+"""How a sample pass runs its stages: the items this process owns as tasks on its pool with progress and
+cancellation, spans of the frame's surfaces for the whole-image stages, the team it renders with, the stage clock."""
 from __future__ import annotations
 
 from ..parallel.tasks import Progress, map_tasks, spans
+from ..parallel.team import Solo
 from .plan import PassPlan
 
 
 class PassRunner:
-    """The plan of the pass being rendered, its progress/stop state, the frame's clock and chunk size."""
+    """The plan of the pass being rendered, its progress/stop state, the frame's clock and chunk size, and the team
+    (parallel/team.py) whose members share the pass's items."""
 
-    def __init__(self, plan: PassPlan, stop: Progress, clock, tile_pixels: int):
+    def __init__(self, plan: PassPlan, stop: Progress, clock, tile_pixels: int, team=None):
         self.plan, self.stop, self.clock, self.tile_pixels = plan, stop, clock, tile_pixels
+        self.team = team or Solo()
 
     def map(self, fn, items) -> list:
-        """fn(item) for every item on the pool (raises parallel.tasks.Stopped when asked to stop part-way)."""
-        return map_tasks(fn, items, self.stop)
+        """fn(item) for every item this process owns (item i: the team's member i mod size) on the pool, in item
+        order (raises parallel.tasks.Stopped when asked to stop part-way)."""
+        team = self.team
+        mine = items if team.size == 1 else [it for i, it in enumerate(items) if team.owns(i)]
+        return map_tasks(fn, mine, self.stop)
+
+    def gather(self, kind, parts, n: int):
+        """n reservoirs of ``kind`` from this process's (rows, Reservoirs) parts and every other member's: complete
+        once the barrier passed."""
+        if self.team.size == 1:
+            return kind.gather(parts, n)
+        out = kind.allocate(n, self.team.empty)
+        for rows, part in parts:
+            out.assign(rows, part)
+        self.team.barrier()
+        return out
 
     def spans(self, n: int) -> list[slice]:
         """The frame's n surfaces (or pixels) in chunk-sized slices."""

@@ -24,6 +24,7 @@ class Chunk:
     hits: object = None    # camera_paths.PrimaryHits (rows index ``pixels``)                       [primary]
     chain: object = None   # camera_paths.SpecularChains: its surfaces seen through smooth glass      [primary]
     first: int = 0         # index of its first surface in the frame's G-buffer                     [primary]
+    count: int = 0         # its surfaces (hit pixels; known for every chunk of the frame, hits only for its own)
     res: object = None     # di.DIReservoirs of its surfaces (initial, then after reuse)             [initial, reuse]
     bsdf_ray: object = None  # the BSDF candidate's traced ray, taken over by the path continuation   [initial]
     direct: np.ndarray = None    # (3, n) direct light: the continuation's part, then the shaded part [paths, shade]
@@ -36,7 +37,7 @@ class Chunk:
     @property
     def surfaces(self) -> slice:
         """Its surfaces' rows in the frame's whole-image buffers."""
-        return slice(self.first, self.first + len(self.hits.rows))
+        return slice(self.first, self.first + self.count)
 
 
 def make_chunks(span_list, batch: int) -> list[Chunk]:
@@ -45,22 +46,31 @@ def make_chunks(span_list, batch: int) -> list[Chunk]:
                   batch) for i, sl in enumerate(span_list)]
 
 
-def place(chunks: list[Chunk]) -> int:
-    """Give each chunk its first row in the frame's surface order (chunk order); returns the surface count."""
+def place(chunks: list[Chunk], team) -> int:
+    """Give each chunk its surface count and first row in the frame's surface order (chunk order), from the
+    primary hits of the chunks this process owns and the team's for the others; returns the surface count."""
+    counts = team.table({c.index: len(c.hits.rows) for c in chunks if c.hits is not None}, len(chunks), 1)
     first = 0
-    for c in chunks:
-        c.first = first
-        first += len(c.hits.rows)
+    for c, k in zip(chunks, counts[:, 0].astype(np.int64)):
+        c.first, c.count = first, int(k)
+        first += int(k)
     return first
 
 
-def frame_reservoirs(chunks: list[Chunk], field: str, kind, n: int):
+def own(chunks: list[Chunk], team) -> list[Chunk]:
+    """The chunks this process computes."""
+    return chunks if team.size == 1 else [c for c in chunks if team.owns(c.index)]
+
+
+def frame_reservoirs(chunks: list[Chunk], field: str, kind, n: int, team):
     """The chunks' reservoirs in ``field`` ("res" or "gi_res") as one frame-wide ``kind`` array of the frame's n
-    surfaces (the reuse stages' input); the chunks let go of theirs."""
-    res = kind.empty(n)
-    for c in chunks:
+    surfaces (the reuse stages' input; in the team's shared buffers, complete after its barrier); the chunks let go
+    of theirs."""
+    res = kind.empty(n) if team.size == 1 else kind.allocate(n, team.empty)
+    for c in own(chunks, team):
         res.assign(c.surfaces, getattr(c, field))
         setattr(c, field, None)  # the frame's array holds them now
+    team.barrier()
     return res
 
 

@@ -40,6 +40,12 @@ class Reservoirs:
         arrays[cls.key_field()][:] = -1
         return cls(**arrays)
 
+    @classmethod
+    def allocate(cls, n: int, empty) -> "Reservoirs":
+        """n reservoirs in arrays from ``empty(shape, dtype)`` (e.g. a team's shared buffers), not initialized: the
+        caller writes every row."""
+        return cls(**{name: empty(n, dt) for name, dt in {**cls.SAMPLE, **COMMON}.items()})
+
     def __len__(self) -> int:
         return len(self.M)
 
