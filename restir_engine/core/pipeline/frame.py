@@ -23,7 +23,7 @@ from ..integrators import pathtracer, trace_context
 from ..integrators.context_cache import context_for, fingerprint
 from ..integrators.method_choice import GI_MIN_SHARE
 from ..modes import DirectMethod, Integrator
-from ..parallel.pool import quiet_float_errors
+from ..parallel.pool import quiet_float_errors, thread_count
 from ..parallel.tasks import Progress, Stopped, spans
 from ..parallel.team import Solo
 from ..profile import NullClock
@@ -401,12 +401,23 @@ class FrameRenderer:
 
 
 def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
-                 clock=None) -> FrameResult:
-    """Render one frame with the chosen integrator.
+                 clock=None, processes: int | None = None) -> FrameResult:
+    """Render one frame with the chosen integrator, in ``processes`` worker processes (None: the count that
+    parallel.processes.process_count chooses for the thread count; 1: in this process) where the image has more
+    than one chunk of pixels. The same seed gives the same image either way.
 
     progress(fraction, message) is called as chunks finish; should_stop() is polled while they run,
-    and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none).
+    and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none). ``history`` is the
+    result's history of the previous frame (rendered the same way; another kind is not reused).
     """
+    from ..parallel import processes as procs
+    n = procs.process_count(thread_count()) if processes is None else int(processes)
+    _x0, _y0, w, h = scene.camera.window
+    if n > 1 and len(spans(w * h, settings.tile_pixels)) > 1:
+        from .shared_frame import render_frame_shared
+        return render_frame_shared(scene, settings, procs.team(n), progress, should_stop, history, clock)
+    if not isinstance(history, TemporalHistory):
+        history = None
     t0 = time.perf_counter()
     fr = FrameRenderer(scene, settings, history, clock)
     cancelled = False

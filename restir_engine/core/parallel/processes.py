@@ -1,0 +1,251 @@
+"""Worker processes rendering each frame together, driven from the rendering process (Blender's, or the CLI's).
+
+Python runs one thread of bytecode at a time, so threads stop scaling at a few cores; processes do not. A
+:class:`WorkerTeam` is a persistent set of N spawned processes (spawn, as Windows and macOS need; inside Blender its
+own Python): each imports only the core (boot/restir_worker_boot.py), builds its own Embree scenes and renders every
+sample pass at the same time as the others, each computing the chunks it owns (team.py). They share, through
+segments of shared memory that this process creates and unlinks: the exported scene (wire.pack, once per frame),
+the three arena slots of the whole-image buffers and the film, which this process reads the passes from.
+
+Faults: a stop request sets a shared flag and breaks the team's barrier (every worker leaves its pass within a
+stage's task); a worker that dies or fails ends the whole team with one error (:class:`WorkerFailed`), its
+processes killed and its segments unlinked; the next render starts a new team. Worker processes also exit when
+this process is gone (a watchdog thread in each).
+"""
+from __future__ import annotations
+
+import atexit
+import contextlib
+import itertools
+import multiprocessing as mp
+import os
+import sys
+import threading
+import time
+from multiprocessing import connection
+
+import numpy as np
+
+from . import wire
+
+CORE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BOOT_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "boot")
+POLL_SECONDS = 0.02      # how often a waiting rendering process asks should_stop and checks its workers
+START_TIMEOUT = 120.0    # seconds a new worker may take to import the core and answer
+QUIT_SECONDS = 2.0       # a worker asked to quit is killed after this long
+
+_IDS = itertools.count(1)
+
+
+class WorkerFailed(RuntimeError):
+    """A worker process died or raised: the frame is lost and the team is ended."""
+
+
+@contextlib.contextmanager
+def _plain_main():
+    """Spawned children re-import the parent's ``__main__`` from its file or module name; Blender's (a text block,
+    a script importing bpy) cannot be imported without bpy, and workers need nothing from it."""
+    main = sys.modules.get("__main__")
+    saved = {k: main.__dict__[k] for k in ("__file__", "__spec__") if main is not None and k in main.__dict__}
+    try:
+        if main is not None:
+            main.__dict__.pop("__file__", None)
+            main.__dict__["__spec__"] = None
+        yield
+    finally:
+        if main is not None:
+            main.__dict__.pop("__spec__", None)
+            main.__dict__.update(saved)
+
+
+class WorkerTeam:
+    """``size`` worker processes of ``threads`` threads each, started now and kept until :meth:`close`."""
+
+    def __init__(self, size: int, threads: int = 1):
+        self.id = next(_IDS)
+        self.size, self.threads = int(size), max(1, int(threads))
+        ctx = mp.get_context("spawn")
+        self.barrier = ctx.Barrier(self.size)
+        self.stop = ctx.RawValue("b", 0)
+        self.closed = False
+        self.slot_segs, self.slot_bytes = [], 0
+        self.film_seg = None
+        self.tokens = itertools.count(1)
+        self.lock = threading.Lock()  # one frame at a time
+        if BOOT_DIR not in sys.path:
+            sys.path.insert(0, BOOT_DIR)
+        import restir_worker_boot
+        self.conns, self.procs = [], []
+        t0 = time.perf_counter()
+        with _plain_main():
+            for rank in range(self.size):
+                mine, theirs = ctx.Pipe()
+                p = ctx.Process(target=restir_worker_boot.main, name=f"restir-worker-{rank}", daemon=True,
+                                args=(CORE_DIR, rank, self.size, theirs, self.barrier, self.stop, self.threads))
+                p.start()
+                theirs.close()
+                self.conns.append(mine)
+                self.procs.append(p)
+        self.start_seconds = time.perf_counter() - t0
+        atexit.register(self.close)
+
+    # -- shared segments ---------------------------------------------------------------------------------------
+    def ensure_slots(self, nbytes: int) -> list[str]:
+        """Names of the three arena slots, each at least ``nbytes`` (new, larger ones replace smaller ones)."""
+        if self.slot_bytes < nbytes:
+            self._unlink(self.slot_segs)
+            self.slot_bytes = int(nbytes)
+            self.slot_segs = [wire.create_segment(self.slot_bytes) for _ in range(3)]
+        return [s.name for s in self.slot_segs]
+
+    def film(self, nbytes: int):
+        """(segment name, zeros(shape) over it): the film's segment, zero-filled, at least ``nbytes``."""
+        seg = self.film_seg
+        if seg is None or seg.size < nbytes:
+            self._unlink([seg] if seg is not None else [])
+            seg = self.film_seg = wire.create_segment(nbytes)
+        else:
+            view = np.frombuffer(seg.buf, np.uint8, nbytes)
+            view[:] = 0
+            del view
+        from .team import Arena
+        arena = Arena(seg.buf, seg.name)
+        return seg.name, (lambda shape: arena.empty(shape, "float64"))
+
+    @staticmethod
+    def _unlink(segs) -> None:
+        for seg in segs:
+            wire.release_segment(seg)
+            with contextlib.suppress(FileNotFoundError, OSError):
+                seg.unlink()
+
+    # -- messages ------------------------------------------------------------------------------------------------
+    def run(self, msg, should_stop=None, timeout: float | None = None):
+        """Send ``msg`` to every worker and wait for all replies: the payloads (rank order), or None when the
+        pass was stopped (``should_stop()`` turned true, which stops every worker). Raises WorkerFailed when a
+        worker died or failed (the team is then closed)."""
+        if self.closed:
+            raise WorkerFailed("the render worker processes were shut down")
+        for c in self.conns:
+            c.send(msg)
+        replies = [None] * self.size
+        pending = set(range(self.size))
+        stopping, failure = False, None
+        t0 = time.perf_counter()
+        while pending:
+            waits = [self.conns[i] for i in pending] + [self.procs[i].sentinel for i in pending]
+            ready = connection.wait(waits, timeout=POLL_SECONDS)
+            for i in list(pending):
+                if self.conns[i] in ready or self.conns[i].poll():
+                    try:
+                        replies[i] = self.conns[i].recv()
+                    except (EOFError, OSError):
+                        failure = failure or self._died(i)
+                    pending.discard(i)
+                elif self.procs[i].sentinel in ready:
+                    failure = failure or self._died(i)
+                    pending.discard(i)
+            if failure is not None:
+                break
+            if not stopping and should_stop is not None and should_stop():
+                stopping = True
+                self.stop.value = 1
+                self.barrier.abort()
+            if timeout is not None and time.perf_counter() - t0 > timeout:
+                failure = f"the render worker processes did not answer within {timeout:.0f} s"
+                break
+        if failure is None:
+            errors = [r[1] for r in replies if r[0] == "error"]
+            if errors:
+                failure = "a render worker process failed: " + errors[0]
+        if failure is not None:
+            self.close(kill=True)
+            raise WorkerFailed(failure)
+        if stopping or any(r[0] == "stopped" for r in replies):
+            self.barrier.reset()
+            self.stop.value = 0
+            if any(r[0] == "stopped" for r in replies):
+                return None
+        return [wire.loads(r[1], "restir_core") for r in replies]
+
+    def _died(self, i: int) -> str:
+        p = self.procs[i]
+        p.join(0.5)
+        return f"render worker process {i} (pid {p.pid}) ended unexpectedly (exit code {p.exitcode})"
+
+    def next_token(self) -> int:
+        return next(self.tokens)
+
+    def alive(self) -> bool:
+        return not self.closed and all(p.is_alive() for p in self.procs)
+
+    def close(self, kill: bool = False) -> None:
+        """End the workers (asked to quit, then killed after QUIT_SECONDS; at once with ``kill``) and unlink every
+        segment this team created."""
+        if self.closed:
+            return
+        self.closed = True
+        for c in self.conns:
+            with contextlib.suppress(Exception):
+                if not kill:
+                    c.send(("quit",))
+        deadline = time.perf_counter() + (0.0 if kill else QUIT_SECONDS)
+        for p in self.procs:
+            p.join(max(0.0, deadline - time.perf_counter()))
+        for p in self.procs:
+            if p.is_alive():
+                p.kill()
+                p.join(1.0)
+        for c in self.conns:
+            c.close()
+        self._unlink(self.slot_segs + ([self.film_seg] if self.film_seg is not None else []))
+        self.slot_segs, self.film_seg = [], None
+        with contextlib.suppress(Exception):
+            atexit.unregister(self.close)
+
+
+_TEAM: WorkerTeam | None = None
+_TEAM_LOCK = threading.Lock()
+_PROCESSES: int | None = None  # set_process_count's: None = not set (this process alone), 0 = Auto
+
+
+def set_process_count(processes: int | None) -> None:
+    """Render with ``processes`` worker processes from the next frame on: 0 = Auto (see :func:`process_count`),
+    1 or None = in the rendering process itself (the core's default; the add-on sets Render Properties >
+    Performance > Processes)."""
+    global _PROCESSES
+    _PROCESSES = None if processes is None else max(0, int(processes))
+
+
+def process_count(cores: int) -> int:
+    """Worker processes for ``cores`` cores: the count set; Auto: one per core from AUTO_MIN_CORES cores up, else
+    1 (the rendering process alone, with ``cores`` threads)."""
+    if _PROCESSES is None:
+        return 1
+    if _PROCESSES > 0:
+        return _PROCESSES
+    return cores if cores >= AUTO_MIN_CORES else 1
+
+
+AUTO_MIN_CORES = 3  # Auto uses worker processes from this many cores up
+
+
+def team(size: int, threads: int = 1) -> WorkerTeam:
+    """The persistent team of ``size`` workers (a new one when the size changed or the last one failed)."""
+    global _TEAM
+    with _TEAM_LOCK:
+        if _TEAM is not None and (_TEAM.size != size or _TEAM.threads != threads or not _TEAM.alive()):
+            _TEAM.close(kill=not _TEAM.alive())
+            _TEAM = None
+        if _TEAM is None:
+            _TEAM = WorkerTeam(size, threads)
+        return _TEAM
+
+
+def shutdown() -> None:
+    """End the persistent team (add-on unregister, interpreter exit)."""
+    global _TEAM
+    with _TEAM_LOCK:
+        if _TEAM is not None:
+            _TEAM.close()
+            _TEAM = None

@@ -1,0 +1,132 @@
+"""A render worker process's loop: it renders the frames it is sent as one member of a team (team.py), each sample
+pass at the same time as the other workers, into the team's shared film.
+
+Messages (tuples from the rendering process; each is answered with ("ok", pickled payload) or ("stopped", None) or
+("error", text)):
+  ("frame", frame)  build the frame's renderer: the scene (wire.pack), settings, the history token it may reuse,
+                    the film's and the arena slots' segments
+  ("pass", left)    render the next sample pass (at most ``left`` samples); payload: the samples it rendered
+  ("finish", token) end the frame: keep its history under ``token``; the leader's payload: the frame's stats, data
+                    passes and whether the film has reservoir passes
+  ("quit",)         exit
+"""
+from __future__ import annotations
+
+import traceback
+
+from . import wire
+from .pool import set_thread_count
+from .team import Arena, Team
+
+KEEP_SCENES = 3  # scene segments a worker keeps attached (a context may still refer to the last frames' arrays)
+
+
+class _Worker:
+    def __init__(self, rank: int, size: int, conn, barrier, stop, threads: int):
+        self.rank, self.size, self.conn, self.barrier, self.stop = rank, size, conn, barrier, stop
+        set_thread_count(max(1, int(threads)))
+        self.team = None
+        self.slot_names = None
+        self.film_seg = None
+        self.scenes: list = []     # attached scene segments, newest last
+        self.fr = None
+        self.scene = None
+        self.clock = None
+        self.history, self.history_token = None, None
+
+    # -- segments --------------------------------------------------------------------------------------------
+    def _slots(self, names, size: int) -> None:
+        if self.slot_names == names:
+            return
+        segs = [wire.attach_segment(n) for n in names]
+        self._drop(getattr(self, "slot_segs", []))
+        self.slot_segs, self.slot_names = segs, names
+        self.team = Team(self.rank, self.size, self.barrier, [Arena(s.buf, s.name) for s in segs], self.stop)
+        self.history, self.history_token = None, None  # it lived in the old slots
+
+    def _film(self, name: str):
+        if self.film_seg is None or self.film_seg.name != name:
+            if self.film_seg is not None:
+                self._drop([self.film_seg])
+            self.film_seg = wire.attach_segment(name)
+        arena = Arena(self.film_seg.buf, name)
+        return lambda shape: arena.empty(shape, "float64")
+
+    def _drop(self, segs) -> None:
+        for seg in segs:
+            wire.release_segment(seg)
+
+    # -- messages ----------------------------------------------------------------------------------------------
+    def frame(self, frame: dict):
+        from ..pipeline.frame import FrameRenderer
+        from ..profile import StageClock
+        self._slots(frame["slots"], frame["slot_bytes"])
+        zeros = self._film(frame["film"])
+        scene = wire.unpack(frame["scene"], self.scenes)
+        if len(self.scenes) > KEEP_SCENES:
+            self._drop(self.scenes[:-KEEP_SCENES])
+            del self.scenes[:-KEEP_SCENES]
+        settings = wire.loads(frame["settings"], frame["sender"])
+        history = self.history if frame["history"] is not None and frame["history"] == self.history_token else None
+        self.clock = StageClock() if frame["clock"] and self.team.leader else None
+        self.scene = scene
+        self.fr = FrameRenderer(scene, settings, history, self.clock, team=self.team, film_zeros=zeros)
+        return {"build_seconds": self.fr.build_seconds}
+
+    def sample_pass(self, left: int):
+        fr = self.fr
+        batch = fr.batch_size(int(left))
+        if not fr.sample_pass(None, self.team.stopping, batch):
+            return None
+        return batch
+
+    def finish(self, token: int):
+        from ..pipeline.frame import frame_stats
+        fr = self.fr
+        out = None
+        if self.team.leader:
+            data = tuple(a for a in fr.data_passes()) if fr.settings.data_passes else None
+            out = {"stats": frame_stats(fr, self.scene, self.clock), "data": data,
+                   "reservoirs": fr.candidates is not None, "history": fr.history is not None}
+        if fr.history is not None:
+            self.history, self.history_token = fr.history, token
+        fr.release()
+        self.fr = self.scene = None
+        return out
+
+    def serve(self) -> None:
+        try:
+            self._serve()
+        finally:  # quietly: arrays of the last frame may still view them
+            self.fr = self.scene = self.history = self.team = None
+            self._drop(self.scenes + getattr(self, "slot_segs", []) + ([self.film_seg] if self.film_seg else []))
+
+    def _serve(self) -> None:
+        while True:
+            try:
+                msg = self.conn.recv()
+            except EOFError:
+                return
+            kind = msg[0]
+            if kind == "quit":
+                return
+            try:
+                if kind == "frame":
+                    out = self.frame(msg[1])
+                elif kind == "pass":
+                    out = self.sample_pass(msg[1])
+                    if out is None:
+                        self.conn.send(("stopped", None))
+                        continue
+                elif kind == "finish":
+                    out = self.finish(msg[1])
+                else:
+                    raise ValueError(f"unknown message {kind!r}")
+                self.conn.send(("ok", wire.dumps(out)))
+            except Exception as exc:  # the others must not wait for this one at a barrier
+                self.barrier.abort()
+                self.conn.send(("error", f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}"))
+
+
+def serve(rank: int, size: int, conn, barrier, stop, threads: int) -> None:
+    _Worker(rank, size, conn, barrier, stop, threads).serve()

@@ -1,0 +1,101 @@
+"""A frame rendered by a team of worker processes (parallel/processes.py): the same passes, in the same order,
+from the same random streams as :func:`frame.render_frame` in one process, so the same seed gives the same image.
+
+This process sends the scene once (in shared memory), asks for one sample pass after another (polling the stop
+request and the workers while they render) and reads the passes from the shared film. The temporal history stays
+in the workers (in their arena slots); the frame's result carries a :class:`SharedHistory` that names it.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from ..parallel import wire
+from ..parallel.processes import WorkerTeam
+from ..sampling import finite
+from . import methods
+from .film import Film, film_keys
+from .frame import Cancelled, FrameResult
+from .settings import RenderSettings, validate
+
+SURFACE_BYTES = 300  # per surface and pass: the target terms (DI's and GI's), the G-buffer, tables
+DI_BYTES = 24        # one DI reservoir (restir.di.DIReservoirs)
+GI_BYTES = 44        # one GI reservoir (restir.gi.GIReservoirs)
+PIXEL_BYTES = 12     # the light tiles' surface positions
+SLACK = 1.25         # alignment and margin
+FIXED_BYTES = 1 << 20
+
+
+@dataclass(frozen=True)
+class SharedHistory:
+    """The temporal history a team's workers kept from a frame (``token``), and the view it was seen from."""
+
+    team: int
+    token: int
+    size: tuple  # (window width, window height, camera width, camera height)
+
+    def fits(self, camera) -> bool:
+        return self.size == _view_size(camera)
+
+
+def _view_size(camera) -> tuple:
+    return (*camera.window[2:], camera.width, camera.height)
+
+
+def slot_bytes(pixels: int, st: RenderSettings) -> int:
+    """Bytes an arena slot needs for one pass of ``pixels`` window pixels: every whole-image buffer it allocates
+    (parallel/team.py)."""
+    per = SURFACE_BYTES + DI_BYTES * (3 + int(st.spatial_passes)) + GI_BYTES * (3 + int(st.gi_spatial_passes))
+    return int((pixels * (per + PIXEL_BYTES)) * SLACK) + FIXED_BYTES
+
+
+def film_bytes(w: int, h: int, gi: bool, denoise_data: bool) -> int:
+    from ..parallel.team import ALIGN
+    return sum(-(-(w * h * c * 8) // ALIGN) * ALIGN for _key, c in film_keys(gi, denoise_data)) + ALIGN
+
+
+def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
+                        history=None, clock=None) -> FrameResult:
+    """:func:`frame.render_frame` on ``team``'s workers (same arguments and result; ``history`` a SharedHistory
+    of this team, anything else is not reused)."""
+    validate(settings)
+    t0 = time.perf_counter()
+    with team.lock:
+        cam = scene.camera
+        _x0, _y0, w, h = cam.window
+        gi = methods.gi_possible(settings)
+        film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data))
+        film = Film(w, h, gi, settings.denoise_data, zeros)
+        slots = team.ensure_slots(slot_bytes(w * h, settings))
+        usable = isinstance(history, SharedHistory) and history.team == team.id and history.fits(cam)
+        seg, packed = wire.pack(scene)
+        try:
+            team.run(("frame", {"scene": packed, "settings": wire.dumps(settings), "sender": wire.core_name(),
+                                "history": history.token if usable else None, "film": film_name, "slots": slots,
+                                "slot_bytes": team.slot_bytes, "clock": clock is not None}))
+        finally:  # every worker attached (or the team is gone): the name is no longer needed
+            team._unlink([seg])
+        done, cancelled = 0, False
+        while done < settings.samples:
+            if progress:
+                progress(done / settings.samples, f"Sample {done + 1}/{settings.samples}")
+            replies = team.run(("pass", settings.samples - done), should_stop)
+            if replies is None:
+                cancelled = True
+                break
+            done += int(replies[0])
+        token = team.next_token()
+        out = team.run(("finish", token))[0]
+        if done == 0:
+            raise Cancelled("render cancelled before the first sample pass finished")
+        film.samples = done
+        passes = film.passes(out["reservoirs"])
+        if out["data"] is not None:
+            passes["Depth"], passes["Normal"], passes["Vector"] = (finite(a) for a in out["data"])
+        film.release()
+        stats = out["stats"]
+        stats["processes"] = team.size
+        if clock is not None and "stages" in stats:
+            clock.stages.update(stats["stages"])
+        hist = SharedHistory(team.id, token, _view_size(cam)) if out["history"] else None
+        return FrameResult(passes, done, time.perf_counter() - t0, cancelled, stats, hist)
