@@ -22,6 +22,8 @@ def unregister():
     import bpy
 
     from . import denoise, engine, presets, properties, ui
+    from .core.parallel import processes
+    processes.shutdown()  # the render worker processes end with the add-on
     ui.unregister()
     bpy.utils.unregister_class(engine.RestirRenderEngine)
     for cls in reversed(denoise.CLASSES):

@@ -73,11 +73,16 @@ def _black_passes(scene, view_layer, window) -> dict:
     return images
 
 
-def apply_threads(render) -> None:
+def apply_threads(scene) -> None:
     """Blender's Render Properties > Performance > Threads (``render.threads_mode``, ``render.threads``): Auto uses
-    every logical core, Fixed that many threads."""
+    every logical core, Fixed that many; and our Processes (``scene.restir.processes``): the worker processes F12
+    and animation frames render in (0 = Auto: one per core from 3 cores up, else Blender's process alone), each
+    with its share of the threads. The viewport renders in Blender's process with every thread."""
     from .core.parallel.pool import set_thread_count
+    from .core.parallel.processes import set_process_count
+    render = scene.render
     set_thread_count(int(render.threads) if render.threads_mode == "FIXED" else None)
+    set_process_count(int(getattr(getattr(scene, "restir", None), "processes", 0)))
 
 
 def _viewport_pass(context) -> str:
@@ -128,7 +133,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         t0 = time.perf_counter()
-        apply_threads(scene.render)
+        apply_threads(scene)
         settings = with_data_passes(settings_from_scene(scene), view_layer)
         # AUTO may resolve to ReSTIR (known once the scene is exported): keep and preroll its history too
         wants_temporal = methods.keeps_history(settings)
@@ -236,7 +241,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         from .export.incremental import SceneExporter, update_level
         from .viewport import ViewportSession
         scene = depsgraph.scene
-        apply_threads(scene.render)
+        apply_threads(scene)
         if self._viewport is None:
             self._viewport = ViewportSession(self.tag_redraw)
             self._exporter = SceneExporter()

@@ -164,6 +164,11 @@ SCENE_FIELDS = (
         "Blender's Denoise node (Open Image Denoise) on Combined with the Denoising Albedo "
         "and Normal passes (turning this on sets the nodes and passes up)", default=False,
         update=_denoise_option)),
+    Field("processes", IntProperty, None, dict(
+        name="Processes", description="Worker processes that render F12 and animation frames together, each "
+        "with its share of the threads (Python runs one thread at a time per process, so processes use many "
+        "cores where threads cannot). 0 = Auto: one per thread from 3 threads up, else Blender's own process. "
+        "The image is the same for any number", default=0, min=0, soft_max=64, max=1024)),
     Field("samples", IntProperty, int, dict(
         name="Samples", description="Iterations averaged per frame", default=16, min=1,
         soft_max=4096)),

@@ -249,6 +249,12 @@ class RESTIR_PT_performance(RestirPanel, bpy.types.Panel):
         row = layout.row()
         row.enabled = render.threads_mode == "FIXED"
         row.prop(render, "threads")
+        layout.prop(context.scene.restir, "processes")
+        from ..core.parallel.processes import split
+        procs, threads = split(render.threads if render.threads_mode == "FIXED" else None,
+                               context.scene.restir.processes)
+        layout.label(text=f"F12 and animation: {procs} process{'es' if procs > 1 else ''} x {threads} "
+                          f"thread{'s' if threads > 1 else ''}", icon="INFO")
 
 
 class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):

@@ -133,6 +133,10 @@ class WorkerTeam:
         stopping, failure = False, None
         t0 = time.perf_counter()
         while pending:
+            if not stopping and should_stop is not None and should_stop():
+                stopping = True
+                self.stop.value = 1
+                self.barrier.abort()
             waits = [self.conns[i] for i in pending] + [self.procs[i].sentinel for i in pending]
             ready = connection.wait(waits, timeout=POLL_SECONDS)
             for i in list(pending):
@@ -147,10 +151,6 @@ class WorkerTeam:
                     pending.discard(i)
             if failure is not None:
                 break
-            if not stopping and should_stop is not None and should_stop():
-                stopping = True
-                self.stop.value = 1
-                self.barrier.abort()
             if timeout is not None and time.perf_counter() - t0 > timeout:
                 failure = f"the render worker processes did not answer within {timeout:.0f} s"
                 break
@@ -228,6 +228,14 @@ def process_count(cores: int) -> int:
 
 
 AUTO_MIN_CORES = 3  # Auto uses worker processes from this many cores up
+
+
+def split(threads: int | None, processes: int) -> tuple[int, int]:
+    """(processes, threads in each) for a Threads setting (None: every logical core) and a Processes setting
+    (0: Auto): what F12 renders with."""
+    cores = max(1, int(threads) if threads else (os.cpu_count() or 1))
+    n = int(processes) if processes and processes > 0 else (cores if cores >= AUTO_MIN_CORES else 1)
+    return n, (max(1, cores // n) if n > 1 else cores)
 
 
 def team(size: int, threads: int = 1) -> WorkerTeam:

@@ -415,7 +415,8 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     _x0, _y0, w, h = scene.camera.window
     if n > 1 and len(spans(w * h, settings.tile_pixels)) > 1:
         from .shared_frame import render_frame_shared
-        return render_frame_shared(scene, settings, procs.team(n), progress, should_stop, history, clock)
+        team = procs.team(n, max(1, thread_count() // n))
+        return render_frame_shared(scene, settings, team, progress, should_stop, history, clock)
     if not isinstance(history, TemporalHistory):
         history = None
     t0 = time.perf_counter()

@@ -1,0 +1,162 @@
+"""Worker processes (core/parallel/processes.py): a frame rendered by N processes is the frame one process renders,
+bit for bit (each chunk and span keeps its own random stream whoever computes it, and each pixel's film sum is
+added in the same order), for stills, animation frames with temporal history, every integrator and reuse stage;
+a stop request ends every worker's pass; a worker that dies gives one error and leaves no process and no
+shared-memory segment behind."""
+import dataclasses
+import os
+import signal
+import time
+
+import numpy as np
+import pytest
+from scenes_core import regression_room
+
+from restir_engine.core.parallel import processes
+from restir_engine.core.parallel.processes import WorkerFailed
+from restir_engine.core.pipeline.shared_frame import SharedHistory
+from restir_engine.core.renderer import Cancelled, RenderSettings, render_frame
+
+SIZE = (96, 72)
+TILE = 1024  # pixels per chunk: 7 chunks, shared unevenly by 2 or 3 workers
+
+SETTINGS = {
+    "path-batched": RenderSettings(integrator="PATH", samples=3, max_bounces=2, tile_pixels=TILE, sample_batch=2),
+    "ris-light-tiles": RenderSettings(integrator="RESTIR", direct_method="RIS", samples=2, max_bounces=1,
+                                      tile_pixels=TILE, light_tiles="ON", light_sampler="SPATIAL"),
+    "restir-di-unbiased": RenderSettings(integrator="RESTIR", direct_method="RESTIR", samples=2, max_bounces=1,
+                                         tile_pixels=TILE, bias_correction="UNBIASED"),
+    "restir-di-boiling": RenderSettings(integrator="RESTIR", direct_method="RESTIR", samples=1, max_bounces=0,
+                                        tile_pixels=TILE, bias_correction="NONE", boiling_filter=True,
+                                        boiling_threshold=1.5),
+    "di-gi-unbiased": RenderSettings(integrator="RESTIR", direct_method="RESTIR", indirect_method="RESTIR_GI",
+                                     samples=2, max_bounces=2, tile_pixels=TILE, bias_correction="UNBIASED",
+                                     denoise_data=True),
+    "auto": RenderSettings(integrator="RESTIR", direct_method="AUTO", indirect_method="AUTO", samples=2,
+                           max_bounces=2, tile_pixels=TILE),
+}
+
+
+def _frames(settings, n):
+    """Two frames of the room (the second with the first's history); passes of both, and the second's stats."""
+    scene = regression_room(*SIZE)
+    first = render_frame(scene, settings, processes=n)
+    second = render_frame(scene, dataclasses.replace(settings, frame=2), history=first.history, processes=n)
+    return first.passes, second.passes, second.stats
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _end_teams():
+    yield
+    processes.shutdown()
+
+
+@pytest.mark.parametrize("name", list(SETTINGS))
+def test_processes_render_the_image_one_process_renders(name):
+    settings = SETTINGS[name]
+    alone = _frames(settings, 1)
+    for n in (2, 3):
+        team = _frames(settings, n)
+        assert team[2]["processes"] == n
+        for frame in (0, 1):
+            assert set(team[frame]) == set(alone[frame])
+            for key, image in alone[frame].items():
+                assert np.array_equal(image, team[frame][key]), (name, n, frame, key)
+    if settings.integrator == "RESTIR" and settings.direct_method == "RESTIR":
+        assert team[2]["reuse"]["temporal_accepted"] > 0.5  # the history crossed frames in the workers
+
+
+def test_the_split_matters_to_the_test():
+    """Power: a change of the random streams (another seed) or of one chunk's work is seen by the comparison."""
+    settings = SETTINGS["restir-di-unbiased"]
+    a = _frames(settings, 1)[1]["Combined"]
+    b = _frames(dataclasses.replace(settings, seed=1), 3)[1]["Combined"]
+    assert not np.array_equal(a, b)
+
+
+def test_a_team_is_started_once_and_kept():
+    settings = SETTINGS["path-batched"]
+    scene = regression_room(*SIZE)
+    render_frame(scene, settings, processes=2)
+    team = processes.team(2)
+    t0 = time.perf_counter()
+    render_frame(scene, settings, processes=2)
+    assert processes.team(2) is team and team.alive()
+    assert time.perf_counter() - t0 < 30
+
+
+def test_histories_of_the_other_kind_are_not_reused():
+    settings = SETTINGS["restir-di-unbiased"]
+    scene = regression_room(*SIZE)
+    shared = render_frame(scene, settings, processes=2)
+    assert isinstance(shared.history, SharedHistory)
+    fresh = render_frame(scene, dataclasses.replace(settings, frame=2), processes=1)
+    handed = render_frame(scene, dataclasses.replace(settings, frame=2), history=shared.history, processes=1)
+    assert np.array_equal(fresh.passes["Combined"], handed.passes["Combined"])
+    alone = render_frame(scene, settings, processes=1)
+    back = render_frame(scene, dataclasses.replace(settings, frame=2), history=alone.history, processes=2)
+    assert np.array_equal(fresh.passes["Combined"], back.passes["Combined"])
+
+
+def test_a_stop_keeps_the_finished_passes_and_the_team_goes_on():
+    settings = dataclasses.replace(SETTINGS["restir-di-unbiased"], samples=4)
+    scene = regression_room(*SIZE)
+    calls = {"passes": 0}
+
+    def progress(fraction, label):
+        calls["passes"] = int(label.split()[1].split("/")[0])  # "Sample k/n": pass k is about to render
+
+    result = render_frame(scene, settings, progress=progress, should_stop=lambda: calls["passes"] >= 2,
+                          processes=3)
+    assert result.cancelled and result.samples_done == 1
+    one = render_frame(scene, dataclasses.replace(settings, samples=1), processes=1)
+    assert np.array_equal(result.passes["Combined"], one.passes["Combined"])
+    with pytest.raises(Cancelled):
+        render_frame(scene, settings, should_stop=lambda: True, processes=3)
+    again = render_frame(scene, dataclasses.replace(settings, samples=1), processes=3)  # the team still works
+    assert np.array_equal(again.passes["Combined"], one.passes["Combined"])
+
+
+def _segments(team):
+    return [s.name for s in team.slot_segs + ([team.film_seg] if team.film_seg is not None else [])]
+
+
+@pytest.mark.skipif(not os.path.isdir("/dev/shm"), reason="shared-memory segments are listed in /dev/shm here")
+def test_a_worker_dying_in_a_render_ends_the_team_with_one_error_and_nothing_left_behind():
+    settings = dataclasses.replace(SETTINGS["restir-di-unbiased"], samples=3)
+    scene = regression_room(*SIZE)
+    render_frame(scene, settings, processes=3)
+    team = processes.team(3)
+    names = _segments(team)
+    assert names and all(os.path.exists(f"/dev/shm/{n.lstrip('/')}") for n in names)
+
+    def kill_in_pass_two(fraction, label):
+        if label.startswith("Sample 2/"):
+            os.kill(team.procs[1].pid, signal.SIGKILL)
+
+    with pytest.raises(WorkerFailed, match=r"render worker process 1 \(pid \d+\) ended unexpectedly"):
+        render_frame(scene, settings, progress=kill_in_pass_two, processes=3)
+    assert not any(p.is_alive() for p in team.procs)
+    assert not any(os.path.exists(f"/dev/shm/{n.lstrip('/')}") for n in names)
+    after = render_frame(scene, settings, processes=3)  # the next render starts a new team
+    assert processes.team(3) is not team
+    assert np.array_equal(after.passes["Combined"], render_frame(scene, settings, processes=1).passes["Combined"])
+
+
+def test_a_worker_that_died_between_renders_is_replaced():
+    settings = SETTINGS["path-batched"]
+    scene = regression_room(*SIZE)
+    render_frame(scene, settings, processes=2)
+    team = processes.team(2)
+    os.kill(team.procs[0].pid, signal.SIGKILL)
+    team.procs[0].join(5)
+    result = render_frame(scene, settings, processes=2)
+    assert processes.team(2) is not team and not any(p.is_alive() for p in team.procs)
+    assert np.array_equal(result.passes["Combined"], render_frame(scene, settings, processes=1).passes["Combined"])
+
+
+def test_auto_uses_processes_from_three_cores():
+    assert processes.split(2, 0) == (1, 2)
+    assert processes.split(16, 0) == (16, 1)
+    assert processes.split(16, 4) == (4, 4)
+    assert processes.split(1, 0) == (1, 1)
