@@ -33,6 +33,7 @@ BOOT_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "boot")
 POLL_SECONDS = 0.02      # how often a waiting rendering process asks should_stop and checks its workers
 START_TIMEOUT = 120.0    # seconds a new worker may take to import the core and answer
 QUIT_SECONDS = 2.0       # a worker asked to quit is killed after this long
+COST_ENTRIES = 1 << 16   # chunks whose costs the team keeps (more chunks: round-robin)
 
 _IDS = itertools.count(1)
 
@@ -70,6 +71,7 @@ class WorkerTeam:
         self.closed = False
         self.slot_segs, self.slot_bytes = [], 0
         self.film_seg = None
+        self.costs_seg = wire.create_segment(8 * COST_ENTRIES)  # the chunks' costs (team.Team.costs)
         self.tokens = itertools.count(1)
         self.lock = threading.Lock()  # one frame at a time
         if BOOT_DIR not in sys.path:
@@ -198,7 +200,7 @@ class WorkerTeam:
                 p.join(1.0)
         for c in self.conns:
             c.close()
-        self._unlink(self.slot_segs + ([self.film_seg] if self.film_seg is not None else []))
+        self._unlink(self.slot_segs + [self.costs_seg] + ([self.film_seg] if self.film_seg is not None else []))
         self.slot_segs, self.film_seg = [], None
         with contextlib.suppress(Exception):
             atexit.unregister(self.close)

@@ -52,15 +52,20 @@ def map_tasks(fn, items, stop: Progress) -> list:
 
 
 BALANCE = 2  # a frame has a multiple of this many chunks (two threads finish together)
+MIN_CHUNKS = 32  # a frame of at least MIN_CHUNKS * MIN_CHUNK_ITEMS items has at least this many chunks
+MIN_CHUNK_ITEMS = 4096
 
 
 def chunk_size(n: int, target: int) -> int:
     """Items per chunk near ``target``, in a multiple of BALANCE chunks, so that the pool's threads finish together
-    (7 chunks on 2 threads leave one core idle for the last one). The split depends on n and target alone, never
-    on the thread count: each chunk draws from its own random stream, so the same seed gives the same image on any
-    number of cores."""
+    (7 chunks on 2 threads leave one core idle for the last one), and at least MIN_CHUNKS chunks where each still
+    holds MIN_CHUNK_ITEMS (worker processes share a frame's chunks: 16 of them need more than 8 to share). The
+    split depends on n and target alone, never on the thread or process count: each chunk draws from its own
+    random stream, so the same seed gives the same image on any number of cores."""
     target = max(64, int(target))
     count = max(1, -(-n // target))
+    if n >= MIN_CHUNKS * MIN_CHUNK_ITEMS:
+        count = max(count, MIN_CHUNKS)
     count = -(-count // BALANCE) * BALANCE
     return max(64, -(-n // count))
 

@@ -36,13 +36,22 @@ class Solo:
     def owns(self, index: int) -> bool:
         return True
 
+    def owns_chunk(self, index: int) -> bool:
+        return True
+
+    def record(self, index: int, seconds: float) -> None:
+        pass
+
+    def publish_costs(self) -> None:
+        pass
+
     def barrier(self) -> None:
         pass
 
     def empty(self, shape, dtype) -> np.ndarray:
         return np.empty(shape, dtype)
 
-    def begin_pass(self, first: bool) -> None:
+    def begin_pass(self, first: bool, chunks: int = 0) -> None:
         pass
 
     def table(self, rows: dict, n: int, k: int) -> np.ndarray:
@@ -81,19 +90,31 @@ class Arena:
 
 class Team:
     """Member ``rank`` of ``size`` processes rendering a pass together. ``barrier`` is a multiprocessing.Barrier of
-    ``size`` parties; ``slots`` three Arenas over the team's shared segments (see the module docstring); ``stop`` a
-    shared flag (a ctypes value) set by the process that drives the team when the pass is to stop."""
+    ``size`` parties; ``slots`` three Arenas over the team's shared segments (see the module docstring); ``costs``
+    a shared float64 array (the chunks' measured seconds, for the assignment); ``stop`` a shared flag (a ctypes
+    value) set by the process that drives the team when the pass is to stop.
 
-    def __init__(self, rank: int, size: int, barrier, slots: list[Arena], stop):
+    Spans of surfaces (the reuse stages) go round-robin: span i to member i mod size. Chunks of pixels go by their
+    cost in the last pass that measured them (longest first, each to the least loaded member, as LPT scheduling),
+    round-robin before any measurement: every member reads the same costs, so all agree on the assignment, and
+    who computes a chunk never changes its result."""
+
+    def __init__(self, rank: int, size: int, barrier, slots: list[Arena], stop, costs: np.ndarray | None = None):
         self.rank, self.size = int(rank), int(size)
         self.leader = self.rank == 0
         self._barrier, self.slots, self.stop = barrier, slots, stop
         self._turn = 0
         self.arena = slots[2]
         self._lock = threading.Lock()
+        self.costs = costs  # [0]: the chunk count they were measured for; [1 + i]: chunk i's seconds
+        self.chunk_owner = np.zeros(0, np.int64)
+        self._spent: dict = {}
 
     def owns(self, index: int) -> bool:
         return index % self.size == self.rank
+
+    def owns_chunk(self, index: int) -> bool:
+        return self.chunk_owner[index] == self.rank
 
     def stopping(self) -> bool:
         return bool(self.stop.value)
@@ -109,15 +130,40 @@ class Team:
         """Release every member waiting at (or arriving at) the barrier with Stopped."""
         self._barrier.abort()
 
-    def begin_pass(self, first: bool) -> None:
+    def begin_pass(self, first: bool, chunks: int = 0) -> None:
         """Allocate the coming pass's buffers from the next first-pass slot (``first``) or from the slot of the
-        other passes."""
+        other passes, and assign its ``chunks`` chunks."""
         if first:
             self.arena = self.slots[self._turn]
             self._turn = 1 - self._turn
         else:
             self.arena = self.slots[2]
         self.arena.reset()
+        self.chunk_owner = assign(chunks, self.size, self._measured(chunks))
+        self._spent = {}
+
+    def _measured(self, chunks: int):
+        c = self.costs
+        if c is None or chunks + 1 > len(c) or int(c[0]) != chunks:
+            return None
+        cost = np.array(c[1:chunks + 1])
+        return cost if (cost > 0).all() else None
+
+    def record(self, index: int, seconds: float) -> None:
+        """Time spent on chunk ``index`` in this pass (summed over its stages)."""
+        with self._lock:
+            self._spent[index] = self._spent.get(index, 0.0) + seconds
+
+    def publish_costs(self) -> None:
+        """Write this member's chunk costs for the next pass's assignment (before the pass's last barrier, so that
+        every member reads them complete)."""
+        c, n = self.costs, len(self.chunk_owner)
+        if c is None or n + 1 > len(c):
+            return
+        for i, seconds in self._spent.items():
+            c[1 + i] = max(seconds, 1e-9)
+        if self.leader:
+            c[0] = n
 
     def empty(self, shape, dtype) -> np.ndarray:
         with self._lock:
@@ -130,3 +176,17 @@ class Team:
             out[i] = v
         self.barrier()
         return out
+
+
+def assign(chunks: int, size: int, cost: np.ndarray | None) -> np.ndarray:
+    """The member of each chunk: round-robin without costs, else longest first to the least loaded member (ties:
+    the lower chunk index first, the lower rank)."""
+    if cost is None or size == 1:
+        return np.arange(chunks, dtype=np.int64) % max(1, size)
+    owner = np.empty(chunks, np.int64)
+    load = np.zeros(size, np.float64)
+    for i in np.argsort(-cost, kind="stable"):  # chunks (tens to a few thousand), not pixels
+        m = int(np.argmin(load))
+        owner[i] = m
+        load[m] += cost[i]
+    return owner

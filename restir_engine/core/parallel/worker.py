@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import traceback
 
+import numpy as np
+
 from . import wire
 from .pool import set_thread_count
 from .team import Arena, Team
@@ -35,13 +37,14 @@ class _Worker:
         self.history, self.history_token = None, None
 
     # -- segments --------------------------------------------------------------------------------------------
-    def _slots(self, names, size: int) -> None:
-        if self.slot_names == names:
+    def _slots(self, names, size: int, costs: str) -> None:
+        if self.slot_names == (names, costs):
             return
-        segs = [wire.attach_segment(n) for n in names]
+        segs = [wire.attach_segment(n) for n in names + [costs]]
         self._drop(getattr(self, "slot_segs", []))
-        self.slot_segs, self.slot_names = segs, names
-        self.team = Team(self.rank, self.size, self.barrier, [Arena(s.buf, s.name) for s in segs], self.stop)
+        self.slot_segs, self.slot_names = segs, (names, costs)
+        self.team = Team(self.rank, self.size, self.barrier, [Arena(s.buf, s.name) for s in segs[:3]], self.stop,
+                         np.frombuffer(segs[3].buf, np.float64))
         self.history, self.history_token = None, None  # it lived in the old slots
 
     def _film(self, name: str):
@@ -60,7 +63,7 @@ class _Worker:
     def frame(self, frame: dict):
         from ..pipeline.frame import FrameRenderer
         from ..profile import StageClock
-        self._slots(frame["slots"], frame["slot_bytes"])
+        self._slots(frame["slots"], frame["slot_bytes"], frame["costs"])
         zeros = self._film(frame["film"])
         scene = wire.unpack(frame["scene"], self.scenes)
         if len(self.scenes) > KEEP_SCENES:

@@ -306,9 +306,9 @@ class FrameRenderer:
         """One pass of ``plan.batch`` samples through the stages. Returns the samples rendered."""
         st, ctx, clock, team = self.settings, self.ctx, self.clock, self.team
         plan = self._plan(batch, cap)
-        team.begin_pass(first=plan.sample == 0)
         _x0, _y0, w, h = ctx.scene.camera.window
         chunks = make_chunks(spans(w * h, st.tile_pixels), plan.batch)
+        team.begin_pass(first=plan.sample == 0, chunks=len(chunks))
         mine = own(chunks, team)  # the chunks this process computes (all of them when it renders alone)
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
         chunk_stages = 4 + int(plan.resampled) + (int(self.spatial.passes) + 1 if plan.reusing else 0) + \
@@ -317,7 +317,7 @@ class FrameRenderer:
                          team)
 
         with run.stage("primary"):
-            run.map(lambda c: primary.primary(ctx, plan, self.masks, c), chunks)
+            run.map_chunks(lambda c: primary.primary(ctx, plan, self.masks, c), chunks)
             n_surf = place(chunks, team)
             self._surfaces_per_chunk = n_surf / (len(chunks) * plan.batch)
         candidates = plan.candidates
@@ -333,9 +333,9 @@ class FrameRenderer:
         gi_terms = team.empty((WIDTH, n_surf), np.float32) if plan.gi or plan.probe else None
         if plan.resampled:
             with run.stage("initial"):
-                run.map(lambda c: direct.initial(ctx, plan, candidates, terms, c), chunks)
+                run.map_chunks(lambda c: direct.initial(ctx, plan, candidates, terms, c), chunks)
         with run.stage("paths"):
-            run.map(lambda c: paths.paths(ctx, plan, terms, gi_terms, self._make_gi, c), chunks)
+            run.map_chunks(lambda c: paths.paths(ctx, plan, terms, gi_terms, self._make_gi, c), chunks)
         gi_reused = self._gi_outcome(plan, chunks)
         if self.gi is not None and not gi_reused:
             self.gi_skipped += plan.batch
@@ -361,7 +361,8 @@ class FrameRenderer:
             self._keep_history(gb, res, gb_gi, gi_history, gi_reused)
         unbiased = st.bias_correction == "UNBIASED"
         with run.stage("shade"):
-            run.map(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c), chunks)
+            run.map_chunks(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c), chunks)
+        team.publish_costs()
         team.barrier()  # every process shaded its chunks: from here on the pass is not stopped (the film takes
         run.stop.should_stop = None  # all of it or, stopped before, none)
         with run.stage("passes"):

@@ -2,6 +2,8 @@
 cancellation, spans of the frame's surfaces for the whole-image stages, the team it renders with, the stage clock."""
 from __future__ import annotations
 
+import time
+
 from ..parallel.tasks import Progress, map_tasks, spans
 from ..parallel.team import Solo
 from .plan import PassPlan
@@ -21,6 +23,21 @@ class PassRunner:
         team = self.team
         mine = items if team.size == 1 else [it for i, it in enumerate(items) if team.owns(i)]
         return map_tasks(fn, mine, self.stop)
+
+    def map_chunks(self, fn, chunks) -> None:
+        """fn(chunk) for every chunk this process owns (the team's assignment), its time recorded for the next
+        pass's assignment."""
+        team = self.team
+        if team.size == 1:
+            map_tasks(fn, chunks, self.stop)
+            return
+
+        def timed(c):
+            t0 = time.perf_counter()
+            fn(c)
+            team.record(c.index, time.perf_counter() - t0)
+
+        map_tasks(timed, [c for c in chunks if team.owns_chunk(c.index)], self.stop)
 
     def gather(self, kind, parts, n: int):
         """n reservoirs of ``kind`` from this process's (rows, Reservoirs) parts and every other member's: complete

@@ -59,7 +59,7 @@ def place(chunks: list[Chunk], team) -> int:
 
 def own(chunks: list[Chunk], team) -> list[Chunk]:
     """The chunks this process computes."""
-    return chunks if team.size == 1 else [c for c in chunks if team.owns(c.index)]
+    return chunks if team.size == 1 else [c for c in chunks if team.owns_chunk(c.index)]
 
 
 def frame_reservoirs(chunks: list[Chunk], field: str, kind, n: int, team):
