@@ -113,12 +113,15 @@ def one(args) -> dict:
     start = time.perf_counter() - t0
     hist, rows, digest = None, [], None
     scenes = data["scenes"]
-    still = spec["frames"] == 1  # a still: F12 twice (the first starts the workers and builds the BVH)
+    # a still on several processes: F12 twice (the first starts the workers and builds the BVH); on one core the
+    # first F12 is the figure (its BVH build is under 1 % of it)
+    still = spec["frames"] == 1 and procs > 1
     for f in range(2 if still else spec["frames"]):
         clock = StageClock()
         t = time.perf_counter()
-        r = render_frame(scenes[0 if still else f % len(scenes)], dataclasses.replace(settings, frame=1 if still else f + 1),
-                         history=None if still else hist, clock=clock, processes=procs)
+        r = render_frame(scenes[0 if still else f % len(scenes)],
+                         dataclasses.replace(settings, frame=1 if spec["frames"] == 1 else f + 1),
+                         history=hist if spec["frames"] > 1 else None, clock=clock, processes=procs)
         wall = time.perf_counter() - t
         hist = r.history
         rows.append({"frame_s": wall, "stages": {k: v["wall"] for k, v in clock.stages.items()},

@@ -160,3 +160,16 @@ def test_auto_uses_processes_from_three_cores():
     assert processes.split(16, 0) == (16, 1)
     assert processes.split(16, 4) == (4, 4)
     assert processes.split(1, 0) == (1, 1)
+
+
+def test_chunks_go_to_the_least_loaded_process_by_their_measured_costs():
+    from restir_engine.core.parallel.team import SEGMENTS, assign
+    assert list(assign(5, 2, None)) == [0, 1, 0, 1, 0]  # nothing measured: round-robin
+    cost = np.zeros((SEGMENTS, 6))
+    cost[0] = [8, 1, 1, 1, 1, 4]  # one heavy chunk: the others share the rest
+    owner = assign(6, 2, cost)
+    loads = [cost[0][owner == m].sum() for m in (0, 1)]
+    assert max(loads) == 8 and list(assign(6, 2, cost)) == list(owner)  # balanced as well as can be, and stable
+    cost[1] = [0, 0, 0, 0, 0, 12]  # a second segment: chunk 5 is heavy there, so chunk 0 goes elsewhere
+    owner = assign(6, 2, cost)
+    assert owner[0] != owner[5]

@@ -27,7 +27,7 @@ CLUSTERS = 1024
 BLOCK = 16  # pixels per side of a screen block
 DEFENSIVE = 0.1
 TILE_POINTS = 256
-PARTS = 4  # block ranges built in parallel (a fixed count: images do not depend on the threads)
+PARTS = 32  # block ranges built in parallel (a fixed count: images do not depend on threads or processes)
 
 
 class LightClusters:
@@ -76,20 +76,23 @@ class BlockLightTiles:
     Same interface as light_tiles.LightTiles (points, rows, size, tile_base) plus :meth:`pdf_area`."""
 
     def __init__(self, lights, positions: np.ndarray, width: int, height: int, rng: np.random.Generator,
-                 size: int = TILE_POINTS):
+                 size: int = TILE_POINTS, team=None):
         """``positions``: (3, height, width) primary-hit positions of the window (NaN where nothing is hit).
-        The blocks are processed in PARTS ranges on the thread pool, each with its own random stream."""
+        The blocks are processed in PARTS ranges, each with its own random stream: on the thread pool, or by the
+        processes of ``team`` (parallel/team.py; each its own ranges, into the team's shared buffers)."""
         cl = clusters_of(lights)
         self.size = int(size)
         self.blocks_x = (width + BLOCK - 1) // BLOCK
         blocks_y = (height + BLOCK - 1) // BLOCK
         bmin, bmax = _block_bounds(positions, self.blocks_x, blocks_y)  # (3, blocks)
         blocks = bmin.shape[1]
-        self.q = np.empty((blocks, cl.count), np.float64)  # (blocks, clusters), rows sum to 1
-        self.rows = np.empty((11, blocks * self.size), np.float32)
+        shared = team is not None and team.size > 1
+        empty = team.empty if shared else np.empty
+        self.q = empty((blocks, cl.count), np.float64)  # (blocks, clusters), rows sum to 1
+        self.rows = empty((11, blocks * self.size), np.float32)
         self.lights, self.clusters = lights, cl
-        light = np.empty(blocks * self.size, np.int32)
-        bary = np.empty((2, blocks * self.size), np.float32)
+        light = empty(blocks * self.size, np.int32)
+        bary = empty((2, blocks * self.size), np.float32)
         bounds = np.linspace(0, blocks, PARTS + 1).astype(int)
         seeds = rng.integers(0, 2 ** 63, PARTS)
 
@@ -98,8 +101,11 @@ class BlockLightTiles:
             if b1 > b0:
                 self._part(b0, b1, bmin[:, b0:b1], bmax[:, b0:b1], np.random.default_rng(seeds[k]), light, bary)
 
+        mine = [k for k in range(PARTS) if not shared or team.owns(k)]
         run = map if in_worker() else pool().map
-        list(run(part, range(PARTS)))
+        list(run(part, mine))
+        if shared:
+            team.barrier()
         self.points = LightPoints(light, bary[0], bary[1], self.rows[0:3], self.rows[3:6], self.rows[6:9], self.rows[9],
                                   self.rows[10] > 0, lights.spot_lamp_tri(light), block=self.rows)
 

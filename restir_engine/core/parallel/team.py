@@ -39,7 +39,7 @@ class Solo:
     def owns_chunk(self, index: int) -> bool:
         return True
 
-    def record(self, index: int, seconds: float) -> None:
+    def record(self, index: int, seconds: float, segment: int = 0) -> None:
         pass
 
     def publish_costs(self) -> None:
@@ -95,9 +95,8 @@ class Team:
     value) set by the process that drives the team when the pass is to stop.
 
     Spans of surfaces (the reuse stages) go round-robin: span i to member i mod size. Chunks of pixels go by their
-    cost in the last pass that measured them (longest first, each to the least loaded member, as LPT scheduling),
-    round-robin before any measurement: every member reads the same costs, so all agree on the assignment, and
-    who computes a chunk never changes its result."""
+    costs in the last pass that measured them (:func:`assign`), round-robin before any measurement: every member
+    reads the same costs, so all agree on the assignment, and who computes a chunk never changes its result."""
 
     def __init__(self, rank: int, size: int, barrier, slots: list[Arena], stop, costs: np.ndarray | None = None):
         self.rank, self.size = int(rank), int(size)
@@ -106,7 +105,8 @@ class Team:
         self._turn = 0
         self.arena = slots[2]
         self._lock = threading.Lock()
-        self.costs = costs  # [0]: the chunk count they were measured for; [1 + i]: chunk i's seconds
+        self.costs = costs  # [0]: the chunk count n they were measured for; [1 + s * n + i]: chunk i's seconds
+        #                     in segment s (the stages between two barriers: SEGMENTS)
         self.chunk_owner = np.zeros(0, np.int64)
         self._spent: dict = {}
 
@@ -144,24 +144,26 @@ class Team:
 
     def _measured(self, chunks: int):
         c = self.costs
-        if c is None or chunks + 1 > len(c) or int(c[0]) != chunks:
+        if c is None or SEGMENTS * chunks + 1 > len(c) or int(c[0]) != chunks:
             return None
-        cost = np.array(c[1:chunks + 1])
-        return cost if (cost > 0).all() else None
+        cost = np.array(c[1:SEGMENTS * chunks + 1]).reshape(SEGMENTS, chunks)
+        return cost if (cost.sum(axis=0) > 0).all() else None
 
-    def record(self, index: int, seconds: float) -> None:
-        """Time spent on chunk ``index`` in this pass (summed over its stages)."""
+    def record(self, index: int, seconds: float, segment: int = 0) -> None:
+        """Time spent on chunk ``index`` in this pass by the stages of ``segment`` (0 <= segment < SEGMENTS)."""
         with self._lock:
-            self._spent[index] = self._spent.get(index, 0.0) + seconds
+            key = (segment, index)
+            self._spent[key] = self._spent.get(key, 0.0) + seconds
 
     def publish_costs(self) -> None:
         """Write this member's chunk costs for the next pass's assignment (before the pass's last barrier, so that
         every member reads them complete)."""
         c, n = self.costs, len(self.chunk_owner)
-        if c is None or n + 1 > len(c):
+        if c is None or SEGMENTS * n + 1 > len(c):
             return
-        for i, seconds in self._spent.items():
-            c[1 + i] = max(seconds, 1e-9)
+        for i in np.flatnonzero(self.chunk_owner == self.rank):
+            for seg in range(SEGMENTS):
+                c[1 + seg * n + i] = self._spent.get((seg, int(i)), 0.0)
         if self.leader:
             c[0] = n
 
@@ -178,15 +180,22 @@ class Team:
         return out
 
 
+SEGMENTS = 3  # stages of a chunk between barriers: primary | initial and paths | shade
+
+
 def assign(chunks: int, size: int, cost: np.ndarray | None) -> np.ndarray:
-    """The member of each chunk: round-robin without costs, else longest first to the least loaded member (ties:
-    the lower chunk index first, the lower rank)."""
+    """The member of each chunk: round-robin without costs; else, as LPT scheduling over several resources, the
+    chunks by decreasing total cost, each to the member whose busiest segment (load relative to that segment's
+    fair share) grows least, since the members wait for each other at the barrier after each segment. ``cost``:
+    (SEGMENTS, chunks) seconds. Ties go to the lower chunk index first and to the lower rank."""
     if cost is None or size == 1:
         return np.arange(chunks, dtype=np.int64) % max(1, size)
+    share = cost.sum(axis=1) / size
+    scale = np.where(share > 0, 1.0 / np.maximum(share, 1e-300), 0.0)[None, :]  # (1, SEGMENTS)
     owner = np.empty(chunks, np.int64)
-    load = np.zeros(size, np.float64)
-    for i in np.argsort(-cost, kind="stable"):  # chunks (tens to a few thousand), not pixels
-        m = int(np.argmin(load))
+    load = np.zeros((size, cost.shape[0]), np.float64)
+    for i in np.argsort(-cost.sum(axis=0), kind="stable"):  # chunks (tens to a few thousand), not pixels
+        m = int(np.argmin(((load + cost[:, i][None, :]) * scale).max(axis=1)))
         owner[i] = m
-        load[m] += cost[i]
+        load[m] += cost[:, i]
     return owner

@@ -27,7 +27,7 @@ def with_light_tiles(ctx, plan: PassPlan, chunks: list[Chunk], sampler: str, tea
             pos[:, c.pixels[:len(c.pixels) // c.batch]] = np.nan  # a chunk's pixels: its span (batch 1 here)
             pos[:, c.pixels[c.hits.rows]] = c.hits.surf.p
         team.barrier()
-        tiles = BlockLightTiles(ctx.lights, pos.reshape(3, h, w), w, h, r_tiles)
+        tiles = BlockLightTiles(ctx.lights, pos.reshape(3, h, w), w, h, r_tiles, team=team)
     else:
         tiles = LightTiles(ctx.lights, plan.candidates.tile_settings, w, h, r_tiles)
     return dataclasses.replace(plan.candidates, tiles=tiles)

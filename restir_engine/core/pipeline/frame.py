@@ -317,7 +317,7 @@ class FrameRenderer:
                          team)
 
         with run.stage("primary"):
-            run.map_chunks(lambda c: primary.primary(ctx, plan, self.masks, c), chunks)
+            run.map_chunks(lambda c: primary.primary(ctx, plan, self.masks, c), chunks, 0)
             n_surf = place(chunks, team)
             self._surfaces_per_chunk = n_surf / (len(chunks) * plan.batch)
         candidates = plan.candidates
@@ -333,9 +333,9 @@ class FrameRenderer:
         gi_terms = team.empty((WIDTH, n_surf), np.float32) if plan.gi or plan.probe else None
         if plan.resampled:
             with run.stage("initial"):
-                run.map_chunks(lambda c: direct.initial(ctx, plan, candidates, terms, c), chunks)
+                run.map_chunks(lambda c: direct.initial(ctx, plan, candidates, terms, c), chunks, 1)
         with run.stage("paths"):
-            run.map_chunks(lambda c: paths.paths(ctx, plan, terms, gi_terms, self._make_gi, c), chunks)
+            run.map_chunks(lambda c: paths.paths(ctx, plan, terms, gi_terms, self._make_gi, c), chunks, 1)
         gi_reused = self._gi_outcome(plan, chunks)
         if self.gi is not None and not gi_reused:
             self.gi_skipped += plan.batch
@@ -361,7 +361,7 @@ class FrameRenderer:
             self._keep_history(gb, res, gb_gi, gi_history, gi_reused)
         unbiased = st.bias_correction == "UNBIASED"
         with run.stage("shade"):
-            run.map_chunks(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c), chunks)
+            run.map_chunks(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c), chunks, 2)
         team.publish_costs()
         team.barrier()  # every process shaded its chunks: from here on the pass is not stopped (the film takes
         run.stop.should_stop = None  # all of it or, stopped before, none)

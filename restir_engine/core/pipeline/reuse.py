@@ -23,8 +23,8 @@ from .runner import PassRunner
 def temporal(run: PassRunner, space, gb, res, hist, motion, cap, stream, possible, bias_correction, stage):
     """One temporal merge of every surface's reservoir with its previous frame's (reuse.temporal_reuse)."""
     with run.stage(stage):
-        prepared = space.prepare(hist.res)
-        now = space.prepare(res) if bias_correction == "UNBIASED" else None
+        prepared = space.prepare(hist.res, run.spans(len(hist.res)), run.team)
+        now = space.prepare(res, run.spans(len(res)), run.team) if bias_correction == "UNBIASED" else None
         jobs = [(rows, (space, gb, res, now, hist, prepared, rows, cap, bias_correction, motion,
                         run.plan.rng(stream, i), possible))
                 for i, rows in enumerate(run.spans(len(gb)))]
@@ -37,7 +37,7 @@ def temporal(run: PassRunner, space, gb, res, hist, motion, cap, stream, possibl
 def spatial(run: PassRunner, space, gb, res, cfg, stream, stage):
     """One spatial pass over every surface (reuse.spatial_reuse)."""
     with run.stage(stage):
-        prepared = space.prepare(res)
+        prepared = space.prepare(res, run.spans(len(res)), run.team)
         jobs = [(rows, (space, gb, res, prepared, rows, cfg, run.plan.rng(stream, i)))
                 for i, rows in enumerate(run.spans(len(gb)))]
         del prepared  # released with the jobs once merged

@@ -24,9 +24,9 @@ class PassRunner:
         mine = items if team.size == 1 else [it for i, it in enumerate(items) if team.owns(i)]
         return map_tasks(fn, mine, self.stop)
 
-    def map_chunks(self, fn, chunks) -> None:
-        """fn(chunk) for every chunk this process owns (the team's assignment), its time recorded for the next
-        pass's assignment."""
+    def map_chunks(self, fn, chunks, segment: int) -> None:
+        """fn(chunk) for every chunk this process owns (the team's assignment), its time recorded under
+        ``segment`` (team.SEGMENTS) for the next pass's assignment."""
         team = self.team
         if team.size == 1:
             map_tasks(fn, chunks, self.stop)
@@ -35,7 +35,7 @@ class PassRunner:
         def timed(c):
             t0 = time.perf_counter()
             fn(c)
-            team.record(c.index, time.perf_counter() - t0)
+            team.record(c.index, time.perf_counter() - t0, segment)
 
         map_tasks(timed, [c for c in chunks if team.owns_chunk(c.index)], self.stop)
 

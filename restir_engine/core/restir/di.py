@@ -77,7 +77,10 @@ class LightSpace:
     def __init__(self, lights):
         self.lights = lights
 
-    def prepare(self, res: DIReservoirs) -> FramePoints:
+    def prepare(self, res: DIReservoirs, spans=None, team=None) -> FramePoints:
+        """The reservoirs' light points (by ``team``'s processes, span by span, where given)."""
+        if team is not None and team.size > 1:
+            return FramePoints.shared(self.lights, res.light, res.b1, res.b2, spans, team)
         return FramePoints(self.lights, res.light, res.b1, res.b2)
 
     @staticmethod

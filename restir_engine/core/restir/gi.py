@@ -174,8 +174,16 @@ class GISpace:
         self.target_kind = target
 
     @staticmethod
-    def prepare(res: GIReservoirs) -> np.ndarray:
-        return _points(res)
+    def prepare(res: GIReservoirs, spans=None, team=None) -> np.ndarray:
+        """The reservoirs' packed points (by ``team``'s processes, span by span, where given)."""
+        if team is None or team.size == 1:
+            return _points(res)
+        out = team.empty((11, len(res)), np.float32)
+        for i, sl in enumerate(spans):
+            if team.owns(i):
+                out[:, sl] = _points(res, sl)
+        team.barrier()
+        return out
 
     @staticmethod
     def gather(prepared: np.ndarray, idx) -> PackedPoints:

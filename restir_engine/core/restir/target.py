@@ -273,6 +273,24 @@ class FramePoints:
         spot_tri = np.concatenate(parts)
         self.spot_tri = spot_tri if (spot_tri >= 0).any() else None
 
+    @classmethod
+    def shared(cls, lights, light: np.ndarray, b1: np.ndarray, b2: np.ndarray, spans, team) -> "FramePoints":
+        """The same points, each of ``spans`` (slices of the reservoirs) computed by the member of ``team`` that
+        owns it (parallel/team.py) into the team's shared buffers; complete after its barrier."""
+        if lights.n_tri == 0:
+            return cls(lights, light, b1, b2)
+        self = cls.__new__(cls)
+        n = len(light)
+        self.rows = team.empty((11, n), np.float32)
+        spot = team.empty(n, np.int32)
+        for i, sl in enumerate(spans):
+            if team.owns(i):
+                spot[sl] = light_points(lights, np.maximum(light[sl], 0), b1[sl], b2[sl],
+                                        out=self.rows[:, sl]).spot_tri
+        team.barrier()
+        self.spot_tri = spot if (spot >= 0).any() else None
+        return self
+
     def points(self, q) -> PackedPoints:
         """Points of reservoirs ``q`` (index array or slice), spot cones not applied."""
         return PackedPoints.of(np.take(self.rows, q, axis=1) if not isinstance(q, slice) else self.rows[:, q])
