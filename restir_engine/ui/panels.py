@@ -251,8 +251,12 @@ class RESTIR_PT_performance(RestirPanel, bpy.types.Panel):
         row.prop(render, "threads")
         layout.prop(context.scene.restir, "processes")
         from ..core.parallel.processes import split
+        from ..core.parallel.tasks import spans
+        from ..core.pipeline.work import CHUNK_PIXELS
+        pixels = (render.resolution_x * render.resolution_y * render.resolution_percentage ** 2) // 10000
         procs, threads = split(render.threads if render.threads_mode == "FIXED" else None,
-                               context.scene.restir.processes)
+                               context.scene.restir.processes,
+                               len(spans(max(1, pixels), CHUNK_PIXELS)))
         layout.label(text=f"F12 and animation: {procs} process{'es' if procs > 1 else ''} x {threads} "
                           f"thread{'s' if threads > 1 else ''}", icon="INFO")
 

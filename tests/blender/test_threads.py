@@ -45,3 +45,22 @@ def test_cli_threads_flag(addon, tmp_path):
     r = subprocess.run([sys.executable, "-m", "restir_engine", str(path), "-t", "-2"], cwd=ROOT, capture_output=True,
                        text=True, timeout=300)
     assert r.returncode == 2 and "--threads: must be at least 0" in r.stderr
+
+
+def test_f12_renders_in_worker_processes_with_the_same_image(addon):
+    """Render Properties > Performance > Processes: F12 in 2 worker processes gives the image of Blender's process
+    alone (a 256x256 frame has 2 chunks of pixels, one per process)."""
+    from restir_engine.core.parallel import processes
+    scene = cornell_box("EMISSIVE", (256, 256))
+    configure_restir(scene, 1, 1)
+    try:
+        scene.restir.processes = 1
+        alone = render_passes(scene)["Combined"]
+        scene.restir.processes = 2
+        shared = render_passes(scene)["Combined"]
+        assert processes._TEAM is not None and processes._TEAM.size == 2 and processes._TEAM.alive()
+        assert np.array_equal(alone, shared)
+    finally:
+        scene.restir.processes = 0
+        processes.shutdown()
+        processes.set_process_count(None)

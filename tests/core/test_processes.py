@@ -155,11 +155,18 @@ def test_a_worker_that_died_between_renders_is_replaced():
     assert np.array_equal(result.passes["Combined"], render_frame(scene, settings, processes=1).passes["Combined"])
 
 
-def test_auto_uses_processes_from_three_cores():
+def test_auto_uses_processes_from_three_cores_and_at_most_one_per_chunk():
     assert processes.split(2, 0) == (1, 2)
     assert processes.split(16, 0) == (16, 1)
     assert processes.split(16, 4) == (4, 4)
     assert processes.split(1, 0) == (1, 1)
+    assert processes.split(16, 0, chunks=8) == (8, 2)
+    processes.set_process_count(0)
+    try:
+        assert processes.process_count(16, 8) == 8 and processes.process_count(2, 8) == 1
+    finally:
+        processes.set_process_count(None)
+    assert processes.process_count(16, 8) == 1  # not set: the rendering process alone
 
 
 def test_chunks_go_to_the_least_loaded_process_by_their_measured_costs():

@@ -37,8 +37,8 @@ def test_one_and_several_threads_give_the_same_image(settings, monkeypatch):
 
 
 def test_the_split_ignores_the_pool_and_balances_it():
-    assert tasks.chunk_size(230400, 32768) == 7200  # 640x360: 32 chunks (MIN_CHUNKS), 16 processes get 2 each
-    assert tasks.chunk_size(921600, 32768) == 28800  # 1280x720: 32 chunks of the target's size
+    assert tasks.chunk_size(230400, 32768) == 28800  # 640x360: 8 chunks
+    assert tasks.chunk_size(921600, 32768) == 28800  # 1280x720: 32 chunks (MIN_CHUNKS), 16 processes get 2 each
     assert tasks.chunk_size(14400, 16384) == 7200  # 2 chunks: both threads of a small viewport pass work
     n = 100000
     count = -(-n // tasks.chunk_size(n, 4096))

@@ -219,24 +219,25 @@ def set_process_count(processes: int | None) -> None:
     _PROCESSES = None if processes is None else max(0, int(processes))
 
 
-def process_count(cores: int) -> int:
-    """Worker processes for ``cores`` cores: the count set; Auto: one per core from AUTO_MIN_CORES cores up, else
-    1 (the rendering process alone, with ``cores`` threads)."""
+def process_count(cores: int, chunks: int) -> int:
+    """Worker processes for ``cores`` cores and a frame of ``chunks`` chunks: the count set, else (Auto) one per core
+    from AUTO_MIN_CORES cores up; never more than the chunks; 1 renders in this process with every thread."""
     if _PROCESSES is None:
         return 1
-    if _PROCESSES > 0:
-        return _PROCESSES
-    return cores if cores >= AUTO_MIN_CORES else 1
+    n = _PROCESSES if _PROCESSES > 0 else (cores if cores >= AUTO_MIN_CORES else 1)
+    return max(1, min(n, chunks))
 
 
 AUTO_MIN_CORES = 3  # Auto uses worker processes from this many cores up
 
 
-def split(threads: int | None, processes: int) -> tuple[int, int]:
-    """(processes, threads in each) for a Threads setting (None: every logical core) and a Processes setting
-    (0: Auto): what F12 renders with."""
+def split(threads: int | None, processes: int, chunks: int | None = None) -> tuple[int, int]:
+    """(processes, threads in each) for a Threads setting (None: every logical core), a Processes setting (0: Auto)
+    and a frame of ``chunks`` chunks (None: any number): what F12 renders with."""
     cores = max(1, int(threads) if threads else (os.cpu_count() or 1))
     n = int(processes) if processes and processes > 0 else (cores if cores >= AUTO_MIN_CORES else 1)
+    if chunks is not None:
+        n = max(1, min(n, int(chunks)))
     return n, (max(1, cores // n) if n > 1 else cores)
 
 

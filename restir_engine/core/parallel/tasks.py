@@ -53,7 +53,7 @@ def map_tasks(fn, items, stop: Progress) -> list:
 
 BALANCE = 2  # a frame has a multiple of this many chunks (two threads finish together)
 MIN_CHUNKS = 32  # a frame of at least MIN_CHUNKS * MIN_CHUNK_ITEMS items has at least this many chunks
-MIN_CHUNK_ITEMS = 4096
+MIN_CHUNK_ITEMS = 16384  # smaller chunks cost more per pixel: NumPy's per-call cost (x1.6 at 7200 px, 2 cores)
 
 
 def chunk_size(n: int, target: int) -> int:

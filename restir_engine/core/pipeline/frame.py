@@ -404,17 +404,18 @@ class FrameRenderer:
 def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
                  clock=None, processes: int | None = None) -> FrameResult:
     """Render one frame with the chosen integrator, in ``processes`` worker processes (None: the count that
-    parallel.processes.process_count chooses for the thread count; 1: in this process) where the image has more
-    than one chunk of pixels. The same seed gives the same image either way.
+    parallel.processes.process_count chooses for the thread count; 1: in this process), at most one per chunk of
+    pixels. The same seed gives the same image either way.
 
     progress(fraction, message) is called as chunks finish; should_stop() is polled while they run,
     and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none). ``history`` is the
     result's history of the previous frame (rendered the same way; another kind is not reused).
     """
     from ..parallel import processes as procs
-    n = procs.process_count(thread_count()) if processes is None else int(processes)
     _x0, _y0, w, h = scene.camera.window
-    if n > 1 and len(spans(w * h, settings.tile_pixels)) > 1:
+    chunks = len(spans(w * h, settings.tile_pixels))
+    n = procs.process_count(thread_count(), chunks) if processes is None else min(int(processes), chunks)
+    if n > 1:
         from .shared_frame import render_frame_shared
         team = procs.team(n, max(1, thread_count() // n))
         return render_frame_shared(scene, settings, team, progress, should_stop, history, clock)
