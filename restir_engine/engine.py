@@ -76,7 +76,7 @@ def _black_passes(scene, view_layer, window) -> dict:
 def apply_threads(scene) -> None:
     """Blender's Render Properties > Performance > Threads (``render.threads_mode``, ``render.threads``): Auto uses
     every logical core, Fixed that many; and our Processes (``scene.restir.processes``): the worker processes F12
-    and animation frames render in (0 = Auto: one per core from 3 cores up, else Blender's process alone), each
+    and animation frames render in (0 = Auto: one per core from 2 cores up, at most one per chunk of pixels), each
     with its share of the threads. The viewport renders in Blender's process with every thread."""
     from .core.parallel.pool import set_thread_count
     from .core.parallel.processes import set_process_count

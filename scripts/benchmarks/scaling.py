@@ -33,7 +33,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 CORE_DIR = os.path.join(ROOT, "restir_engine", "core")
-SIZES = {"720p": (1280, 720), "360p": (640, 360)}
+SIZES = {"720p": (1280, 720), "360p": (640, 360), "180p": (320, 180)}
 # (name, scene file, settings overrides on the add-on's defaults, samples, frames)
 RUNS = [
     ("demo PATH 4b", "demo", dict(integrator="PATH", max_bounces=4), 1, 4),

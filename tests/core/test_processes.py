@@ -155,15 +155,15 @@ def test_a_worker_that_died_between_renders_is_replaced():
     assert np.array_equal(result.passes["Combined"], render_frame(scene, settings, processes=1).passes["Combined"])
 
 
-def test_auto_uses_processes_from_three_cores_and_at_most_one_per_chunk():
-    assert processes.split(2, 0) == (1, 2)
+def test_auto_uses_processes_from_two_cores_and_at_most_one_per_chunk():
+    assert processes.split(2, 0) == (2, 1)
     assert processes.split(16, 0) == (16, 1)
     assert processes.split(16, 4) == (4, 4)
     assert processes.split(1, 0) == (1, 1)
     assert processes.split(16, 0, chunks=8) == (8, 2)
     processes.set_process_count(0)
     try:
-        assert processes.process_count(16, 8) == 8 and processes.process_count(2, 8) == 1
+        assert processes.process_count(16, 8) == 8 and processes.process_count(1, 8) == 1
     finally:
         processes.set_process_count(None)
     assert processes.process_count(16, 8) == 1  # not set: the rendering process alone

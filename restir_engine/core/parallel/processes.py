@@ -228,7 +228,7 @@ def process_count(cores: int, chunks: int) -> int:
     return max(1, min(n, chunks))
 
 
-AUTO_MIN_CORES = 3  # Auto uses worker processes from this many cores up
+AUTO_MIN_CORES = 2  # Auto uses worker processes from this many cores up (2 already gain: docs/RESULTS.md)
 
 
 def split(threads: int | None, processes: int, chunks: int | None = None) -> tuple[int, int]:

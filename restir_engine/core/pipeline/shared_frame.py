@@ -19,10 +19,10 @@ from .frame import Cancelled, FrameResult
 from .settings import RenderSettings, validate
 
 SURFACE_BYTES = 300  # per surface and pass: the target terms (DI's and GI's), the G-buffer, tables
-DI_BYTES = 24        # one DI reservoir (restir.di.DIReservoirs)
-GI_BYTES = 44        # one GI reservoir (restir.gi.GIReservoirs)
-PIXEL_BYTES = 12     # the light tiles' surface positions
-SLACK = 1.25         # alignment and margin
+DI_BYTES = 24 + 48   # one DI reservoir (restir.di.DIReservoirs) and its light point (target.FramePoints)
+GI_BYTES = 44 + 44   # one GI reservoir (restir.gi.GIReservoirs) and its packed point
+PIXEL_BYTES = 12 + 100  # the light tiles' surface positions; the block tiles (lights/blocks.py) per pixel
+SLACK = 1.5          # alignment and margin (the pages of a slot are only committed where written)
 FIXED_BYTES = 1 << 20
 
 
@@ -45,7 +45,7 @@ def _view_size(camera) -> tuple:
 def slot_bytes(pixels: int, st: RenderSettings) -> int:
     """Bytes an arena slot needs for one pass of ``pixels`` window pixels: every whole-image buffer it allocates
     (parallel/team.py)."""
-    per = SURFACE_BYTES + DI_BYTES * (3 + int(st.spatial_passes)) + GI_BYTES * (3 + int(st.gi_spatial_passes))
+    per = SURFACE_BYTES + DI_BYTES * (4 + int(st.spatial_passes)) + GI_BYTES * (4 + int(st.gi_spatial_passes))
     return int((pixels * (per + PIXEL_BYTES)) * SLACK) + FIXED_BYTES
 
 
