@@ -190,6 +190,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"ERROR"}, message)
             self.error_set(message)
             return
+        if result.stats.get("processes_note"):
+            self.report({"WARNING"}, result.stats["processes_note"])
         if result.history is not None and not result.cancelled:
             _TEMPORAL_HISTORY[key] = (scene.frame_current, result.history)
         for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):

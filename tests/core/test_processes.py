@@ -180,3 +180,20 @@ def test_chunks_go_to_the_least_loaded_process_by_their_measured_costs():
     cost[1] = [0, 0, 0, 0, 0, 12]  # a second segment: chunk 5 is heavy there, so chunk 0 goes elsewhere
     owner = assign(6, 2, cost)
     assert owner[0] != owner[5]
+
+
+def test_a_process_count_that_would_not_fit_in_memory_is_lowered_with_a_message(monkeypatch):
+    from restir_engine.core.pipeline import memory
+    settings = SETTINGS["path-batched"]
+    scene = regression_room(*SIZE)
+    estimate = memory.frame_estimate(scene, settings)
+    each = memory.WORKER_FIXED + memory.BVH_PER_TRIANGLE * len(scene.geometry) + memory.WORKER_PER_PIXEL * estimate.pixels
+    monkeypatch.setattr(memory, "available_memory", lambda: estimate.high + 2 * each + 1)  # room for 2 workers
+    result = render_frame(scene, settings, processes=3)
+    assert result.stats["processes"] == 2
+    assert "3 render processes would not fit in memory" in result.stats["processes_note"]
+    assert "rendering with 2" in result.stats["processes_note"]
+    monkeypatch.setattr(memory, "available_memory", lambda: estimate.high + 1)  # no room for any: this process
+    alone = render_frame(scene, settings, processes=3)
+    assert "processes" not in alone.stats and "rendering with 1" in alone.stats["processes_note"]
+    assert np.array_equal(alone.passes["Combined"], result.passes["Combined"])

@@ -415,10 +415,22 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     _x0, _y0, w, h = scene.camera.window
     chunks = len(spans(w * h, settings.tile_pixels))
     n = procs.process_count(thread_count(), chunks) if processes is None else min(int(processes), chunks)
+    note = ""
+    if n > 1:
+        from . import memory
+        free = memory.available_memory()
+        fit = memory.processes_that_fit(n, memory.frame_estimate(scene, settings), len(scene.geometry), free)
+        if fit < n:
+            note = (f"{n} render processes would not fit in memory ({memory.size_text(free)} free, each needs its "
+                    f"own copy of the scene's BVH): rendering with {fit}")
+            n = fit
     if n > 1:
         from .shared_frame import render_frame_shared
         team = procs.team(n, max(1, thread_count() // n))
-        return render_frame_shared(scene, settings, team, progress, should_stop, history, clock)
+        result = render_frame_shared(scene, settings, team, progress, should_stop, history, clock)
+        if note:
+            result.stats["processes_note"] = note
+        return result
     if not isinstance(history, TemporalHistory):
         history = None
     t0 = time.perf_counter()
@@ -442,8 +454,10 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
         passes = fr.passes()
     samples_done = fr.samples_done
     fr.release()
-    return FrameResult(passes, samples_done, time.perf_counter() - t0, cancelled, frame_stats(fr, scene, clock),
-                       fr.history)
+    stats = frame_stats(fr, scene, clock)
+    if note:
+        stats["processes_note"] = note
+    return FrameResult(passes, samples_done, time.perf_counter() - t0, cancelled, stats, fr.history)
 
 
 def frame_stats(fr: FrameRenderer, scene: Scene, clock) -> dict:

@@ -20,6 +20,8 @@ DIRECT_REUSE = 720  # DI reservoirs, their target terms and G-buffer, this frame
 GI = 800          # GI reservoirs, their target terms and G-buffer, this frame's and the history's
 FIXED = 64 << 20  # bytes that do not grow with the image (tables, pools, the pool's threads)
 BVH_PER_TRIANGLE = 160  # Embree's BVH (outside NumPy)
+WORKER_FIXED = 128 << 20  # a worker process's own: its interpreter, NumPy, Embree and the core's tables
+WORKER_PER_PIXEL = 48     # a worker's private whole-image arrays (G-buffer slots, its copy of the history's M, W)
 
 
 @dataclass(frozen=True)
@@ -87,6 +89,16 @@ def available_memory() -> int | None:
         return int(os.sysconf("SC_PHYS_PAGES")) * int(os.sysconf("SC_PAGE_SIZE"))
     except (AttributeError, ValueError, OSError):
         return None
+
+
+def processes_that_fit(n: int, estimate: MemoryEstimate, triangles: int, free: int | None) -> int:
+    """The most worker processes, at most ``n``, that fit in ``free`` bytes with the frame (``estimate``: its
+    pixel buffers are shared by the workers, in shared memory): each worker adds its own WORKER_FIXED, its BVH and
+    WORKER_PER_PIXEL per pixel. At least 1 (the frame alone is judged by :func:`memory_problem`)."""
+    if free is None or n <= 1:
+        return max(1, n)
+    each = WORKER_FIXED + BVH_PER_TRIANGLE * int(triangles) + WORKER_PER_PIXEL * estimate.pixels
+    return max(1, min(n, int((free - estimate.high) // each)))
 
 
 def size_text(n: int) -> str:
