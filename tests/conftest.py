@@ -20,6 +20,23 @@ def addon():
     yield restir_engine
 
 
+@pytest.fixture(autouse=True)
+def _core_renders_in_this_process():
+    """The core renders in the test's own process unless a test asks for worker processes: an F12 through the
+    engine sets Render Properties > Performance > Processes (Auto) for every later render of the process, and tests
+    of the core read its internals (the history's arrays, patched functions) in this process."""
+    yield
+    from restir_engine.core.parallel import processes
+    processes.set_process_count(None)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _end_worker_processes():
+    yield
+    from restir_engine.core.parallel import processes
+    processes.shutdown()
+
+
 SUBJECTS = ("core", "restir", "materials", "blender", "cycles", "tools")
 # the long statistical suites, run alone with -m slow (or left out with -m "not slow")
 SLOW = {"cycles"}

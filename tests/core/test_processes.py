@@ -130,9 +130,12 @@ def test_a_worker_dying_in_a_render_ends_the_team_with_one_error_and_nothing_lef
     names = _segments(team)
     assert names and all(os.path.exists(f"/dev/shm/{n.lstrip('/')}") for n in names)
 
+    killed = []
+
     def kill_in_pass_two(fraction, label):
-        if label.startswith("Sample 2/"):
+        if label.startswith("Sample 2/") and not killed:
             os.kill(team.procs[1].pid, signal.SIGKILL)
+            killed.append(True)
 
     with pytest.raises(WorkerFailed, match=r"render worker process 1 \(pid \d+\) ended unexpectedly"):
         render_frame(scene, settings, progress=kill_in_pass_two, processes=3)

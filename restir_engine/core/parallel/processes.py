@@ -68,6 +68,7 @@ class WorkerTeam:
         ctx = mp.get_context("spawn")
         self.barrier = ctx.Barrier(self.size)
         self.stop = ctx.RawValue("b", 0)
+        self.progress = ctx.RawValue("d", 0.0)  # the leader's fraction of the pass in flight
         self.closed = False
         self.slot_segs, self.slot_bytes = [], 0
         self.film_seg = None
@@ -83,7 +84,8 @@ class WorkerTeam:
             for rank in range(self.size):
                 mine, theirs = ctx.Pipe()
                 p = ctx.Process(target=restir_worker_boot.main, name=f"restir-worker-{rank}", daemon=True,
-                                args=(CORE_DIR, rank, self.size, theirs, self.barrier, self.stop, self.threads))
+                                args=(CORE_DIR, rank, self.size, theirs, self.barrier, self.stop, self.progress,
+                                      self.threads))
                 p.start()
                 theirs.close()
                 self.conns.append(mine)
@@ -122,10 +124,11 @@ class WorkerTeam:
                 seg.unlink()
 
     # -- messages ------------------------------------------------------------------------------------------------
-    def run(self, msg, should_stop=None, timeout: float | None = None):
+    def run(self, msg, should_stop=None, timeout: float | None = None, on_poll=None):
         """Send ``msg`` to every worker and wait for all replies: the payloads (rank order), or None when the
-        pass was stopped (``should_stop()`` turned true, which stops every worker). Raises WorkerFailed when a
-        worker died or failed (the team is then closed)."""
+        pass was stopped (``should_stop()`` turned true, which stops every worker); ``on_poll()`` is called every
+        POLL_SECONDS while waiting. Raises WorkerFailed when a worker died or failed (the team is then
+        closed)."""
         if self.closed:
             raise WorkerFailed("the render worker processes were shut down")
         for c in self.conns:
@@ -135,6 +138,8 @@ class WorkerTeam:
         stopping, failure = False, None
         t0 = time.perf_counter()
         while pending:
+            if on_poll is not None:
+                on_poll()
             if not stopping and should_stop is not None and should_stop():
                 stopping = True
                 self.stop.value = 1

@@ -78,9 +78,15 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
             team._unlink([seg])
         done, cancelled = 0, False
         while done < settings.samples:
+            poll = None
             if progress:
-                progress(done / settings.samples, f"Sample {done + 1}/{settings.samples}")
-            replies = team.run(("pass", settings.samples - done), should_stop)
+                label = f"Sample {done + 1}/{settings.samples}"
+                progress(done / settings.samples, label)
+                team.progress.value = 0.0
+
+                def poll(done=done, label=label):  # the leader's share of its pass: one sample's worth
+                    progress((done + team.progress.value) / settings.samples, label)
+            replies = team.run(("pass", settings.samples - done), should_stop, on_poll=poll)
             if replies is None:
                 cancelled = True
                 break

@@ -3,7 +3,7 @@
 This file is imported on its own, from its folder on ``sys.path``, never as part of the add-on: the add-on's
 package imports bpy, which a worker cannot. It limits the worker's math libraries to one thread, ignores Ctrl+C
 (the rendering process stops its workers), exits when the rendering process is gone, loads the core package from
-``core_dir`` under the name ``restir_core`` and serves the rendering process (restir_core.parallel.worker).
+``core_dir`` under the name ``restir_core`` and serves the rendering process (restir_core.pipeline.worker).
 """
 import os
 import sys
@@ -40,5 +40,5 @@ def main(core_dir: str, *args) -> None:
     module = importlib.util.module_from_spec(spec)
     sys.modules["restir_core"] = module
     spec.loader.exec_module(module)
-    from restir_core.parallel import worker
+    from restir_core.pipeline import worker
     worker.serve(*args)

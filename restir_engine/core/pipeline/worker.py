@@ -16,16 +16,17 @@ import traceback
 
 import numpy as np
 
-from . import wire
-from .pool import set_thread_count
-from .team import Arena, Team
+from ..parallel import wire
+from ..parallel.pool import set_thread_count
+from ..parallel.team import Arena, Team
 
 KEEP_SCENES = 3  # scene segments a worker keeps attached (a context may still refer to the last frames' arrays)
 
 
 class _Worker:
-    def __init__(self, rank: int, size: int, conn, barrier, stop, threads: int):
+    def __init__(self, rank: int, size: int, conn, barrier, stop, progress, threads: int):
         self.rank, self.size, self.conn, self.barrier, self.stop = rank, size, conn, barrier, stop
+        self.progress = progress  # the leader's fraction of the pass in flight (a shared double)
         set_thread_count(max(1, int(threads)))
         self.team = None
         self.slot_names = None
@@ -61,7 +62,7 @@ class _Worker:
 
     # -- messages ----------------------------------------------------------------------------------------------
     def frame(self, frame: dict):
-        from ..pipeline.frame import FrameRenderer
+        from .frame import FrameRenderer
         from ..profile import StageClock
         self._slots(frame["slots"], frame["slot_bytes"], frame["costs"])
         zeros = self._film(frame["film"])
@@ -79,12 +80,18 @@ class _Worker:
     def sample_pass(self, left: int):
         fr = self.fr
         batch = fr.batch_size(int(left))
-        if not fr.sample_pass(None, self.team.stopping, batch):
+        report = None
+        if self.team.leader:
+            self.progress.value = 0.0
+
+            def report(fraction):
+                self.progress.value = fraction
+        if not fr.sample_pass(report, self.team.stopping, batch):
             return None
         return batch
 
     def finish(self, token: int):
-        from ..pipeline.frame import frame_stats
+        from .frame import frame_stats
         fr = self.fr
         out = None
         if self.team.leader:
@@ -131,5 +138,5 @@ class _Worker:
                 self.conn.send(("error", f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}"))
 
 
-def serve(rank: int, size: int, conn, barrier, stop, threads: int) -> None:
-    _Worker(rank, size, conn, barrier, stop, threads).serve()
+def serve(rank: int, size: int, conn, barrier, stop, progress, threads: int) -> None:
+    _Worker(rank, size, conn, barrier, stop, progress, threads).serve()
