@@ -110,6 +110,8 @@ def one(args) -> dict:
         procs = 1
     t0 = time.perf_counter()
     team = processes.team(procs) if procs > 1 else None
+    if team is not None:
+        team.run(("ping",))  # every worker started and imported the core
     start = time.perf_counter() - t0
     hist, rows, digest = None, [], None
     scenes = data["scenes"]

@@ -8,6 +8,7 @@ Messages (tuples from the rendering process; each is answered with ("ok", pickle
   ("pass", left)    render the next sample pass (at most ``left`` samples); payload: the samples it rendered
   ("finish", token) end the frame: keep its history under ``token``; the leader's payload: the frame's stats, data
                     passes and whether the film has reservoir passes
+  ("ping",)         answer once started (the core imported)
   ("quit",)         exit
 """
 from __future__ import annotations
@@ -121,7 +122,9 @@ class _Worker:
             if kind == "quit":
                 return
             try:
-                if kind == "frame":
+                if kind == "ping":
+                    out = None
+                elif kind == "frame":
                     out = self.frame(msg[1])
                 elif kind == "pass":
                     out = self.sample_pass(msg[1])
