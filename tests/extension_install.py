@@ -29,6 +29,12 @@ scene.render.filepath = out
 scene.render.image_settings.file_format = "PNG"
 bpy.ops.render.render(write_still=True)
 print("RENDERED", os.path.exists(out), flush=True)
+# a frame of 2 chunks in 2 worker processes, which load the installed copy's core without the add-on
+scene.render.resolution_x, scene.render.resolution_y = 256, 256
+scene.restir.samples, scene.restir.processes = 1, 2
+bpy.ops.render.render()
+team = sys.modules[mod.__name__ + ".core.parallel.processes"]._TEAM
+print("PROCESSES", team.size if team is not None and team.alive() else 0, flush=True)
 os._exit(0)
 """
 
@@ -39,6 +45,7 @@ class Installed:
     module: str     # the file the engine was imported from ('' when it was not)
     rendered: bool  # the frame was written
     output: str     # the process's stdout and stderr
+    processes: int  # worker processes alive after the second frame (0: none)
 
 
 def install_and_render(python: str, zip_path: str, folder: str, timeout: float = 600) -> Installed:
@@ -51,4 +58,6 @@ def install_and_render(python: str, zip_path: str, folder: str, timeout: float =
     p = subprocess.run([python, script, zip_path, out], capture_output=True, text=True, env=env, cwd=folder,
                        check=False, timeout=timeout)
     module = next((ln.split(" ", 1)[1] for ln in p.stdout.splitlines() if ln.startswith("MODULE")), "")
-    return Installed(p.returncode, module, "RENDERED True" in p.stdout and os.path.exists(out), p.stdout + p.stderr)
+    procs = next((int(ln.split()[1]) for ln in p.stdout.splitlines() if ln.startswith("PROCESSES")), 0)
+    return Installed(p.returncode, module, "RENDERED True" in p.stdout and os.path.exists(out), p.stdout + p.stderr,
+                     procs)

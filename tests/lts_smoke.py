@@ -89,6 +89,7 @@ def check_extension(tmp: str) -> None:
         return
     check("extension installs and renders", result.returncode == 0 and result.rendered and
           result.module.startswith(os.path.join(tmp, "user")), result.output[-800:])
+    check("extension renders in worker processes", result.processes == 2, result.output[-800:])
 
 if __name__ == "__main__":
     try:

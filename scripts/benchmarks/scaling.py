@@ -146,7 +146,8 @@ def run(args) -> None:
     cores = [c for c in cores if c <= avail]
     modes = args.modes.split(",")
     results = {"meta": {"machine": platform.processor() or platform.machine(), "logical_cores": os.cpu_count(),
-                        "python": platform.python_version(), "size": args.size, "tile": args.tile, "date": time.strftime("%Y-%m-%d")},
+                        "python": platform.python_version(), "size": args.size, "tile": args.tile,
+                        "date": time.strftime("%Y-%m-%d")},
                "runs": []}
     os.makedirs(args.out, exist_ok=True)
     for name, scene, settings, samples, frames in RUNS:

@@ -30,3 +30,4 @@ def test_built_extension_validates_installs_and_renders(tmp_path):
     assert result.returncode == 0, result.output[-6000:]
     assert result.module.startswith(str(tmp_path / "user")), result.module  # the installed copy, not the checkout
     assert result.rendered
+    assert result.processes == 2, result.output[-3000:]  # F12 in worker processes from the installed extension

@@ -200,3 +200,23 @@ def test_a_process_count_that_would_not_fit_in_memory_is_lowered_with_a_message(
     alone = render_frame(scene, settings, processes=3)
     assert "processes" not in alone.stats and "rendering with 1" in alone.stats["processes_note"]
     assert np.array_equal(alone.passes["Combined"], result.passes["Combined"])
+
+
+def test_esc_stops_every_worker_within_half_a_second():
+    """A stop asked half-way through the second pass of a 64-sample ReSTIR DI + GI frame (320x240, 2 processes of
+    its 2 chunks): the render returns within 0.5 s with the first pass, and every worker is free for the next."""
+    scene = regression_room(320, 240)
+    settings = RenderSettings(integrator="RESTIR", direct_method="RESTIR", indirect_method="RESTIR_GI", samples=64,
+                              max_bounces=4)
+    render_frame(scene, dataclasses.replace(settings, samples=1), processes=2)  # the team started
+    asked = {}
+
+    def progress(fraction, _label):
+        if fraction > 1.5 / 64 and "t" not in asked:
+            asked["t"] = time.perf_counter()
+
+    result = render_frame(scene, settings, progress=progress, should_stop=lambda: "t" in asked, processes=2)
+    latency = time.perf_counter() - asked["t"]
+    assert result.cancelled and result.samples_done == 1 and result.stats["processes"] == 2
+    assert latency < 0.5, f"stopped {latency:.2f} s after the request"
+    assert processes.team(2).alive()
