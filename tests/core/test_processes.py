@@ -220,3 +220,21 @@ def test_esc_stops_every_worker_within_half_a_second():
     assert result.cancelled and result.samples_done == 1 and result.stats["processes"] == 2
     assert latency < 0.5, f"stopped {latency:.2f} s after the request"
     assert processes.team(2).alive()
+
+
+def test_workers_that_cannot_start_leave_the_render_to_this_process_with_a_message(monkeypatch):
+    """A worker whose core fails to import (as where no Python can be spawned, or shared memory is missing): the
+    frame renders in this process, the stats say why, and later frames do not try again."""
+    processes.shutdown()
+    monkeypatch.setattr(processes, "_DISABLED", None)
+    monkeypatch.setattr(processes, "CORE_DIR", "/nonexistent/restir_core")
+    settings = SETTINGS["path-batched"]
+    scene = regression_room(*SIZE)
+    result = render_frame(scene, settings, processes=2)
+    assert "processes" not in result.stats
+    assert "render worker processes could not start" in result.stats["processes_note"]
+    assert processes._TEAM is None and processes._DISABLED
+    assert np.array_equal(result.passes["Combined"], render_frame(scene, settings, processes=1).passes["Combined"])
+    t0 = time.perf_counter()
+    again = render_frame(scene, settings, processes=2)
+    assert "could not start" in again.stats["processes_note"] and time.perf_counter() - t0 < 10

@@ -42,6 +42,11 @@ class WorkerFailed(RuntimeError):
     """A worker process died or raised: the frame is lost and the team is ended."""
 
 
+class WorkerStartFailed(WorkerFailed):
+    """Worker processes cannot start here (no shared memory, no Python to spawn, the core failing to import):
+    this process renders alone for the rest of the session."""
+
+
 @contextlib.contextmanager
 def _plain_main():
     """Spawned children re-import the parent's ``__main__`` from its file or module name; Blender's (a text block,
@@ -246,15 +251,29 @@ def split(threads: int | None, processes: int, chunks: int | None = None) -> tup
     return n, (max(1, cores // n) if n > 1 else cores)
 
 
+_DISABLED: str | None = None  # why worker processes could not start in this session (None: they can)
+
+
 def team(size: int, threads: int = 1) -> WorkerTeam:
-    """The persistent team of ``size`` workers (a new one when the size changed or the last one failed)."""
-    global _TEAM
+    """The persistent team of ``size`` workers (a new one when the size changed or the last one failed), started
+    and answering. Raises WorkerStartFailed when workers cannot start here (then for the rest of the session)."""
+    global _TEAM, _DISABLED
     with _TEAM_LOCK:
+        if _DISABLED is not None:
+            raise WorkerStartFailed(_DISABLED)
         if _TEAM is not None and (_TEAM.size != size or _TEAM.threads != threads or not _TEAM.alive()):
             _TEAM.close(kill=not _TEAM.alive())
             _TEAM = None
         if _TEAM is None:
-            _TEAM = WorkerTeam(size, threads)
+            try:
+                started = WorkerTeam(size, threads)
+                started.run(("ping",), timeout=START_TIMEOUT)
+            except Exception as exc:  # noqa: BLE001 - any failure to start means: render in this process
+                if "started" in locals():
+                    started.close(kill=True)
+                _DISABLED = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+                raise WorkerStartFailed(_DISABLED) from exc
+            _TEAM = started
         return _TEAM
 
 

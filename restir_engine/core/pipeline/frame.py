@@ -424,9 +424,14 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
             note = (f"{n} render processes would not fit in memory ({memory.size_text(free)} free, each needs its "
                     f"own copy of the scene's BVH): rendering with {fit}")
             n = fit
+    team = None
     if n > 1:
+        try:
+            team = procs.team(n, max(1, thread_count() // n))
+        except procs.WorkerStartFailed as exc:
+            note = f"render worker processes could not start ({exc}): rendering in one process"
+    if team is not None:
         from .shared_frame import render_frame_shared
-        team = procs.team(n, max(1, thread_count() // n))
         result = render_frame_shared(scene, settings, team, progress, should_stop, history, clock)
         if note:
             result.stats["processes_note"] = note
