@@ -102,7 +102,7 @@ class WorkerTeam:
     def ensure_slots(self, nbytes: int) -> list[str]:
         """Names of the three arena slots, each at least ``nbytes`` (new, larger ones replace smaller ones)."""
         if self.slot_bytes < nbytes:
-            self._unlink(self.slot_segs)
+            wire.unlink_segments(self.slot_segs)
             self.slot_bytes = int(nbytes)
             self.slot_segs = [wire.create_segment(self.slot_bytes) for _ in range(3)]
         return [s.name for s in self.slot_segs]
@@ -111,22 +111,14 @@ class WorkerTeam:
         """(segment name, zeros(shape) over it): the film's segment, zero-filled, at least ``nbytes``."""
         seg = self.film_seg
         if seg is None or seg.size < nbytes:
-            self._unlink([seg] if seg is not None else [])
+            wire.unlink_segments([seg] if seg is not None else [])
             seg = self.film_seg = wire.create_segment(nbytes)
         else:
             view = np.frombuffer(seg.buf, np.uint8, nbytes)
             view[:] = 0
             del view
-        from .team import Arena
-        arena = Arena(seg.buf, seg.name)
-        return seg.name, (lambda shape: arena.empty(shape, "float64"))
-
-    @staticmethod
-    def _unlink(segs) -> None:
-        for seg in segs:
-            wire.release_segment(seg)
-            with contextlib.suppress(FileNotFoundError, OSError):
-                seg.unlink()
+        from .team import film_zeros
+        return seg.name, film_zeros(seg)
 
     # -- messages ------------------------------------------------------------------------------------------------
     def run(self, msg, should_stop=None, timeout: float | None = None, on_poll=None):
@@ -210,7 +202,7 @@ class WorkerTeam:
                 p.join(1.0)
         for c in self.conns:
             c.close()
-        self._unlink(self.slot_segs + [self.costs_seg] + ([self.film_seg] if self.film_seg is not None else []))
+        wire.unlink_segments(self.slot_segs + [self.costs_seg] + ([self.film_seg] if self.film_seg is not None else []))
         self.slot_segs, self.film_seg = [], None
         with contextlib.suppress(Exception):
             atexit.unregister(self.close)

@@ -88,6 +88,13 @@ class Arena:
         return np.frombuffer(self.buffer, dtype, count, start).reshape(shape)
 
 
+def film_zeros(segment):
+    """zeros(shape) of a film (pipeline/film.Film) over a zero-filled shared segment: float64 arrays in the order
+    asked, so the rendering process and every worker see the same accumulators."""
+    arena = Arena(segment.buf, segment.name)
+    return lambda shape: arena.empty(shape, np.float64)
+
+
 class Team:
     """Member ``rank`` of ``size`` processes rendering a pass together. ``barrier`` is a multiprocessing.Barrier of
     ``size`` parties; ``slots`` three Arenas over the team's shared segments (see the module docstring); ``costs``

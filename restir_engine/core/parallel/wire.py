@@ -62,6 +62,16 @@ def release_segment(seg: shared_memory.SharedMemory) -> None:
         seg._buf = seg._mmap = None
 
 
+def unlink_segments(segs) -> None:
+    """Close and unlink segments this process created (names already gone are fine)."""
+    for seg in segs:
+        release_segment(seg)
+        try:
+            seg.unlink()
+        except OSError:  # FileNotFoundError included
+            pass
+
+
 def pack(obj):
     """(segment, description) of ``obj``: the description (bytes and names only) goes to the workers, the
     segment stays with the caller until no worker needs the object."""

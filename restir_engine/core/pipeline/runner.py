@@ -7,6 +7,7 @@ import time
 from ..parallel.tasks import Progress, map_tasks, spans
 from ..parallel.team import Solo
 from .plan import PassPlan
+from .work import frame_array, own
 
 
 class PassRunner:
@@ -37,14 +38,12 @@ class PassRunner:
             fn(c)
             team.record(c.index, time.perf_counter() - t0, segment)
 
-        map_tasks(timed, [c for c in chunks if team.owns_chunk(c.index)], self.stop)
+        map_tasks(timed, own(chunks, team), self.stop)
 
     def gather(self, kind, parts, n: int):
         """n reservoirs of ``kind`` from this process's (rows, Reservoirs) parts and every other member's: complete
         once the barrier passed."""
-        if self.team.size == 1:
-            return kind.gather(parts, n)
-        out = kind.allocate(n, self.team.empty)
+        out = frame_array(kind, n, self.team)
         for rows, part in parts:
             out.assign(rows, part)
         self.team.barrier()

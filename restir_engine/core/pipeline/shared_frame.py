@@ -72,10 +72,9 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         try:
             team.run(("frame", {"scene": packed, "settings": wire.dumps(settings), "sender": wire.core_name(),
                                 "history": history.token if usable else None, "film": film_name, "slots": slots,
-                                "costs": team.costs_seg.name,
-                                "slot_bytes": team.slot_bytes, "clock": clock is not None}))
+                                "costs": team.costs_seg.name, "clock": clock is not None}))
         finally:  # every worker attached (or the team is gone): the name is no longer needed
-            team._unlink([seg])
+            wire.unlink_segments([seg])
         done, cancelled = 0, False
         while done < settings.samples:
             poll = None

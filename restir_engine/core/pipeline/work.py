@@ -62,11 +62,17 @@ def own(chunks: list[Chunk], team) -> list[Chunk]:
     return chunks if team.size == 1 else [c for c in chunks if team.owns_chunk(c.index)]
 
 
+def frame_array(kind, n: int, team):
+    """n reservoirs of ``kind`` for the frame's whole-image stages: empty ones where this process renders alone,
+    the team's shared buffers (not initialized: every member writes its own rows) otherwise."""
+    return kind.empty(n) if team.size == 1 else kind.allocate(n, team.empty)
+
+
 def frame_reservoirs(chunks: list[Chunk], field: str, kind, n: int, team):
     """The chunks' reservoirs in ``field`` ("res" or "gi_res") as one frame-wide ``kind`` array of the frame's n
     surfaces (the reuse stages' input; in the team's shared buffers, complete after its barrier); the chunks let go
     of theirs."""
-    res = kind.empty(n) if team.size == 1 else kind.allocate(n, team.empty)
+    res = frame_array(kind, n, team)
     for c in own(chunks, team):
         res.assign(c.surfaces, getattr(c, field))
         setattr(c, field, None)  # the frame's array holds them now

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..parallel import wire
 from ..parallel.pool import set_thread_count
-from ..parallel.team import Arena, Team
+from ..parallel.team import Arena, Team, film_zeros
 
 KEEP_SCENES = 3  # scene segments a worker keeps attached (a context may still refer to the last frames' arrays)
 
@@ -39,7 +39,7 @@ class _Worker:
         self.history, self.history_token = None, None
 
     # -- segments --------------------------------------------------------------------------------------------
-    def _slots(self, names, size: int, costs: str) -> None:
+    def _slots(self, names, costs: str) -> None:
         if self.slot_names == (names, costs):
             return
         segs = [wire.attach_segment(n) for n in names + [costs]]
@@ -54,8 +54,7 @@ class _Worker:
             if self.film_seg is not None:
                 self._drop([self.film_seg])
             self.film_seg = wire.attach_segment(name)
-        arena = Arena(self.film_seg.buf, name)
-        return lambda shape: arena.empty(shape, "float64")
+        return film_zeros(self.film_seg)
 
     def _drop(self, segs) -> None:
         for seg in segs:
@@ -65,7 +64,7 @@ class _Worker:
     def frame(self, frame: dict):
         from .frame import FrameRenderer
         from ..profile import StageClock
-        self._slots(frame["slots"], frame["slot_bytes"], frame["costs"])
+        self._slots(frame["slots"], frame["costs"])
         zeros = self._film(frame["film"])
         scene = wire.unpack(frame["scene"], self.scenes)
         if len(self.scenes) > KEEP_SCENES:

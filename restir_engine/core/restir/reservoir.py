@@ -65,14 +65,6 @@ class Reservoirs:
         for name in self.fields():
             getattr(self, name)[rows] = getattr(other, name)
 
-    @classmethod
-    def gather(cls, parts, n: int) -> "Reservoirs":
-        """n reservoirs assembled from (rows, Reservoirs) parts (rows: index arrays or slices)."""
-        out = cls.empty(n)
-        for rows, part in parts:
-            out.assign(rows, part)
-        return out
-
     def replace(self, **arrays) -> "Reservoirs":
         """A set sharing this one's arrays except those given."""
         return type(self)(**{name: arrays.get(name, getattr(self, name)) for name in self.fields()})
