@@ -422,3 +422,22 @@ def glass_scene(size=(96, 64), only=None, window=False, roughness=None):
     black_world(scene)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def node_planes(graphs, cols: int, px: int = 16, name="Nodes"):
+    """Emission planes facing an orthographic camera, one per ``graphs`` entry in a grid of ``cols`` columns
+    (row 0 at the top), each ``px`` pixels square: ``graph(tree, color_socket)`` wires nodes into the Emission
+    shader's Color (strength 1). Planes are 1 x 1 with a UV map covering them; Generated coordinates span [0, 1]
+    over each, object coordinates [-0.5, 0.5]. No lights, a black world: each pixel is its pattern's radiance."""
+    scene = reset()
+    black_world(scene)
+    rows = (len(graphs) + cols - 1) // cols
+    for k, graph in enumerate(graphs):
+        r, c = divmod(k, cols)
+        mat = emission(f"{name}{k}", (1, 1, 1), 1.0)
+        tree = mat.node_tree
+        graph(tree, tree.nodes["Emission"].inputs["Color"])
+        _with_uvs(plane(f"{name}Plane{k}", 1.0, (c + 0.5 - cols / 2, rows / 2 - r - 0.5, 0), material=mat))
+    camera((0, 0, 5), (0, 0, 0), ortho_scale=max(cols, rows))
+    scene.render.resolution_x, scene.render.resolution_y = cols * px, rows * px
+    return scene

@@ -28,6 +28,8 @@ class TriangleSet:
     instance: np.ndarray | None = None  # (n,) int32 index into Scene.motion's instance matrices
     tangents: np.ndarray | None = None  # (n, 3, 4) per-corner UV tangent (xyz, world space) and bitangent sign,
     #                                     or None when no material has a normal map
+    objects: "ObjectTable | None" = None  # per instance: what node programs read of the object (or None)
+    attributes: dict | None = None  # colour attributes node programs read: name -> (n, 3 corners, 4) RGBA, linear
 
     @staticmethod
     def empty() -> TriangleSet:
@@ -36,6 +38,23 @@ class TriangleSet:
 
     def __len__(self) -> int:
         return len(self.verts)
+
+
+@dataclass
+class ObjectTable:
+    """What shader nodes read of each instance (index: TriangleSet.instance).
+
+    world_to_object (k, 3, 4)  the inverse of the instance's world matrix (affine rows)
+    texspace_lo, texspace_size (k, 3)  its texture space: Generated = (object position - lo) / size
+    location (k, 3) world-space origin; color (k, 4) the object's Color (RGBA); random (k,) Object Info Random
+    """
+
+    world_to_object: np.ndarray
+    texspace_lo: np.ndarray
+    texspace_size: np.ndarray
+    location: np.ndarray
+    color: np.ndarray
+    random: np.ndarray
 
 
 @dataclass
@@ -79,6 +98,11 @@ class MaterialTable:
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
+    program     (m,) int32  index into ``programs`` of the material's node program (-1 = none): fields that vary
+                        per hit ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness",
+                        "emission", "mix:<k>" the weight of Mix component k) evaluated at the hits
+                        (core/materials/nodes), replacing the row's constants
+    programs    list of nodes.program.Program
     textures    list of (h, w, 3) float32 linear images, row 0 at the bottom (Blender's order)
     names       material names, for messages
     """
@@ -116,6 +140,8 @@ class MaterialTable:
     mix_weight: np.ndarray = None
     mix_tex: np.ndarray = None
     mix_sign: np.ndarray = None
+    program: np.ndarray = None
+    programs: list = field(default_factory=list)
     textures: list = field(default_factory=list)
     names: list = field(default_factory=list)
 
@@ -140,7 +166,7 @@ class MaterialTable:
             glass_reflect=col("glass_reflect", (1.0, 1.0, 1.0)), glass_refract=col("glass_refract", (1.0, 1.0, 1.0)),
             glass_alpha=col("glass_alpha", 0.0), glass_multiscatter=col("glass_multiscatter", 1.0),
             diffuse_roughness=col("diffuse_roughness", 0.0),
-            **_mix_arrays(rows),
+            **_mix_arrays(rows), **_programs(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
 
 
@@ -157,6 +183,16 @@ def _mix_arrays(rows: list[dict]) -> dict:
     return {"mix_first": first, "mix_count": count, "mix_comp": np.array(cols[0], np.int32),
             "mix_weight": np.array(cols[1], np.float32), "mix_tex": np.array(cols[2], np.int32),
             "mix_sign": np.array(cols[3], np.float32)}
+
+
+def _programs(rows: list[dict]) -> dict:
+    """The program fields of :class:`MaterialTable` from rows' "program" entries (a Program or absent)."""
+    programs = [r["program"] for r in rows if r.get("program") is not None]
+    index, k = np.full(len(rows), -1, np.int32), 0
+    for i, r in enumerate(rows):
+        if r.get("program") is not None:
+            index[i], k = k, k + 1
+    return {"program": index, "programs": programs}
 
 
 DEFAULT_MATERIAL = {"name": "(default grey)", "base_color": (0.8, 0.8, 0.8), "roughness": 0.5, "f0": 0.04}

@@ -8,6 +8,8 @@ naming the material and the reason.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
@@ -15,6 +17,7 @@ from ..compat import uses_nodes
 from ..core.materials.textures import NearestImage
 from .images import TEXTURES, srgb_bytes_to_linear, unreadable_file
 from .limits import clamped_radiance
+from .node_graph import GraphCompiler
 
 # Mix/Add shader levels followed; deeper nests (Blender allows any) are cut off with a warning
 MAX_MIX_DEPTH = 256
@@ -57,11 +60,28 @@ class MaterialRegistry:
         return any(mapped(self.rows[i]) for i in indices)
 
     def uses_textures(self, indices) -> bool:
+        """Whether materials ``indices`` read UVs (an image, or a node program reading the UV map)."""
         def textured(row: dict) -> bool:
             if max(row.get(k, -1) for k in ("base_tex", "emit_tex", "alpha_tex", "normal_tex", "bump_tex")) >= 0:
                 return True
+            if row.get("program") is not None and "uv" in row["program"].reads:
+                return True
             return any(tex >= 0 or textured(self.rows[comp]) for comp, _w, tex, _s in row.get("mix", ()))
         return any(textured(self.rows[i]) for i in indices)
+
+    def attribute_names(self, indices) -> set:
+        """The colour / geometry attributes the node programs of materials ``indices`` read."""
+        names: set = set()
+
+        def collect(row: dict) -> None:
+            prog = row.get("program")
+            if prog is not None:
+                names.update(r.split(":", 1)[1] for r in prog.reads if r.startswith("attr"))
+            for comp, *_rest in row.get("mix", ()):
+                collect(self.rows[comp])
+        for i in indices:
+            collect(self.rows[i])
+        return names
 
     def table(self) -> MaterialTable:
         for row in self.rows:
@@ -86,19 +106,54 @@ class MaterialRegistry:
             return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
         return self._shader(material, outs[0].inputs["Surface"].links[0].from_node, depth=0)
 
+    def _compiler(self, material) -> GraphCompiler:
+        """A node-graph compiler for one row of ``material`` (images go to this registry's texture list)."""
+        return GraphCompiler(lambda image, alpha: self._texture(material, image, alpha=alpha),
+                             lambda reason: self._warn(material, reason))
+
+    def _param(self, material, g: GraphCompiler, socket, kind: str, field: str, varying: dict, row: dict | None = None,
+               key_tex: str | None = None):
+        """A socket's constant (float or RGB tuple); where its graph varies over the surface, its register goes to
+        ``varying[field]`` (the row's node program computes it) and a neutral constant is returned. ``key_tex``:
+        an Image Texture read plainly (UV, Linear or Closest, Repeat) goes to that row field instead."""
+        if key_tex is not None and row is not None:
+            tex = self._plain_image(material, socket)
+            if tex is not None:
+                row[key_tex] = tex
+                return (1.0, 1.0, 1.0)
+        reg = g.value(socket, kind)
+        if reg.const is not None:
+            return reg.constant_value()
+        varying[field] = reg
+        return (1.0, 1.0, 1.0) if kind == "color" else float(getattr(socket, "default_value", 0.0))
+
+    def _plain_image(self, material, socket) -> int | None:
+        """The texture index of an Image Texture's Color wired straight into ``socket`` and sampled as the fixed
+        texture path samples (the render UV map, Linear or Closest, Repeat), else None."""
+        link = socket.links[0] if socket.is_linked else None
+        node = link.from_node if link is not None else None
+        if (node is None or node.type != "TEX_IMAGE" or node.image is None or node.mute or link.is_muted
+                or link.from_socket.name != "Color" or node.inputs["Vector"].is_linked
+                or node.interpolation not in {"Linear", "Closest"} or node.extension != "REPEAT"
+                or node.projection != "FLAT"):
+            return None
+        return self._texture(material, node.image, closest=node.interpolation == "Closest")
+
     def _color_input(self, material, socket, key_tex: str, row: dict, fallback):
-        """Constant colour of a socket, or 1 with a texture index when an Image Texture drives it."""
+        """Constant colour of a socket (its graph folded), or 1 with a texture index when an Image Texture drives
+        it plainly (``key_tex``); a colour that varies otherwise is approximated by the socket's value (reported)."""
         if not socket.is_linked:
             return tuple(socket.default_value[:3])
-        node = socket.links[0].from_node
-        if node.type == "TEX_IMAGE" and node.image is not None and key_tex is not None:
-            if node.inputs["Vector"].is_linked:
-                self._warn(material, f"'{node.name}' has a mapped vector input; the active UV map is used instead")
-            row[key_tex] = self._texture(material, node.image, closest=node.interpolation == "Closest")
-            return (1.0, 1.0, 1.0)
-        if node.type == "RGB":
-            return tuple(node.outputs[0].default_value[:3])
-        self._warn(material, f"'{node.name}' ({node.type}) drives '{socket.name}'; approximated by the socket's value")
+        if key_tex is not None:
+            tex = self._plain_image(material, socket)
+            if tex is not None:
+                row[key_tex] = tex
+                return (1.0, 1.0, 1.0)
+        reg = self._compiler(material).value(socket, "color")
+        if reg.const is not None:
+            return reg.constant_value()
+        self._warn(material, f"'{socket.name}' of '{socket.node.name}' varies over the surface; approximated by the "
+                   "socket's value")
         return tuple(socket.default_value[:3]) if hasattr(socket, "default_value") else fallback
 
     def _multiscatter(self, material, node) -> float:
@@ -110,11 +165,14 @@ class MaterialRegistry:
         return 1.0
 
     def _float_input(self, material, socket) -> float:
+        """Constant value of a float socket (its graph folded); one that varies over the surface is approximated by
+        the socket's value (reported)."""
         if socket.is_linked:
-            node = socket.links[0].from_node
-            if node.type == "VALUE":
-                return float(node.outputs[0].default_value)
-            self._warn(material, f"'{node.name}' ({node.type}) drives '{socket.name}'; approximated by the socket's value")
+            reg = self._compiler(material).value(socket, "float")
+            if reg.const is not None:
+                return reg.constant_value()
+            self._warn(material, f"'{socket.name}' of '{socket.node.name}' varies over the surface; approximated by "
+                       "the socket's value")
         return float(socket.default_value)
 
     def _shader(self, material, node, depth: int) -> dict:
@@ -122,33 +180,39 @@ class MaterialRegistry:
         if t == "BSDF_PRINCIPLED":
             row: dict = {}
             inp = node.inputs
-            row["base_color"] = self._color_input(material, inp["Base Color"], "base_tex", row, (0.8, 0.8, 0.8))
-            row["metallic"] = self._float_input(material, inp["Metallic"])
-            row["roughness"] = self._float_input(material, inp["Roughness"])
-            ior = self._float_input(material, inp["IOR"]) if "IOR" in inp else 1.5
-            level = self._float_input(material, inp["Specular IOR Level"]) if "Specular IOR Level" in inp else 0.5
-            row["f0"] = float(np.clip(((ior - 1) / (ior + 1)) ** 2 * 2 * max(level, 0.0), 0, 1))
+            g, varying = self._compiler(material), {}
+            row["base_color"] = self._param(material, g, inp["Base Color"], "color", "base_color", varying, row,
+                                            "base_tex")
+            row["metallic"] = self._param(material, g, inp["Metallic"], "float", "metallic", varying)
+            row["roughness"] = self._param(material, g, inp["Roughness"], "float", "roughness", varying)
+            ior_reg = g.value(inp["IOR"], "float") if "IOR" in inp else g.constant(1.5, "float")
+            level = g.value(inp["Specular IOR Level"], "float") if "Specular IOR Level" in inp else \
+                g.constant(0.5, "float")
+            f0 = g.emit("principled_f0", {}, [ior_reg, level], ("float",))[0]
+            if f0.const is not None:
+                row["f0"] = f0.constant_value()
+            else:
+                varying["f0"] = f0
+            ior = ior_reg.constant_value() if ior_reg.const is not None else float(inp["IOR"].default_value)
             if "Specular Tint" in inp:
-                row["specular_tint"] = self._color_input(material, inp["Specular Tint"], None, row, (1, 1, 1))
+                row["specular_tint"] = self._param(material, g, inp["Specular Tint"], "color", "specular_tint",
+                                                   varying)
             row["multiscatter"] = self._multiscatter(material, node)
             if "Anisotropic" in inp and (inp["Anisotropic"].is_linked or float(inp["Anisotropic"].default_value) > 0):
                 self._warn(material, "Principled 'Anisotropic' is not supported; rendered isotropic")
-            strength = self._float_input(material, inp["Emission Strength"])
-            ec = self._color_input(material, inp["Emission Color"], "emit_tex", row, (0, 0, 0))
-            row["emission"] = tuple(np.array(ec, np.float32) * strength)
-            if row.get("emit_tex", -1) >= 0 and strength == 0:
-                row["emit_tex"] = -1
+            self._emission(material, g, inp["Emission Color"], inp["Emission Strength"], row, varying)
             for name in ("Coat Weight", "Sheen Weight", "Subsurface Weight"):
                 if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
                     self._warn(material, f"Principled '{name}' is not supported and was ignored")
             if "Transmission Weight" in inp:
                 self._principled_transmission(material, inp, row, ior)
             if "Diffuse Roughness" in inp:
-                row["diffuse_roughness"] = float(np.clip(self._float_input(material, inp["Diffuse Roughness"]), 0, 1))
+                dr = self._param(material, g, inp["Diffuse Roughness"], "float", "diffuse_roughness", varying)
+                row["diffuse_roughness"] = float(np.clip(dr, 0, 1))
             if "Alpha" in inp:
                 self._alpha(material, inp["Alpha"], row)
             self._normal(material, node, row)
-            return row
+            return self._with_program(row, g, varying)
         if t == "BSDF_GLASS":
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
             ior = self._float_input(material, node.inputs["IOR"])
@@ -163,31 +227,62 @@ class MaterialRegistry:
             return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transparent": True, "alpha": 0.0}
         if t == "BSDF_DIFFUSE":
             row = {"f0": 0.0, "metallic": 0.0}
-            row["base_color"] = self._color_input(material, node.inputs["Color"], "base_tex", row, (0.8, 0.8, 0.8))
-            row["diffuse_roughness"] = float(np.clip(self._float_input(material, node.inputs["Roughness"]), 0, 1))
+            g, varying = self._compiler(material), {}
+            row["base_color"] = self._param(material, g, node.inputs["Color"], "color", "base_color", varying, row,
+                                            "base_tex")
+            dr = self._param(material, g, node.inputs["Roughness"], "float", "diffuse_roughness", varying)
+            row["diffuse_roughness"] = float(np.clip(dr, 0, 1))
             self._normal(material, node, row)
-            return row
+            return self._with_program(row, g, varying)
         if t == "EMISSION":
             row = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
-            c = self._color_input(material, node.inputs["Color"], "emit_tex", row, (1, 1, 1))
-            row["emission"] = tuple(np.array(c, np.float32) * self._float_input(material, node.inputs["Strength"]))
-            return row
+            g, varying = self._compiler(material), {}
+            self._emission(material, g, node.inputs["Color"], node.inputs["Strength"], row, varying)
+            return self._with_program(row, g, varying)
         if t in {"BSDF_GLOSSY", "BSDF_ANISOTROPIC"}:
             # Cycles: GGX with the constant Fresnel "colour" (f0 = 0: no dielectric layer, no diffuse)
             row = {"metallic": 1.0, "f0": 0.0, "metal_f90": 0.0}
-            row["base_color"] = self._color_input(material, node.inputs["Color"], "base_tex", row, (0.8, 0.8, 0.8))
-            row["roughness"] = self._float_input(material, node.inputs["Roughness"])
+            g, varying = self._compiler(material), {}
+            row["base_color"] = self._param(material, g, node.inputs["Color"], "color", "base_color", varying, row,
+                                            "base_tex")
+            row["roughness"] = self._param(material, g, node.inputs["Roughness"], "float", "roughness", varying)
             row["multiscatter"] = self._multiscatter(material, node)
             if "Anisotropy" in node.inputs and (node.inputs["Anisotropy"].is_linked
                                                 or abs(float(node.inputs["Anisotropy"].default_value)) > 1e-4):
                 self._warn(material, "Glossy BSDF anisotropy is not supported; rendered isotropic")
             self._normal(material, node, row)
-            return row
+            return self._with_program(row, g, varying)
         if t in {"MIX_SHADER", "ADD_SHADER"}:
             return self._mix(material, node, depth)
         self._warn(material, f"shader '{node.name}' ({t}) is not supported; approximated by the viewport colour")
         return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                 "roughness": float(material.roughness), "f0": 0.04}
+
+    def _emission(self, material, g: GraphCompiler, color_socket, strength_socket, row: dict, varying: dict) -> None:
+        """Emission colour x strength -> the row's constant "emission" (with "emit_tex" for a plain image), or
+        the node program's "emission" where either varies over the surface."""
+        strength = g.value(strength_socket, "float")
+        if strength.const is not None:
+            s_val = strength.constant_value()
+            c = self._param(material, g, color_socket, "color", "emission_color", varying, row, "emit_tex")
+            if "emission_color" not in varying:
+                row["emission"] = tuple(float(x) * s_val for x in c)
+                if row.get("emit_tex", -1) >= 0 and s_val == 0:
+                    row["emit_tex"] = -1
+                return
+            color = varying.pop("emission_color")
+        else:
+            color = g.value(color_socket, "color")
+        varying["emission"] = g.emit("scale", {}, [color, strength], ("color",))[0]
+        row["emission"] = (0.0, 0.0, 0.0)
+
+    @staticmethod
+    def _with_program(row: dict, g: GraphCompiler, varying: dict) -> dict:
+        """The row with its node program (when some field varies)."""
+        prog = g.program(varying)
+        if prog is not None:
+            row["program"] = prog
+        return row
 
     def _principled_transmission(self, material, inp, row: dict, ior: float) -> None:
         """Principled Transmission Weight t: a smooth glass closure with probability (1 - Metallic) t (untinted
@@ -277,7 +372,11 @@ class MaterialRegistry:
         is the weighted sum of theirs. Components without a BSDF (Emission, empty sockets) drop out of the sum.
         A Transparent BSDF leaf becomes the row's alpha cut-out (opacity 1 - its weight) and the other components
         are renormalized (opaque points reflect with the full BSDF; exact for Mix trees, whose weights sum to 1)."""
+        if self._mix_varies(node, set()):
+            return self._mix_program(material, node, depth)
         parts = self._flatten(material, node, depth, 1.0, -1, 0.0)
+        if any(p[0].get("program") is not None and p[0]["program"].has("emission") for p in parts):
+            return self._mix_program(material, node, depth)
         comps, emission, emit_tex = [], np.zeros(3, np.float32), -1
         out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
         clear = [p for p in parts if p[0].get("transparent")]
@@ -312,6 +411,104 @@ class MaterialRegistry:
         if emit_tex >= 0:
             out["emit_tex"] = emit_tex
         return out
+
+    def _mix_varies(self, node, seen: set) -> bool:
+        """Whether a Mix/Add tree has a factor that varies over the surface other than a plain Image Texture
+        (those go to the fixed texture path)."""
+        if node.type not in {"MIX_SHADER", "ADD_SHADER"} or node.name in seen:
+            return False
+        seen.add(node.name)
+        if node.type == "MIX_SHADER":
+            fac = node.inputs["Fac"]
+            if fac.is_linked and fac.links[0].from_node.type not in {"TEX_IMAGE", "VALUE"}:
+                return True
+            if fac.is_linked and fac.links[0].from_node.type == "TEX_IMAGE":
+                img = fac.links[0].from_node
+                if (img.inputs["Vector"].is_linked or img.interpolation not in {"Linear", "Closest"}
+                        or img.extension != "REPEAT"):
+                    return True
+        return any(self._mix_varies(s.links[0].from_node, seen) for s in node.inputs
+                   if s.type == "SHADER" and s.is_linked)
+
+    def _mix_program(self, material, node, depth: int) -> dict:
+        """A Mix/Add tree whose weights vary over the surface: each leaf's weight (the sum over its paths of the
+        product of the factors along them, Fac clamped to [0, 1] as Cycles) and the weighted emission are outputs
+        of the mix row's node program ("mix:<k>" for component k, "emission"); components keep weight 1."""
+        g = self._compiler(material)
+        weights: dict = {}
+        order: list = []
+
+        def walk(nd, w, level):
+            if nd.type not in {"MIX_SHADER", "ADD_SHADER"}:
+                if nd.name in weights:
+                    weights[nd.name] = (nd, g.emit("add", {}, [weights[nd.name][1], w], ("float",))[0])
+                else:
+                    weights[nd.name] = (nd, w)
+                    order.append(nd.name)
+                return
+            if level >= MAX_MIX_DEPTH:
+                self._warn(material, f"shader mixes nested deeper than {MAX_MIX_DEPTH} levels are cut off")
+                return
+            shaders = [sk for sk in nd.inputs if sk.type == "SHADER"]
+            if nd.type == "ADD_SHADER":
+                ws = [w, w]
+            else:
+                fac = g.emit("saturate", {}, [g.value(nd.inputs["Fac"], "float")], ("float",))[0]
+                rest = g.emit("one_minus", {}, [fac], ("float",))[0]
+                ws = [g.emit("multiply", {}, [w, rest], ("float",))[0], g.emit("multiply", {}, [w, fac], ("float",))[0]]
+            for sk, ww in zip(shaders, ws):
+                if sk.is_linked:
+                    walk(sk.links[0].from_node, ww, level + 1)
+        walk(node, g.constant(1.0, "float"), 0)
+        out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
+        comps, outputs, emission = [], {}, None
+        for name in order:
+            leaf, w = weights[name]
+            row = self._shader(material, leaf, depth + 1)
+            if row.get("transparent"):
+                if w.const is None:
+                    self._warn(material, "a Transparent BSDF under a varying Mix factor is not supported; rendered "
+                               "opaque")
+                    continue
+                out["alpha"] = float(np.clip(1 - w.constant_value(), 0, 1))
+                out["mix_normalize"] = True
+                continue
+            if row.get("alpha", 1.0) < 1 or row.get("alpha_tex", -1) >= 0:
+                self._warn(material, "alpha inside a Mix/Add shader is ignored (rendered opaque)")
+            e = self._leaf_emission(g, leaf)
+            if e is not None:
+                e = g.emit("scale", {}, [e, w], ("color",))[0]
+                emission = e if emission is None else g.emit("add", {}, [emission, e], ("color",))[0]
+            if _has_bsdf(row):
+                comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, alpha=1.0, alpha_tex=-1,
+                            name=f"{material.name} ({len(comps) + 1})")
+                prog = comp.get("program")
+                if prog is not None and prog.has("emission"):
+                    comp["program"] = dataclasses.replace(prog, outputs={k: v for k, v in prog.outputs.items()
+                                                                         if k != "emission"})
+                if w.const is not None:
+                    comps.append((self.add_row(comp), w.constant_value(), -1, 0.0))
+                else:
+                    outputs[f"mix:{len(comps)}"] = w
+                    comps.append((self.add_row(comp), 1.0, -1, 0.0))
+        if emission is not None:
+            if emission.const is not None:
+                out["emission"] = emission.constant_value()
+            else:
+                outputs["emission"] = emission
+        out["mix"] = comps
+        return self._with_program(out, g, outputs)
+
+    def _leaf_emission(self, g: GraphCompiler, leaf):
+        """The emitted radiance of a Mix leaf as a register of ``g`` (None for a shader that does not emit)."""
+        if leaf.type == "EMISSION":
+            return g.emit("scale", {}, [g.value(leaf.inputs["Color"], "color"),
+                                        g.value(leaf.inputs["Strength"], "float")], ("color",))[0]
+        if leaf.type == "BSDF_PRINCIPLED":
+            e = g.emit("scale", {}, [g.value(leaf.inputs["Emission Color"], "color"),
+                                     g.value(leaf.inputs["Emission Strength"], "float")], ("color",))[0]
+            return None if e.const is not None and not np.any(e.const) else e
+        return None
 
     def _flatten(self, material, node, depth: int, weight: float, tex: int, sign: float) -> list:
         """[(row, weight, factor texture, sign)]: the leaves of a Mix/Add tree with the products of their constant

@@ -9,16 +9,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.scene import TriangleSet
+from ..core.scene import ObjectTable, TriangleSet
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "CURVES", "SURFACE", "FONT", "META"}
 MAX_COORD = 1e7  # beyond this float32 precision makes ray offsets meaningless
 
 
-def _read_mesh(mesh, want_uv: bool, want_tangents: bool = False, warnings: list | None = None) -> dict | None:
+def _read_mesh(mesh, want_uv: bool, want_tangents: bool = False, warnings: list | None = None,
+               attributes: frozenset = frozenset()) -> dict | None:
     """Local-space triangle arrays of a mesh datablock: verts (t,3,3), normals (t,3,3),
     uvs (t,3,2) or None, tangents (t,3,4) (MikkTSpace tangent of the UV map and bitangent sign) or None,
-    slot (t,) int32 material slot index."""
+    slot (t,) int32 material slot index, attributes {name: (t,3,4) RGBA} of the named colour / geometry
+    attributes it has ("" = its render colour attribute), texspace (lo (3,), size (3,))."""
     mesh.calc_loop_triangles()
     tris = mesh.loop_triangles
     nt = len(tris)
@@ -59,8 +61,85 @@ def _read_mesh(mesh, want_uv: bool, want_tangents: bool = False, warnings: list 
         except RuntimeError as e:  # n-gons: Blender computes tangents for triangles and quads only
             if warnings is not None:
                 warnings.append(f"Mesh '{mesh.name}': no tangents for its normal map ({e}); rendered without it")
-    return {"verts": co.reshape(-1, 3)[vidx].reshape(nt, 3, 3), "normals": nrm, "uvs": uvs, "slot": slot,
-            "tangents": tangents}
+    attrs = {}
+    for name in attributes:
+        got = _read_attribute(mesh, name, vidx, loops, nt)
+        if got is not None:
+            attrs[name] = got
+    local = co.reshape(-1, 3)
+    return {"verts": local[vidx].reshape(nt, 3, 3), "normals": nrm, "uvs": uvs, "slot": slot,
+            "tangents": tangents, "attributes": attrs, "texspace": _texspace(mesh, local)}
+
+
+def _texspace(mesh, local: np.ndarray) -> tuple:
+    """(lo, size) of a mesh's texture space: Generated = (local position - lo) / size (Blender's auto texture
+    space is its box; a flat axis gets size 2 around its centre, a tiny one 2e-5)."""
+    if getattr(mesh, "use_auto_texspace", True) or not hasattr(mesh, "texspace_location"):
+        lo, hi = (local.min(0), local.max(0)) if len(local) else (np.zeros(3), np.zeros(3))
+        loc, half = (lo + hi) / 2, (hi - lo) / 2
+    else:
+        loc, half = np.array(mesh.texspace_location[:], np.float64), np.array(mesh.texspace_size[:], np.float64)
+    half = np.where(half == 0, 1.0, np.where(np.abs(half) < 1e-5, np.copysign(1e-5, half), half))
+    return (loc - half).astype(np.float32), (2 * half).astype(np.float32)
+
+
+def _read_attribute(mesh, name: str, vidx, loops, nt: int):
+    """(t, 3, 4) RGBA corner values of a colour attribute (or a float / vector geometry attribute), linear; None
+    when the mesh has none of that name."""
+    attr = None
+    if name == "":
+        ca = mesh.color_attributes
+        idx = getattr(ca, "render_color_index", -1)
+        attr = ca[idx] if 0 <= idx < len(ca) else (ca[0] if len(ca) else None)
+    else:
+        attr = mesh.attributes.get(name)
+    if attr is None:
+        return None
+    n = len(attr.data)
+    if attr.data_type in {"FLOAT_COLOR", "BYTE_COLOR"}:
+        buf = np.empty(n * 4, np.float32)
+        attr.data.foreach_get("color", buf)  # scene-linear for both storage types
+        vals = buf.reshape(n, 4)
+    elif attr.data_type in {"FLOAT_VECTOR", "FLOAT2", "FLOAT"}:
+        width = {"FLOAT_VECTOR": 3, "FLOAT2": 2, "FLOAT": 1}[attr.data_type]
+        buf = np.empty(n * width, np.float32)
+        attr.data.foreach_get("vector" if width > 1 else "value", buf)
+        vals = np.ones((n, 4), np.float32)
+        vals[:, :3] = 0
+        if width == 1:
+            vals[:, :3] = buf[:, None]
+        else:
+            vals[:, :width] = buf.reshape(n, width)
+    else:
+        return None
+    if attr.domain == "POINT":
+        return vals[vidx].reshape(nt, 3, 4)
+    if attr.domain == "CORNER":
+        return vals[loops].reshape(nt, 3, 4)
+    if attr.domain == "FACE":
+        poly = np.empty(nt, np.int32)
+        mesh.loop_triangles.foreach_get("polygon_index", poly)
+        return np.repeat(vals[poly][:, None], 3, axis=1)
+    return None
+
+
+def hash_string(name: str) -> int:
+    """Cycles' string hash (h = 37 h + byte over the UTF-8 bytes, uint32)."""
+    h = 0
+    for b in name.encode():
+        h = (h * 37 + b) & 0xFFFFFFFF
+    return h
+
+
+def object_random(inst) -> float:
+    """Object Info Random of an instance, as Cycles: the depsgraph's random id for instances, a hash of the
+    object's name otherwise; float32(id) · 2⁻³²."""
+    from ..core.materials.nodes.hashing import hash_uint
+    if inst.is_instance:
+        rid = int(inst.random_id) & 0xFFFFFFFF
+    else:
+        rid = int(hash_uint(np.uint32(hash_string(inst.object.name)), np.uint32(0)))
+    return float(np.float32(rid) * np.float32(1.0 / 4294967296.0))
 
 
 def instance_key(inst) -> tuple:
@@ -118,8 +197,9 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
         if key not in cache:
             want_uv = registry.uses_textures(slot_cache[mats_key])
             want_tangents = registry.uses_normal_maps(slot_cache[mats_key])
+            want_attrs = frozenset(registry.attribute_names(slot_cache[mats_key]))
             # the name guards against a freed mesh's address reused by another one
-            kept = (key, data.name_full if data is not None else obj.name_full, want_uv, want_tangents)
+            kept = (key, data.name_full if data is not None else obj.name_full, want_uv, want_tangents, want_attrs)
             if mesh_cache is not None and kept in mesh_cache:
                 cache[key] = mesh_cache[kept]
             else:
@@ -131,7 +211,7 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
                     cache[key] = None
                     continue
                 try:
-                    cache[key] = _read_mesh(mesh, want_uv, want_tangents, warnings)
+                    cache[key] = _read_mesh(mesh, want_uv, want_tangents, warnings, want_attrs)
                     reads += 1
                 finally:
                     obj.to_mesh_clear()
@@ -141,7 +221,7 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
         if arrays is None:
             continue
         blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name,
-                       instance_key(inst)))
+                       instance_key(inst), (tuple(obj.color), object_random(inst))))
 
     if not blocks:
         return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0, "instance_keys": [],
@@ -157,8 +237,10 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
     need_tangents = any(b[0]["tangents"] is not None for b in blocks)
     # a mesh without tangents gets zero ones: its normal map then leaves the normal as it is (m_z N)
     tangents = np.zeros((total, 3, 4), np.float32) if need_tangents else None
+    attr_names = sorted({a for b in blocks for a in b[0].get("attributes", {})})
+    attributes = {a: np.zeros((total, 3, 4), np.float32) for a in attr_names}
     at = 0
-    for k, (arrays, m, slot_map, _name, _key) in enumerate(blocks):  # per instance, vectorized over triangles
+    for k, (arrays, m, slot_map, _name, _key, _info) in enumerate(blocks):  # per instance, vectorized over triangles
         n = len(arrays["verts"])
         lin = m[:3, :3]
         verts[at:at + n] = (arrays["verts"].reshape(-1, 3) @ lin.T + m[:3, 3]).reshape(n, 3, 3)
@@ -173,6 +255,8 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
         instance[at:at + n] = k
         if uvs is not None and arrays["uvs"] is not None:
             uvs[at:at + n] = arrays["uvs"]
+        for a, vals in arrays.get("attributes", {}).items():
+            attributes[a][at:at + n] = vals
         if tangents is not None and arrays["tangents"] is not None:
             tw = arrays["tangents"][..., :3].reshape(-1, 3) @ lin.T   # surface vectors move with the linear part
             tw /= np.maximum(np.linalg.norm(tw, axis=1), 1e-30)[:, None]
@@ -197,6 +281,7 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
     if not keep.all():
         verts, normals, material, instance = verts[keep], normals[keep], material[keep], instance[keep]
         uvs = uvs[keep] if uvs is not None else None
+        attributes = {a: v[keep] for a, v in attributes.items()}
         tangents = tangents[keep] if tangents is not None else None
     bad_n = ~np.isfinite(normals).all(axis=2)
     if bad_n.any():
@@ -204,7 +289,21 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
     stats = {"triangles": len(verts), "instances": len(blocks), "dropped": int((~keep).sum()),
              "instance_keys": [b[4] for b in blocks], "instance_matrices": np.array([b[1] for b in blocks]),
              "meshes_read": reads, "slot_signature": tuple(slots_seen)}
-    return TriangleSet(verts, normals, material, uvs, instance, tangents), stats
+    return TriangleSet(verts, normals, material, uvs, instance, tangents, objects=_object_table(blocks),
+                       attributes=attributes or None), stats
+
+
+def _object_table(blocks) -> ObjectTable:
+    """What shader nodes read of each exported instance (world matrix inverse, texture space, Object Info)."""
+    from ..core.scene import affine_inverse
+    mats = np.array([b[1] for b in blocks], np.float64)
+    inv = affine_inverse(mats)[:, :3, :].astype(np.float32)
+    lo = np.array([b[0]["texspace"][0] for b in blocks], np.float32)
+    size = np.array([b[0]["texspace"][1] for b in blocks], np.float32)
+    return ObjectTable(world_to_object=inv, texspace_lo=lo, texspace_size=size,
+                       location=mats[:, :3, 3].astype(np.float32),
+                       color=np.array([b[5][0] for b in blocks], np.float32).reshape(len(blocks), 4),
+                       random=np.array([b[5][1] for b in blocks], np.float32))
 
 
 def _spans(blocks):

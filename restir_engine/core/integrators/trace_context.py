@@ -38,6 +38,7 @@ class TraceContext:
     normal_maps: bool = False  # some material has a tangent-space normal map (surface.normal_map)
     bump_maps: bool = False    # some material has a Bump node (surface.bump_map)
     has_glass: bool = False    # some material has a smooth glass closure (core/materials/glass.py)
+    has_programs: bool = False  # some material has a node program (core/materials/nodes)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -136,6 +137,7 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         bump_maps=scene.materials.bump_tex is not None and bool((scene.materials.bump_tex >= 0).any()),
                         has_glass=scene.materials.transmission is not None
                         and bool((scene.materials.transmission > 0).any()),
+                        has_programs=bool(getattr(scene.materials, "programs", None)),
                         world=world,
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)

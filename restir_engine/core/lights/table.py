@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..materials.nodes import HitAttributes, emission_programs, run_programs
 from ..materials.params import luminance
 from ..materials.textures import apply_texture, mean_color
 from ..sampling import AliasTable, barycentric, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
@@ -74,7 +75,38 @@ def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarra
         c = np.take(tris.uvs, tri, axis=0)
         uv = barycentric(c[:, 0], c[:, 1], c[:, 2], b1[:, None], b2[:, None])  # (n, 2) texture coordinates
         le = apply_texture(le, materials.emit_tex[mat], uv, materials.textures)
-    return np.ascontiguousarray(le.T, dtype=np.float32)
+    le = np.ascontiguousarray(le.T, dtype=np.float32)
+    for rows, out in run_programs(materials, mat, lambda r: HitAttributes(tris, tri[r], b1[r], b2[r],
+                                                                          materials.textures), ("emission",)):
+        le[:, rows] = out["emission"]
+    return le
+
+
+#: points per triangle at which an emission program is evaluated to estimate the triangle's power: the centroid,
+#: the midpoints towards the corners and the corners (barycentrics b1, b2)
+_POWER_POINTS = np.array([[1 / 3, 1 / 3], [2 / 3, 1 / 6], [1 / 6, 2 / 3], [1 / 6, 1 / 6],
+                          [1, 0], [0, 1], [0, 0]], np.float32)
+
+
+def program_emission_density(tris: TriangleSet, materials: MaterialTable) -> tuple:
+    """(triangles, luminance (k,)) of the triangles whose material's node program computes the emission: the mean
+    emitted luminance over :data:`_POWER_POINTS` (for power-proportional selection), at least a tenth of their
+    material's mean over all of them (a triangle whose points happen to be dark still gets picked), and a tiny
+    positive value where the material is dark at every point (hits on it still count its emission)."""
+    prog = emission_programs(materials)
+    tri = np.flatnonzero(prog[tris.material]) if len(tris) else EMPTY
+    if not tri.size:
+        return tri, np.zeros(0, np.float32)
+    k = len(_POWER_POINTS)
+    pts = np.repeat(tri, k)
+    b = np.tile(_POWER_POINTS, (tri.size, 1))
+    le = emitted_radiance(tris, materials, pts, b[:, 0], b[:, 1])
+    dens = np.maximum(luminance(le.T), 0).reshape(tri.size, k).mean(axis=1)
+    mat = tris.material[tri]
+    sums = np.bincount(mat, dens, minlength=len(materials.emission))
+    counts = np.maximum(np.bincount(mat, minlength=len(materials.emission)), 1)
+    floor = (sums / counts)[mat] * 0.1
+    return tri, np.maximum(np.maximum(dens, floor), 1e-12).astype(np.float32)
 
 
 def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -122,8 +154,14 @@ class LightTable:
         emit_lum = luminance(mats.emission)
         tex_mean = np.array([luminance(mean_color(t)[None])[0] for t in mats.textures], np.float32)
         emit_scale = np.where(mats.emit_tex >= 0, tex_mean[np.maximum(mats.emit_tex, 0)] if len(tex_mean) else 0.0, 1.0)
-        mat_power_density = emit_lum * emit_scale * np.where(mats.two_sided_emission, 2.0, 1.0) * np.pi
-        g_idx = np.flatnonzero(mat_power_density[geom.material] > 0) if len(geom) else np.zeros(0, np.int64)
+        sides = np.where(mats.two_sided_emission, 2.0, 1.0) * np.pi
+        mat_power_density = emit_lum * emit_scale * sides
+        geom_density = mat_power_density[geom.material] if len(geom) else np.zeros(0)
+        prog_tri, prog_density = program_emission_density(geom, mats)
+        if prog_tri.size:  # emission from node programs: per triangle
+            geom_density = geom_density.copy()
+            geom_density[prog_tri] = prog_density * sides[geom.material[prog_tri]]
+        g_idx = np.flatnonzero(geom_density > 0) if len(geom) else np.zeros(0, np.int64)
         # lamp entries: area-light triangles, and the first proxy triangle of each point/spot sphere
         first_of_sphere = (lamps.sphere_first < 0) | (lamps.sphere_first == np.arange(len(lamps.sphere_first)))
         l_idx = np.flatnonzero((mat_power_density[lamps.tris.material] > 0) & first_of_sphere) if len(lamps.tris) \
@@ -153,11 +191,15 @@ class LightTable:
         self.tri_le = mats.emission[tri_mat].astype(np.float32) if len(tri_mat) else np.zeros((0, 3), np.float32)
         tri_uvs = len(tri_mat) and (geom.uvs is not None or lamps.tris.uvs is not None)
         self.tri_textured = (mats.emit_tex[tri_mat] >= 0) if tri_uvs else np.zeros(len(tri_mat), bool)
+        if prog_tri.size:  # emission from node programs: evaluated at each point, like a texture
+            self.tri_textured = self.tri_textured | emission_programs(mats)[tri_mat]
         self.any_textured = bool(self.tri_textured.any())
         self.rows_le = np.ascontiguousarray(self.tri_le.T)
         self.any_spots = bool(len(lamps.tris) and (lamps.spot_cos[l_idx] > -1.5).any())
         # power (W, luminance-weighted) decides selection; zero-area triangles get zero power
-        tri_power = mat_power_density[tri_mat] * self.tri_area if len(tri_mat) else np.zeros(0, np.float32)
+        tri_density = np.concatenate([geom_density[g_idx], mat_power_density[lamps.tris.material[l_idx]]]) \
+            if len(tri_mat) else np.zeros(0)
+        tri_power = tri_density * self.tri_area if len(tri_mat) else np.zeros(0, np.float32)
         sun_power = luminance(lamps.sun_irradiance) * np.pi * scene_radius ** 2 if len(lamps.sun_dir) else np.zeros(0)
         self.n_tri = len(self.tri_verts)
         self.n_geom = len(g_idx)

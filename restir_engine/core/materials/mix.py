@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .nodes import run_programs
 from .textures import sample
 
 
@@ -27,10 +28,13 @@ def hash_uniform(prim: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return (h >> np.uint32(8)).astype(np.float32) * np.float32(1.0 / (1 << 24))
 
 
-def pick_components(mats, mat: np.ndarray, rows: np.ndarray, xi: np.ndarray, uv: np.ndarray | None):
+def pick_components(mats, mat: np.ndarray, rows: np.ndarray, xi: np.ndarray, uv: np.ndarray | None,
+                    attrs_of=None):
     """For hits ``rows`` (k,) on mixed materials ``mat[rows]``: the picked component material (k,) and the BSDF scale
     W (k,) (0 where every weight is 0; 1 for renormalized mixes, whose transparent share is a cut-out). ``xi`` (k,)
-    uniforms; ``uv`` (k, 2) the hits' UVs (None: no textures)."""
+    uniforms; ``uv`` (k, 2) the hits' UVs (None: no textures); ``attrs_of(sub)`` the HitAttributes of hits
+    ``rows[sub]``, for mixes whose node program computes the weights ("mix:<j>" of component j, replacing its
+    constant weight)."""
     m = mat[rows]
     first, count = mats.mix_first[m], mats.mix_count[m]
     width = int(count.max())
@@ -44,6 +48,12 @@ def pick_components(mats, mat: np.ndarray, rows: np.ndarray, xi: np.ndarray, uv:
             r, c = np.nonzero(tex == t)
             val = np.clip(sample(mats.textures[t], uv[r])[:, 0], 0, 1)
             w[r, c] *= np.where(mats.mix_sign[k[r, c]] > 0, val, 1 - val)
+    if attrs_of is not None:
+        for sub, out in run_programs(mats, m, attrs_of):
+            for j in range(width):
+                got = out.get(f"mix:{j}")
+                if got is not None:
+                    w[sub, j] = np.maximum(got, 0) * valid[sub, j]
     total = w.sum(axis=1)
     cdf = np.cumsum(w, axis=1)
     pick = np.minimum((cdf <= (xi * total)[:, None]).sum(axis=1), count - 1)

@@ -8,12 +8,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..sampling import barycentric, cols, dot, norm, orthonormal_basis
+from . import microfacet_tables
 from .bsdf import ViewTerms
 from .glass import GLASS_SALT
 from .microfacet_tables import lerp_rows, mu_index
 from .mix import hash_uniform, pick_components
+from .nodes import HitAttributes, run_programs
 from .params import SurfaceParams
 from .textures import apply_texture, gradient, sample
+
+
+#: the BSDF fields a material's node program may compute (scene.MaterialTable.program)
+PARAM_FIELDS = ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness")
 
 
 class Surface:
@@ -28,7 +34,7 @@ class Surface:
         self.p = (o + d * t).astype(np.float32, copy=False)
         mat = geom.material[prim].astype(np.intp)
         self.mat = mat  # the triangle's material (a Mix/Add shader stays itself here)
-        mat, scale = self._pick_mix_components(ctx, mat)
+        mat, scale = self._pick_mix_components(ctx, mat, d)
         ng = cols(ctx.geom_ng_rows, prim)
         ns = self._interpolated_normal(ctx, ng)
         ns, mapped, smooth_n = self._mapped_normal(ctx, mat, ns, ng, d)
@@ -49,13 +55,15 @@ class Surface:
         # up once per hit when first used (α and η are constant per material: one interpolation in μo)
         self._mu, self._tables = mu, (ctx.material_albedo, ctx.material_layer)
         self._at = self._albedo = self._layer = None
+        if self._varying is not None:  # α or F0 vary per hit there: their tables at each hit's own (α, μo, F0)
+            self._per_hit_tables(self._varying)
 
     def _uv(self, geom, rows) -> np.ndarray:
         """(k, 2) texture coordinates of the hits ``rows``."""
         c = np.take(geom.uvs, self.prim[rows], axis=0)
         return barycentric(c[:, 0], c[:, 1], c[:, 2], self.b1[rows][:, None], self.b2[rows][:, None])
 
-    def _pick_mix_components(self, ctx, mat):
+    def _pick_mix_components(self, ctx, mat, d):
         """Mix/Add shaders: one component per hit, scaled by the weights' sum (core/materials/mix.py). Returns
         (the material each hit uses (n,), the scale (n,) float32 or None where no hit is mixed)."""
         if not ctx.has_mix:
@@ -66,7 +74,10 @@ class Surface:
             return mat, None
         prim, u, v = self.prim, self.b1, self.b2
         uv = self._uv(geom, mixed) if geom.uvs is not None else None
-        comp, w = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv)
+        def attrs_of(rows):  # the mixed hits ``rows`` (indices into ``mixed``), for weights from node programs
+            r = mixed[rows]
+            return HitAttributes(geom, prim[r], u[r], v[r], mats.textures, wo=-cols(d, r))
+        comp, w = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv, attrs_of)
         mat = mat.copy()
         mat[mixed] = comp
         scale = np.ones(len(mat), np.float32)
@@ -124,8 +135,43 @@ class Surface:
                 tm = mat[textured]
                 base = apply_texture(mats.base_color[tm], mats.base_tex[tm], uv, mats.textures)
                 self.params.assign(textured, SurfaceParams.of_table(mats, tm, base))
+        self._varying = self._node_params(ctx, mat) if ctx.has_programs else None
         if scale is not None:
             self.params.scale(scale)
+
+    def _node_params(self, ctx, mat):
+        """BSDF parameters from the materials' node programs at their hits (core/materials/nodes): the hits'
+        parameters re-derived with the fields the programs compute. Returns the hits whose α or F0 now vary
+        (indices) or None."""
+        mats, geom = ctx.scene.materials, ctx.scene.geometry
+        varying = []
+        for rows, out in run_programs(mats, mat, lambda r: HitAttributes(
+                geom, self.prim[r], self.b1[r], self.b2[r], mats.textures, wo=cols(self.wo, r),
+                normal=cols(self.ns, r), true_normal=cols(self.ng, r)), PARAM_FIELDS):
+            if not out:
+                continue
+            tm = mat[rows]
+            base = out["base_color"].T if "base_color" in out else mats.base_color[tm]
+            if "base_color" not in out and geom.uvs is not None and (mats.base_tex[tm] >= 0).any():
+                base = apply_texture(base, mats.base_tex[tm], self._uv(geom, rows), mats.textures)
+            dr = out.get("diffuse_roughness", mats.diffuse_roughness[tm])
+            self.params.assign(rows, SurfaceParams.from_material(
+                base, out.get("metallic", mats.metallic[tm]), out.get("roughness", mats.roughness[tm]),
+                out.get("f0", mats.f0[tm]), out["specular_tint"].T if "specular_tint" in out else mats.specular_tint[tm],
+                mats.metal_f90[tm], mats.multiscatter[tm], dr))
+            if "roughness" in out or "f0" in out:
+                varying.append(rows)
+        return np.concatenate(varying) if varying else None
+
+    def _per_hit_tables(self, rows) -> None:
+        """The GGX albedo and the layer factor at hits ``rows`` from their own α and F0 (the per-material rows
+        assume the material's constants)."""
+        albedo, layer = self.albedo.copy(), self.layer.copy()
+        p = self.params.take(rows)
+        mu = self._mu[rows]
+        albedo[rows] = microfacet_tables.albedo(p.alpha, mu)
+        layer[rows] = microfacet_tables.layer_s(p.alpha, mu, p.f0r)
+        self._albedo, self._layer = albedo, layer
 
     def _glass(self, ctx, mat, scale, s_ng) -> None:
         """Smooth glass (core/materials/glass.py): picked per point with the material's transmission share; black

@@ -1,0 +1,130 @@
+"""The attributes a node program reads at a batch of surface points, computed on first use.
+
+World-space vectors are (3, n) float32 rows; normals face the viewer where the view is known. Names (as the
+exporter's programs read them): "position", "normal" (shading), "true_normal", "incoming" (towards the viewer),
+"backfacing" (1 or 0), "uv" (u, v, 0), "generated" (the object's texture space, [0, 1] over its box),
+"object" (object-space position), "object_normal", "reflection", "parametric", "object_location",
+"object_color", "object_alpha", "object_random", and "attr:<name>" / "attr_alpha:<name>" for a colour attribute
+(RGB and alpha, linear)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ...sampling import barycentric, dot, norm
+
+_F = np.float32
+
+
+class HitAttributes:
+    """Surface points on triangles ``prim`` of ``tris`` (scene.TriangleSet) at barycentrics (b1, b2); ``wo``
+    (3, n) towards the viewer, ``normal`` and ``true_normal`` (3, n) facing it, when the caller has them;
+    ``textures``: the material table's images."""
+
+    def __init__(self, tris, prim, b1, b2, textures, wo=None, normal=None, true_normal=None):
+        self.tris, self.prim = tris, np.asarray(prim, np.intp)
+        self.b1, self.b2 = np.asarray(b1, np.float32), np.asarray(b2, np.float32)
+        self.textures = textures
+        self._cache = {}
+        if wo is not None:
+            self._cache["incoming"] = wo
+        if normal is not None:
+            self._cache["normal"] = normal
+        if true_normal is not None:
+            self._cache["true_normal"] = true_normal
+        self._wo = wo
+
+    def __len__(self) -> int:
+        return len(self.prim)
+
+    def get(self, name: str):
+        got = self._cache.get(name)
+        if got is None:
+            got = self._cache[name] = self._compute(name)
+        return got
+
+    def _corners(self, data):
+        c = np.take(data, self.prim, axis=0)  # (n, 3 corners, k)
+        return barycentric(c[:, 0].T, c[:, 1].T, c[:, 2].T, self.b1, self.b2).astype(np.float32)
+
+    def _geometric(self):
+        v = np.take(self.tris.verts, self.prim, axis=0)
+        ng = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]).T
+        return (ng / np.maximum(norm(ng), _F(1e-30))).astype(np.float32)
+
+    def _facing(self, n):
+        wo = self._wo
+        if wo is None:
+            return n
+        return np.where(dot(self._geometric(), wo) < 0, -n, n).astype(np.float32)
+
+    def _instances(self):
+        inst = self.tris.instance
+        objs = getattr(self.tris, "objects", None)
+        if inst is None or objs is None or len(objs.world_to_object) == 0:
+            return None, None
+        return np.take(inst, self.prim), objs
+
+    def _compute(self, name: str):
+        n = len(self.prim)
+        if name == "position":
+            return self._corners(self.tris.verts)
+        if name == "true_normal":
+            return self._facing(self._geometric())
+        if name == "normal":
+            s = self._corners(self.tris.normals)
+            ln = norm(s)
+            ok = np.isfinite(ln) & (ln > 0.5)
+            s = np.where(ok, s / np.where(ok, ln, 1), self._geometric())
+            return self._facing(s.astype(np.float32))
+        if name == "incoming":
+            return self.get("normal")
+        if name == "backfacing":
+            if self._wo is None:
+                return np.zeros(n, np.float32)
+            return (dot(self._geometric(), self._wo) < 0).astype(np.float32)
+        if name == "uv":
+            if self.tris.uvs is None:
+                return np.zeros((3, n), np.float32)
+            uv = self._corners(self.tris.uvs)
+            return np.concatenate([uv, np.zeros((1, n), np.float32)])
+        if name == "parametric":
+            return np.stack([1 - self.b1 - self.b2, self.b1, np.zeros(n, np.float32)]).astype(np.float32)
+        if name == "reflection":
+            nn, wi = self.get("normal"), self.get("incoming")
+            return (2 * dot(nn, wi) * nn - wi).astype(np.float32)
+        if name == "object":
+            inst, objs = self._instances()
+            p = self.get("position")
+            if inst is None:
+                return p
+            m = objs.world_to_object[inst]  # (n, 3, 4)
+            return (np.einsum("nij,jn->in", m[:, :, :3], p) + m[:, :, 3].T).astype(np.float32)
+        if name == "generated":
+            inst, objs = self._instances()
+            if inst is None:
+                return self.get("object")
+            return ((self.get("object") - objs.texspace_lo[inst].T) / objs.texspace_size[inst].T).astype(np.float32)
+        if name == "object_normal":
+            inst, objs = self._instances()
+            nn = self.get("normal")
+            if inst is None:
+                return nn
+            m = objs.world_to_object[inst][:, :, :3]  # normals go with the transposed world matrix: (M⁻¹)⁻ᵀ = Mᵀ
+            lin = np.linalg.inv(m.astype(np.float64)).astype(np.float32)
+            out = np.einsum("nji,jn->in", lin, nn)
+            return (out / np.maximum(norm(out), _F(1e-30))).astype(np.float32)
+        if name in {"object_location", "object_color", "object_alpha", "object_random"}:
+            inst, objs = self._instances()
+            if inst is None:
+                return np.zeros((3, n) if name in {"object_location", "object_color"} else n, np.float32)
+            data = {"object_location": objs.location, "object_color": objs.color[:, :3],
+                    "object_alpha": objs.color[:, 3], "object_random": objs.random}[name]
+            return np.ascontiguousarray(data[inst].T, dtype=np.float32)
+        if name.startswith("attr:") or name.startswith("attr_alpha:"):
+            key = name.split(":", 1)[1]
+            data = (getattr(self.tris, "attributes", None) or {}).get(key)
+            if data is None:
+                return np.zeros((3, n) if name.startswith("attr:") else n, np.float32)
+            vals = self._corners(data)  # (4, n)
+            return np.ascontiguousarray(vals[:3]) if name.startswith("attr:") else np.ascontiguousarray(vals[3])
+        raise KeyError(f"unknown hit attribute {name!r}")
