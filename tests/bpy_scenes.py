@@ -427,7 +427,8 @@ def glass_scene(size=(96, 64), only=None, window=False, roughness=None):
 def node_planes(graphs, cols: int, px: int = 16, name="Nodes"):
     """Emission planes facing an orthographic camera, one per ``graphs`` entry in a grid of ``cols`` columns
     (row 0 at the top), each ``px`` pixels square: ``graph(tree, color_socket)`` wires nodes into the Emission
-    shader's Color (strength 1). Planes are 1 x 1 with a UV map covering them; Generated coordinates span [0, 1]
+    shader's Color (strength 1); ``graph.setup(obj)``, where present, sets up its plane. Planes are 1 x 1 with a
+    UV map covering them; Generated coordinates span [0, 1]
     over each, object coordinates [-0.5, 0.5]. No lights, a black world: each pixel is its pattern's radiance."""
     scene = reset()
     black_world(scene)
@@ -437,7 +438,70 @@ def node_planes(graphs, cols: int, px: int = 16, name="Nodes"):
         mat = emission(f"{name}{k}", (1, 1, 1), 1.0)
         tree = mat.node_tree
         graph(tree, tree.nodes["Emission"].inputs["Color"])
-        _with_uvs(plane(f"{name}Plane{k}", 1.0, (c + 0.5 - cols / 2, rows / 2 - r - 0.5, 0), material=mat))
+        obj = _with_uvs(plane(f"{name}Plane{k}", 1.0, (c + 0.5 - cols / 2, rows / 2 - r - 0.5, 0), material=mat))
+        if hasattr(graph, "setup"):  # per-object state the graph reads (a tilt, a colour attribute, Object Color)
+            graph.setup(obj)
     camera((0, 0, 5), (0, 0, 0), ortho_scale=max(cols, rows))
     scene.render.resolution_x, scene.render.resolution_y = cols * px, rows * px
+    return scene
+
+
+def node_materials_scene(size=(96, 64)):
+    """Lit materials whose inputs come from node graphs: a floor whose Roughness and Metallic come from a Checker
+    through Map Range and whose Base Color is Noise through a Color Ramp; a sphere with Base Color from a Gradient
+    of object coordinates and Roughness from Noise; a sphere mixing Diffuse and Glossy by a Layer Weight's Facing;
+    a quad light whose emission is a Checker (a textured light by node program), and an area light."""
+    import node_graphs as ng
+    scene = reset()
+    floor = bpy.data.materials.new("NodeFloor")
+    enable_nodes(floor)
+    t = floor.node_tree
+    b = t.nodes["Principled BSDF"]
+    chk = ng._node(t, "ShaderNodeTexChecker")
+    ng._set(chk, "Scale", 4.0)
+    mr = ng._node(t, "ShaderNodeMapRange")
+    ng._set(mr, "To Min", 0.15)
+    ng._set(mr, "To Max", 0.8)
+    t.links.new(chk.outputs["Fac"], mr.inputs["Value"])
+    t.links.new(mr.outputs["Result"], b.inputs["Roughness"])
+    inv = ng._node(t, "ShaderNodeMath", operation="SUBTRACT")
+    ng._set(inv, "Value", 1.0)
+    t.links.new(chk.outputs["Fac"], inv.inputs[1])
+    t.links.new(inv.outputs[0], b.inputs["Metallic"])
+    ng.ramp("EASE")(t, b.inputs["Base Color"])
+    plane("Floor", 4.0, (0, 0, 0), material=floor)
+    s1 = bpy.data.materials.new("NodeSphere")
+    enable_nodes(s1)
+    t = s1.node_tree
+    b = t.nodes["Principled BSDF"]
+    ng.gradient("LINEAR")(t, b.inputs["Base Color"])
+    ng.noise(output="Fac", scale=3.0)(t, b.inputs["Roughness"])
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(-0.7, 0.2, 0.5), segments=32, ring_count=16)
+    bpy.ops.object.shade_smooth()
+    bpy.context.active_object.data.materials.append(s1)
+    s2 = bpy.data.materials.new("NodeMix")
+    enable_nodes(s2)
+    t = s2.node_tree
+    t.nodes.remove(t.nodes["Principled BSDF"])
+    mix = t.nodes.new("ShaderNodeMixShader")
+    d = t.nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = (0.8, 0.2, 0.1, 1)
+    gl = t.nodes.new("ShaderNodeBsdfGlossy")
+    gl.inputs["Roughness"].default_value = 0.3
+    lw = t.nodes.new("ShaderNodeLayerWeight")
+    lw.inputs["Blend"].default_value = 0.4
+    t.links.new(lw.outputs["Facing"], mix.inputs["Fac"])
+    t.links.new(d.outputs[0], mix.inputs[1])
+    t.links.new(gl.outputs[0], mix.inputs[2])
+    t.links.new(mix.outputs[0], t.nodes["Material Output"].inputs["Surface"])
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.45, location=(0.75, -0.1, 0.45), segments=32, ring_count=16)
+    bpy.ops.object.shade_smooth()
+    bpy.context.active_object.data.materials.append(s2)
+    lamp = emission("NodeLamp", (1, 1, 1), 12.0)
+    ng.checker(2.0)(lamp.node_tree, lamp.node_tree.nodes["Emission"].inputs["Color"])
+    _with_uvs(plane("NodeLampQuad", 1.2, (0, 1.9, 1.4), (math.radians(-60), 0, 0), material=lamp))
+    light("AREA", (-1.5, -1.5, 2.5), (math.radians(40), 0, math.radians(-45)), energy=150.0, size=1.0)
+    camera((0, -3.6, 2.2), (math.radians(62), 0, 0), lens=35)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
     return scene

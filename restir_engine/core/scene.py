@@ -30,6 +30,8 @@ class TriangleSet:
     #                                     or None when no material has a normal map
     objects: "ObjectTable | None" = None  # per instance: what node programs read of the object (or None)
     attributes: dict | None = None  # colour attributes node programs read: name -> (n, 3 corners, 4) RGBA, linear
+    local_verts: np.ndarray | None = None  # (n, 3, 3) object-space corners, where node programs read object or
+    #                                        generated coordinates (or None)
 
     @staticmethod
     def empty() -> TriangleSet:
@@ -44,7 +46,7 @@ class TriangleSet:
 class ObjectTable:
     """What shader nodes read of each instance (index: TriangleSet.instance).
 
-    world_to_object (k, 3, 4)  the inverse of the instance's world matrix (affine rows)
+    world_to_object (k, 3, 4)  the inverse of the instance's world matrix (affine rows), float64
     texspace_lo, texspace_size (k, 3)  its texture space: Generated = (object position - lo) / size
     location (k, 3) world-space origin; color (k, 4) the object's Color (RGBA); random (k,) Object Info Random
     """

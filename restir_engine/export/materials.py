@@ -69,6 +69,15 @@ class MaterialRegistry:
             return any(tex >= 0 or textured(self.rows[comp]) for comp, _w, tex, _s in row.get("mix", ()))
         return any(textured(self.rows[i]) for i in indices)
 
+    def reads_object_space(self, indices) -> bool:
+        """Whether the node programs of materials ``indices`` read object or generated coordinates."""
+        def reads(row: dict) -> bool:
+            prog = row.get("program")
+            if prog is not None and {"object", "generated"} & set(prog.reads):
+                return True
+            return any(reads(self.rows[comp]) for comp, *_r in row.get("mix", ()))
+        return any(reads(self.rows[i]) for i in indices)
+
     def attribute_names(self, indices) -> set:
         """The colour / geometry attributes the node programs of materials ``indices`` read."""
         names: set = set()

@@ -238,6 +238,8 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
     # a mesh without tangents gets zero ones: its normal map then leaves the normal as it is (m_z N)
     tangents = np.zeros((total, 3, 4), np.float32) if need_tangents else None
     attr_names = sorted({a for b in blocks for a in b[0].get("attributes", {})})
+    local_verts = np.empty((total, 3, 3), np.float32) if any(registry.reads_object_space(b[2]) for b in blocks) \
+        else None
     attributes = {a: np.zeros((total, 3, 4), np.float32) for a in attr_names}
     at = 0
     for k, (arrays, m, slot_map, _name, _key, _info) in enumerate(blocks):  # per instance, vectorized over triangles
@@ -257,6 +259,8 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
             uvs[at:at + n] = arrays["uvs"]
         for a, vals in arrays.get("attributes", {}).items():
             attributes[a][at:at + n] = vals
+        if local_verts is not None:
+            local_verts[at:at + n] = arrays["verts"]
         if tangents is not None and arrays["tangents"] is not None:
             tw = arrays["tangents"][..., :3].reshape(-1, 3) @ lin.T   # surface vectors move with the linear part
             tw /= np.maximum(np.linalg.norm(tw, axis=1), 1e-30)[:, None]
@@ -282,6 +286,7 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
         verts, normals, material, instance = verts[keep], normals[keep], material[keep], instance[keep]
         uvs = uvs[keep] if uvs is not None else None
         attributes = {a: v[keep] for a, v in attributes.items()}
+        local_verts = local_verts[keep] if local_verts is not None else None
         tangents = tangents[keep] if tangents is not None else None
     bad_n = ~np.isfinite(normals).all(axis=2)
     if bad_n.any():
@@ -290,14 +295,14 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
              "instance_keys": [b[4] for b in blocks], "instance_matrices": np.array([b[1] for b in blocks]),
              "meshes_read": reads, "slot_signature": tuple(slots_seen)}
     return TriangleSet(verts, normals, material, uvs, instance, tangents, objects=_object_table(blocks),
-                       attributes=attributes or None), stats
+                       attributes=attributes or None, local_verts=local_verts), stats
 
 
 def _object_table(blocks) -> ObjectTable:
     """What shader nodes read of each exported instance (world matrix inverse, texture space, Object Info)."""
     from ..core.scene import affine_inverse
     mats = np.array([b[1] for b in blocks], np.float64)
-    inv = affine_inverse(mats)[:, :3, :].astype(np.float32)
+    inv = affine_inverse(mats)[:, :3, :]  # float64: object coordinates on a flat axis stay exact
     lo = np.array([b[0]["texspace"][0] for b in blocks], np.float32)
     size = np.array([b[0]["texspace"][1] for b in blocks], np.float32)
     return ObjectTable(world_to_object=inv, texspace_lo=lo, texspace_size=size,

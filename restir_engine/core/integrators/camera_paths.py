@@ -99,7 +99,7 @@ def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: n
         em = np.flatnonzero((hits.prim >= 0) & (ctx.lights.geom_to_light[prim] >= 0))
         if em.size:
             emitted[:, em] += emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em],
-                                               hits.v[em])
+                                               hits.v[em], -cols(d, em) if ctx.has_programs else None)
     return finite(emitted), alpha
 
 

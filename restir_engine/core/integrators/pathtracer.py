@@ -263,7 +263,8 @@ def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) 
     em = np.flatnonzero((light >= 0) if collect is None else (light >= 0) & collect[hsel])
     if em.size:
         hs = hsel[em]
-        le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs])
+        le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs],
+                              -cols(d, hs) if ctx.has_programs else None)
         cos_l = -dot(cols(d, hs), cols(ctx.geom_ng_rows, hp[em]))
         le *= (cos_l > 0) | ctx.lights.tri_two_sided[light[em]]
         pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)

@@ -67,8 +67,10 @@ def triangle_geometry(verts: np.ndarray):
 
 
 def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarray,
-                     b1: np.ndarray, b2: np.ndarray) -> np.ndarray:
-    """Emitted radiance (3, n) rows, W·sr⁻¹·m⁻², at barycentrics (b1, b2) of triangles ``tri``."""
+                     b1: np.ndarray, b2: np.ndarray, wo: np.ndarray | None = None) -> np.ndarray:
+    """Emitted radiance (3, n) rows, W·sr⁻¹·m⁻², at barycentrics (b1, b2) of triangles ``tri``, towards unit
+    directions ``wo`` (3, n) where a node program reads the view (Layer Weight, Fresnel, Incoming, Backfacing;
+    without ``wo`` the view is along the surface normal)."""
     mat = tris.material[tri]
     le = np.take(materials.emission, mat, axis=0)
     if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
@@ -76,8 +78,8 @@ def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarra
         uv = barycentric(c[:, 0], c[:, 1], c[:, 2], b1[:, None], b2[:, None])  # (n, 2) texture coordinates
         le = apply_texture(le, materials.emit_tex[mat], uv, materials.textures)
     le = np.ascontiguousarray(le.T, dtype=np.float32)
-    for rows, out in run_programs(materials, mat, lambda r: HitAttributes(tris, tri[r], b1[r], b2[r],
-                                                                          materials.textures), ("emission",)):
+    for rows, out in run_programs(materials, mat, lambda r: HitAttributes(
+            tris, tri[r], b1[r], b2[r], materials.textures, wo=None if wo is None else cols(wo, r)), ("emission",)):
         le[:, rows] = out["emission"]
     return le
 
@@ -381,8 +383,13 @@ class LightTable:
                 for sel, tris, ids, offset in ((geo, scene.geometry, self.geom_ids, 0),
                                                (~geo, scene.lamps.tris, self.lamp_ids, self.n_geom)):
                     if sel.any():
-                        out[:, tex[sel]] = emitted_radiance(tris, scene.materials, ids[lt[sel] - offset],
-                                                            b1[tex[sel]], b2[tex[sel]])
+                        rows = tex[sel]
+                        wo = None
+                        if p_receiver is not None:  # towards the receiver, for view-dependent node programs
+                            wo = cols(p_receiver, rows) - self.positions(light[rows], b1[rows], b2[rows])
+                            wo = wo / np.maximum(norm(wo), np.float32(1e-30))
+                        out[:, rows] = emitted_radiance(tris, scene.materials, ids[lt[sel] - offset], b1[rows],
+                                                        b2[rows], wo)
         if p_receiver is not None and self.any_spots:
             lm = np.flatnonzero(light >= self.n_geom)
             if lm.size:

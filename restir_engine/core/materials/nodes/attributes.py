@@ -93,17 +93,26 @@ class HitAttributes:
             nn, wi = self.get("normal"), self.get("incoming")
             return (2 * dot(nn, wi) * nn - wi).astype(np.float32)
         if name == "object":
+            local = getattr(self.tris, "local_verts", None)
+            if local is not None:  # the exported object-space corners: exact where the object is flat
+                return self._corners(local)
             inst, objs = self._instances()
-            p = self.get("position")
             if inst is None:
-                return p
-            m = objs.world_to_object[inst]  # (n, 3, 4)
-            return (np.einsum("nij,jn->in", m[:, :, :3], p) + m[:, :, 3].T).astype(np.float32)
+                return self.get("position")
+            # the corners taken to object space in float64, then interpolated: a flat object's flat axis stays
+            # exactly flat (a checker's cell boundary on it must not flicker with rounding)
+            m = objs.world_to_object[inst].astype(np.float64)  # (n, 3, 4)
+            c = np.take(self.tris.verts, self.prim, axis=0).astype(np.float64)  # (n, 3 corners, 3)
+            local = np.einsum("nij,nkj->nki", m[:, :, :3], c) + m[:, None, :, 3]
+            b1, b2 = self.b1.astype(np.float64), self.b2.astype(np.float64)
+            p = local[:, 0] * (1 - b1 - b2)[:, None] + local[:, 1] * b1[:, None] + local[:, 2] * b2[:, None]
+            return np.ascontiguousarray(p.T, dtype=np.float32)
         if name == "generated":
             inst, objs = self._instances()
             if inst is None:
                 return self.get("object")
-            return ((self.get("object") - objs.texspace_lo[inst].T) / objs.texspace_size[inst].T).astype(np.float32)
+            return ((self.get("object").astype(np.float64) - objs.texspace_lo[inst].T) / objs.texspace_size[inst].T
+                    ).astype(np.float32)
         if name == "object_normal":
             inst, objs = self._instances()
             nn = self.get("normal")

@@ -1,0 +1,451 @@
+"""Shader node graphs for the node tests: each a function ``graph(tree, socket)`` that builds nodes in a material's
+tree and links a colour into ``socket``, in families of cases (name, graph) that cover each node's parameters.
+Outputs stay non-negative (an emission colour below 0 is not a radiance)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from bpy_scenes import packed_image
+
+
+def _node(tree, kind, **props):
+    n = tree.nodes.new(kind)
+    for k, v in props.items():
+        setattr(n, k, v)
+    return n
+
+
+def _set(node, ident, value):
+    sock = next(s for s in node.inputs if s.identifier == ident)
+    sock.default_value = value
+
+
+def _in(node, ident):
+    return next(s for s in node.inputs if s.identifier == ident)
+
+
+def _out(node, ident):
+    return next(s for s in node.outputs if s.identifier == ident)
+
+
+def _link(tree, out, inp):
+    tree.links.new(out, inp)
+
+
+def _coords(tree, which="Generated"):
+    return _node(tree, "ShaderNodeTexCoord").outputs[which]
+
+
+def _abs(tree, out):
+    m = _node(tree, "ShaderNodeMath", operation="ABSOLUTE")
+    _link(tree, out, m.inputs[0])
+    return m.outputs[0]
+
+
+def noise(dims="3D", kind="FBM", scale=4.0, detail=2.5, roughness=0.5, lacunarity=2.0, distortion=0.0, w=0.3,
+          offset=1.0, gain=1.0, normalize=True, output="Color", positive=False):
+    def graph(tree, socket):
+        n = _node(tree, "ShaderNodeTexNoise", noise_dimensions=dims, noise_type=kind, normalize=normalize)
+        for ident, v in (("Scale", scale), ("Detail", detail), ("Roughness", roughness), ("Lacunarity", lacunarity),
+                         ("Distortion", distortion), ("W", w), ("Offset", offset), ("Gain", gain)):
+            _set(n, ident, v)
+        out = n.outputs[output]
+        _link(tree, _abs(tree, out) if positive else out, socket)
+    return graph
+
+
+NOISE = [
+    ("fbm 3D", noise()), ("fbm 3D raw", noise(normalize=False, output="Fac", positive=True)),
+    ("fbm 2D distorted", noise("2D", distortion=1.0)), ("fbm 4D", noise("4D", w=0.7, detail=1.3)),
+    ("fbm 1D", noise("1D", w=2.3)), ("multifractal", noise(kind="MULTIFRACTAL", detail=3, roughness=0.6,
+                                                          output="Fac", positive=True)),
+    ("ridged", noise(kind="RIDGED_MULTIFRACTAL", detail=2, gain=2.0, output="Fac", positive=True)),
+    ("hybrid 2D", noise("2D", "HYBRID_MULTIFRACTAL", detail=3.5, gain=1.5, offset=0.5, output="Fac", positive=True)),
+    ("hetero 4D distorted", noise("4D", "HETERO_TERRAIN", distortion=0.5, detail=2.2, offset=0.3, output="Fac",
+                                  positive=True)),
+    ("fbm lacunarity", noise(scale=7.0, detail=0.0, lacunarity=2.5, output="Fac")),
+]
+
+
+def checker(scale=3.0):
+    def graph(tree, socket):
+        c = _node(tree, "ShaderNodeTexChecker")
+        _set(c, "Scale", scale)
+        _set(c, "Color1", (0.9, 0.3, 0.1, 1))
+        _set(c, "Color2", (0.1, 0.2, 0.7, 1))
+        _link(tree, c.outputs["Color"], socket)
+    return graph
+
+
+def gradient(kind, coords="Object"):
+    def graph(tree, socket):
+        g = _node(tree, "ShaderNodeTexGradient", gradient_type=kind)
+        _link(tree, _coords(tree, coords), g.inputs["Vector"])
+        _link(tree, g.outputs["Color"], socket)
+    return graph
+
+
+def white_noise(dims="3D", cells=6.0, output="Color"):
+    def graph(tree, socket):
+        m = _node(tree, "ShaderNodeVectorMath", operation="SCALE")
+        _link(tree, _coords(tree), m.inputs[0])
+        _set(m, "Scale", cells)
+        f = _node(tree, "ShaderNodeVectorMath", operation="FLOOR")
+        _link(tree, m.outputs[0], f.inputs[0])
+        wn = _node(tree, "ShaderNodeTexWhiteNoise", noise_dimensions=dims)
+        _set(wn, "W", 1.5)
+        _link(tree, f.outputs[0], wn.inputs["Vector"])
+        _link(tree, wn.outputs[output], socket)
+    return graph
+
+
+def _checker_image():
+    n = 8
+    yy, xx = np.mgrid[0:n, 0:n]
+    rgb = np.stack([(xx + yy) % 2 * 0.8 + 0.1, xx / (n - 1), yy / (n - 1)], axis=-1).astype(np.float32)
+    return packed_image("NodeChecker", rgb)
+
+
+def image(interpolation="Linear", extension="REPEAT", rotation=30.0, scale=1.7, output="Color"):
+    def graph(tree, socket):
+        img = _node(tree, "ShaderNodeTexImage", interpolation=interpolation, extension=extension)
+        img.image = _checker_image()
+        mp = _node(tree, "ShaderNodeMapping", vector_type="POINT")
+        _set(mp, "Rotation", (0, 0, math.radians(rotation)))
+        _set(mp, "Scale", (scale, scale, 1))
+        _set(mp, "Location", (-0.3, -0.2, 0))
+        _link(tree, _coords(tree, "UV"), mp.inputs["Vector"])
+        _link(tree, mp.outputs[0], img.inputs["Vector"])
+        _link(tree, img.outputs[output], socket)
+    return graph
+
+
+TEXTURES = [
+    ("checker", checker()), ("checker fine", checker(7.5)),
+    *[(f"gradient {k.lower()}", gradient(k)) for k in ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "SPHERICAL",
+                                                          "QUADRATIC_SPHERE", "RADIAL")],
+    ("gradient generated", gradient("LINEAR", "Generated")),
+    ("white noise 3D", white_noise()), ("white noise 2D value", white_noise("2D", 5.0, "Value")),
+    ("white noise 4D", white_noise("4D", 4.0)),
+    ("image linear repeat", image()), ("image closest extend", image("Closest", "EXTEND")),
+    ("image cubic mirror", image("Cubic", "MIRROR")), ("image linear clip", image("Linear", "CLIP", 10.0, 1.3)),
+    ("image alpha clip", image("Closest", "CLIP", -20.0, 1.4, "Alpha")),
+]
+
+
+def ramp(interpolation, mode="RGB", hue="NEAR"):
+    def graph(tree, socket):
+        g = _node(tree, "ShaderNodeTexGradient")
+        r = _node(tree, "ShaderNodeValToRGB")
+        cr = r.color_ramp
+        cr.interpolation = interpolation
+        cr.color_mode = mode
+        if mode != "RGB":
+            cr.hue_interpolation = hue
+        cr.elements[0].position = 0.1
+        cr.elements[0].color = (1, 0.1, 0, 1)
+        e = cr.elements.new(0.45)
+        e.color = (0.1, 0.9, 0.2, 1)
+        cr.elements[-1].position = 0.85
+        cr.elements[-1].color = (0.2, 0.3, 1.0, 1)
+        _link(tree, g.outputs["Fac"], r.inputs["Fac"])
+        _link(tree, r.outputs["Color"], socket)
+    return graph
+
+
+def _x_of(tree, coords="Generated"):
+    s = _node(tree, "ShaderNodeSeparateXYZ")
+    _link(tree, _coords(tree, coords), s.inputs[0])
+    return s
+
+
+def math_op(op, b=0.35, c=0.2, scale=3.0, clamp=False):
+    def graph(tree, socket):
+        s = _x_of(tree, "Object")
+        pre = _node(tree, "ShaderNodeMath", operation="MULTIPLY")
+        _link(tree, s.outputs["X"], pre.inputs[0])
+        _set(pre, "Value_001", scale)
+        m = _node(tree, "ShaderNodeMath", operation=op, use_clamp=clamp)
+        _link(tree, pre.outputs[0], m.inputs[0])
+        if op in {"ARCTAN2", "SMOOTH_MIN", "SMOOTH_MAX", "COMPARE"}:
+            _link(tree, s.outputs["Y"], m.inputs[1])
+        else:
+            _set(m, "Value_001", b)
+        _set(m, "Value_002", c)
+        _link(tree, _abs(tree, m.outputs[0]), socket)
+    return graph
+
+
+def vector_op(op, b=(0.3, -0.5, 0.8), scale=1.5):
+    def graph(tree, socket):
+        m = _node(tree, "ShaderNodeVectorMath", operation=op)
+        _link(tree, _coords(tree, "Object"), m.inputs[0])
+        _set(m, "Vector_001", b)
+        _set(m, "Vector_002", (0.5, 0.5, 0.5))
+        _set(m, "Scale", scale)
+        out = m.outputs["Value"] if op in {"DOT_PRODUCT", "DISTANCE", "LENGTH"} else m.outputs["Vector"]
+        a = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+        _link(tree, out, a.inputs[0])
+        _link(tree, a.outputs[0], socket)
+    return graph
+
+
+def map_range(kind, clamp=True, vector=False):
+    def graph(tree, socket):
+        m = _node(tree, "ShaderNodeMapRange", interpolation_type=kind, clamp=clamp,
+                  data_type="FLOAT_VECTOR" if vector else "FLOAT")
+        if vector:
+            _link(tree, _coords(tree), m.inputs["Vector"])
+            _set(m, "From_Min_FLOAT3", (0.2, 0.1, 0.0))
+            _set(m, "From_Max_FLOAT3", (0.8, 0.9, 1.0))
+            _set(m, "Steps_FLOAT3", (4, 3, 2))
+            _link(tree, m.outputs["Vector"], socket)
+        else:
+            _link(tree, _x_of(tree).outputs["X"], m.inputs["Value"])
+            _set(m, "From Min", 0.2)
+            _set(m, "From Max", 0.7)
+            _set(m, "To Min", 0.1)
+            _set(m, "To Max", 0.9)
+            _set(m, "Steps", 3.0)
+            _link(tree, m.outputs["Result"], socket)
+    return graph
+
+
+def color_node(kind, **inputs):
+    """A colour converter fed by a Checker-and-Gradient mixture."""
+    def graph(tree, socket):
+        g = _node(tree, "ShaderNodeTexGradient", gradient_type="DIAGONAL")
+        n = _node(tree, "ShaderNodeTexNoise")
+        mix = _node(tree, "ShaderNodeMix", data_type="RGBA")
+        _link(tree, g.outputs["Fac"], _in(mix, "Factor_Float"))
+        _set(mix, "A_Color", (0.9, 0.2, 0.1, 1))
+        _link(tree, n.outputs["Color"], _in(mix, "B_Color"))
+        node = _node(tree, kind)
+        for ident, v in inputs.items():
+            _set(node, ident, v)
+        col = next(s for s in node.inputs if s.type == "RGBA")
+        _link(tree, _out(mix, "Result_Color"), col)
+        _link(tree, node.outputs[0], socket)
+    return graph
+
+
+def separate_combine(mode):
+    def graph(tree, socket):
+        n = _node(tree, "ShaderNodeTexNoise")
+        sep = _node(tree, "ShaderNodeSeparateColor", mode=mode)
+        com = _node(tree, "ShaderNodeCombineColor", mode=mode)
+        _link(tree, n.outputs["Color"], sep.inputs[0])
+        _link(tree, sep.outputs[0], com.inputs[1])
+        _link(tree, sep.outputs[1], com.inputs[2])
+        _link(tree, sep.outputs[2], com.inputs[0])
+        _link(tree, com.outputs[0], socket)
+    return graph
+
+
+def curves(kind):
+    def graph(tree, socket):
+        g = _node(tree, "ShaderNodeTexGradient")
+        node = _node(tree, "ShaderNodeRGBCurve" if kind == "RGB" else "ShaderNodeFloatCurve")
+        m = node.mapping
+        for k, c in enumerate(m.curves):
+            c.points.new(0.4, 0.2 + 0.2 * k)
+        m.update()
+        if kind == "RGB":
+            r = _node(tree, "ShaderNodeValToRGB")
+            _link(tree, g.outputs["Fac"], r.inputs["Fac"])
+            _link(tree, r.outputs["Color"], node.inputs["Color"])
+            _link(tree, node.outputs["Color"], socket)
+        else:
+            _link(tree, g.outputs["Fac"], node.inputs["Value"])
+            _link(tree, node.outputs["Value"], socket)
+    return graph
+
+
+CONVERTERS = [
+    *[(f"ramp {k.lower()}", ramp(k)) for k in ("LINEAR", "CONSTANT", "EASE", "CARDINAL", "B_SPLINE")],
+    ("ramp hsv", ramp("LINEAR", "HSV", "FAR")), ("ramp hsl", ramp("LINEAR", "HSL", "CW")),
+    *[(f"math {op.lower()}", math_op(op)) for op in ("POWER", "WRAP", "PINGPONG", "SMOOTH_MIN", "ARCTAN2", "SNAP",
+                                                     "SINE", "LOGARITHM", "FRACT",
+                                                     "TANH", "ROUND")],
+    ("math sqrt", math_op("SQRT", scale=-3.0)), ("math compare", math_op("COMPARE", c=0.9)),
+    ("math floored_modulo", math_op("FLOORED_MODULO", b=1.1)),
+    ("math clamp", math_op("MULTIPLY", 1.7, clamp=True)),
+    *[(f"vector {op.lower()}", vector_op(op)) for op in ("CROSS_PRODUCT", "REFLECT", "PROJECT", "REFRACT",
+                                                        "LENGTH", "DISTANCE", "NORMALIZE", "WRAP", "SNAP",
+                                                        "MODULO", "FACEFORWARD", "DOT_PRODUCT")],
+    *[(f"map range {k.lower()}", map_range(k)) for k in ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")],
+    ("map range vector stepped", map_range("STEPPED", vector=True)),
+    ("invert", color_node("ShaderNodeInvert", Fac=0.8)), ("gamma", color_node("ShaderNodeGamma", Gamma=2.2)),
+    ("bright contrast", color_node("ShaderNodeBrightContrast", Bright=0.1, Contrast=0.6)),
+    ("hue saturation", color_node("ShaderNodeHueSaturation", Hue=0.3, Saturation=1.4, Value=0.9, Fac=0.9)),
+    ("rgb to bw", color_node("ShaderNodeRGBToBW")),
+    ("separate combine hsv", separate_combine("HSV")), ("separate combine hsl", separate_combine("HSL")),
+    ("rgb curves", curves("RGB")), ("float curve", curves("FLOAT")),
+]
+
+
+def mix_color(blend, fac=0.7, clamp=False):
+    def graph(tree, socket):
+        g = _node(tree, "ShaderNodeTexGradient", gradient_type="DIAGONAL")
+        r = _node(tree, "ShaderNodeValToRGB")
+        r.color_ramp.elements[0].color = (0.9, 0.4, 0.1, 1)
+        r.color_ramp.elements[1].color = (0.1, 0.3, 0.8, 1)
+        _link(tree, g.outputs["Fac"], r.inputs["Fac"])
+        n = _node(tree, "ShaderNodeTexNoise")
+        m = _node(tree, "ShaderNodeMix", data_type="RGBA", blend_type=blend, clamp_result=clamp)
+        _set(m, "Factor_Float", fac)
+        _link(tree, r.outputs["Color"], _in(m, "A_Color"))
+        _link(tree, n.outputs["Color"], _in(m, "B_Color"))
+        out = _out(m, "Result_Color")
+        if blend in {"SUBTRACT", "DIFFERENCE", "LINEAR_LIGHT"}:
+            a = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+            _link(tree, out, a.inputs[0])
+            out = a.outputs[0]
+        _link(tree, out, socket)
+    return graph
+
+
+def mix_vector(uniform=True):
+    def graph(tree, socket):
+        m = _node(tree, "ShaderNodeMix", data_type="VECTOR", factor_mode="UNIFORM" if uniform else "NON_UNIFORM")
+        _link(tree, _coords(tree), _in(m, "A_Vector"))
+        _set(m, "B_Vector", (0.9, 0.1, 0.4))
+        if uniform:
+            _link(tree, _x_of(tree).outputs["Y"], _in(m, "Factor_Float"))
+        else:
+            _link(tree, _coords(tree), _in(m, "Factor_Vector"))
+        _link(tree, _out(m, "Result_Vector"), socket)
+    return graph
+
+
+BLENDS = ("MIX", "DARKEN", "MULTIPLY", "BURN", "LIGHTEN", "SCREEN", "DODGE", "ADD", "OVERLAY", "SOFT_LIGHT",
+          "LINEAR_LIGHT", "DIFFERENCE", "EXCLUSION", "SUBTRACT", "DIVIDE", "HUE", "SATURATION", "COLOR", "VALUE")
+MIXES = [*[(f"mix {b.lower()}", mix_color(b)) for b in BLENDS], ("mix add clamped", mix_color("ADD", 1.0, True)),
+         ("mix vector", mix_vector()), ("mix vector non-uniform", mix_vector(False))]
+
+
+def coords(which, op="ABSOLUTE", scale=1.0):
+    def graph(tree, socket):
+        m = _node(tree, "ShaderNodeVectorMath", operation="SCALE")
+        _link(tree, _coords(tree, which), m.inputs[0])
+        _set(m, "Scale", scale)
+        a = _node(tree, "ShaderNodeVectorMath", operation=op)
+        _link(tree, m.outputs[0], a.inputs[0])
+        _link(tree, a.outputs[0], socket)
+    return graph
+
+
+def geometry(output, tilt=0.0):
+    def graph(tree, socket):
+        g = _node(tree, "ShaderNodeNewGeometry")
+        out = g.outputs[output]
+        if out.type == "VECTOR":
+            a = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+            _link(tree, out, a.inputs[0])
+            out = a.outputs[0]
+        _link(tree, out, socket)
+    graph.setup = lambda obj: setattr(obj, "rotation_euler", (tilt, 0.4 * tilt, 0))
+    return graph
+
+
+def layer_weight(output, blend, tilt):
+    def graph(tree, socket):
+        lw = _node(tree, "ShaderNodeLayerWeight")
+        _set(lw, "Blend", blend)
+        _link(tree, lw.outputs[output], socket)
+    graph.setup = lambda obj: setattr(obj, "rotation_euler", (tilt, 0, 0))
+    return graph
+
+
+def fresnel(ior, tilt):
+    def graph(tree, socket):
+        f = _node(tree, "ShaderNodeFresnel")
+        _set(f, "IOR", ior)
+        _link(tree, f.outputs[0], socket)
+    graph.setup = lambda obj: setattr(obj, "rotation_euler", (tilt, 0, 0))
+    return graph
+
+
+def object_info(output):
+    def graph(tree, socket):
+        o = _node(tree, "ShaderNodeObjectInfo")
+        out = o.outputs[output]
+        if out.type == "VECTOR":
+            a = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+            _link(tree, out, a.inputs[0])
+            out = a.outputs[0]
+        _link(tree, out, socket)
+    graph.setup = lambda obj: setattr(obj, "color", (0.3, 0.6, 0.9, 0.5))
+    return graph
+
+
+def color_attribute(domain="POINT", output="Color"):
+    def graph(tree, socket):
+        c = _node(tree, "ShaderNodeVertexColor", layer_name="Paint")
+        _link(tree, c.outputs[output], socket)
+
+    def setup(obj):
+        mesh = obj.data
+        attr = mesh.color_attributes.new("Paint", "FLOAT_COLOR", domain)
+        n = len(attr.data)
+        vals = np.array([[0.9, 0.1, 0.2, 0.3], [0.1, 0.8, 0.3, 0.9], [0.2, 0.3, 0.9, 0.6], [0.9, 0.9, 0.1, 1.0]],
+                        np.float32)[np.arange(n) % 4]
+        attr.data.foreach_set("color", vals.ravel())
+    graph.setup = setup
+    return graph
+
+
+def group_reroute_mute():
+    """A node group (Noise -> Math inside, a group input scaling the coordinates), reroutes, and a muted node."""
+    def graph(tree, socket):
+        import bpy
+        grp = bpy.data.node_groups.get("NoiseGroup")
+        if grp is None:
+            grp = bpy.data.node_groups.new("NoiseGroup", "ShaderNodeTree")
+            grp.interface.new_socket("Vector", in_out="INPUT", socket_type="NodeSocketVector")
+            grp.interface.new_socket("Gain", in_out="INPUT", socket_type="NodeSocketFloat")
+            grp.interface.new_socket("Result", in_out="OUTPUT", socket_type="NodeSocketColor")
+            gi = grp.nodes.new("NodeGroupInput")
+            go = grp.nodes.new("NodeGroupOutput")
+            nz = grp.nodes.new("ShaderNodeTexNoise")
+            rr = grp.nodes.new("NodeReroute")
+            mx = grp.nodes.new("ShaderNodeMix")
+            mx.data_type = "RGBA"
+            mx.blend_type = "MULTIPLY"
+            grp.links.new(gi.outputs[0], rr.inputs[0])
+            grp.links.new(rr.outputs[0], nz.inputs["Vector"])
+            grp.links.new(nz.outputs["Color"], _in(mx, "A_Color"))
+            grp.links.new(gi.outputs[1], _in(mx, "Factor_Float"))
+            _in(mx, "B_Color").default_value = (0.2, 0.9, 0.4, 1)
+            grp.links.new(_out(mx, "Result_Color"), go.inputs[0])
+        node = _node(tree, "ShaderNodeGroup")
+        node.node_tree = grp
+        node.inputs[1].default_value = 0.8
+        muted = _node(tree, "ShaderNodeVectorMath", operation="SCALE")
+        muted.mute = True  # passes its first input through
+        _link(tree, _coords(tree, "Object"), muted.inputs[0])
+        rr = _node(tree, "NodeReroute")
+        _link(tree, muted.outputs[0], rr.inputs[0])
+        _link(tree, rr.outputs[0], node.inputs[0])
+        _link(tree, node.outputs[0], socket)
+    return graph
+
+
+INPUTS = [
+    ("generated", coords("Generated")), ("object", coords("Object", scale=1.5)), ("uv", coords("UV")),
+    ("object normal", coords("Normal")), ("reflection", coords("Reflection")),
+    ("position", geometry("Position")), ("normal tilted", geometry("Normal", 0.5)),
+    ("true normal tilted", geometry("True Normal", -0.7)), ("incoming", geometry("Incoming", 0.3)),
+    ("backfacing", geometry("Backfacing", 2.6)), ("parametric", geometry("Parametric")),
+    *[(f"layer weight {o.lower()} {b}", layer_weight(o, b, t)) for o, b, t in
+      (("Fresnel", 0.3, 0.6), ("Facing", 0.3, 0.9), ("Facing", 0.8, 0.4), ("Fresnel", 0.6, 1.1))],
+    ("fresnel 1.45", fresnel(1.45, 1.0)), ("fresnel 2.4", fresnel(2.4, 0.5)),
+    ("object random", object_info("Random")), ("object color", object_info("Color")),
+    ("object location", object_info("Location")),
+    ("color attribute point", color_attribute()), ("color attribute corner", color_attribute("CORNER")),
+    ("color attribute alpha", color_attribute("POINT", "Alpha")),
+    ("group reroute mute", group_reroute_mute()),
+]
+
+FAMILIES = {"noise": NOISE, "textures": TEXTURES, "converters": CONVERTERS, "mixes": MIXES, "inputs": INPUTS}
