@@ -51,6 +51,20 @@ def _grad4(h, x, y, z, w):
 
 
 _GRAD = (None, _grad1, _grad2, _grad3, _grad4)
+_MASK = (None, 15, 7, 15, 31)
+
+
+def _gradient_tables(dim: int) -> np.ndarray:
+    """(dim, mask + 1) float32: each gradient as its coefficients on the fractional coordinates (the gradient
+    functions are linear in them, with coefficients 0, ±1, ±2 or ±(1..8)), so a corner's value is a sum of
+    products of table entries (exact: the same float32 result as the branches)."""
+    h = np.arange(_MASK[dim] + 1, dtype=np.uint32)
+    eye = np.eye(dim, dtype=np.float32)
+    return np.stack([_GRAD[dim](h, *[np.full(h.shape, eye[k, j]) for j in range(dim)]) for k in range(dim)]
+                    ).astype(np.float32)
+
+
+_TABLES = (None,) + tuple(_gradient_tables(d) for d in (1, 2, 3, 4))
 
 
 def perlin(*coords) -> np.ndarray:
@@ -65,14 +79,18 @@ def perlin(*coords) -> np.ndarray:
         fr = (c - f).astype(np.float32)
         fracs.append(fr)
         fades.append(_fade(fr))
-    grad = _GRAD[dim]
+    table, mask = _TABLES[dim], np.uint32(_MASK[dim])
     values = {}
     for corner in range(1 << dim):
         bits = [(corner >> k) & 1 for k in range(dim)]
         with np.errstate(over="ignore"):
             keys = [cells[k] + np.uint32(bits[k]) for k in range(dim)]
-        h = hash_uint(*keys)
-        values[corner] = grad(h, *[fracs[k] - _F(bits[k]) for k in range(dim)])
+        h = (hash_uint(*keys) & mask).astype(np.intp)
+        v = None
+        for k in range(dim):
+            term = np.take(table[k], h) * (fracs[k] - _F(bits[k]) if bits[k] else fracs[k])
+            v = term if v is None else v + term
+        values[corner] = v
     # blend along axis 0 first (pairs of corners differing in bit 0), then axis 1, ...
     level = [values[c] for c in range(1 << dim)]
     for k in range(dim):
@@ -108,6 +126,9 @@ def fractal(kind: str, coords: list, detail, roughness, lacunarity, off, gain, n
     ``detail`` (octaves beyond the first, fraction blends the last), ``roughness`` (amplitude ratio), ``off``,
     ``gain`` are per point or constant."""
     coords = [np.asarray(c, np.float32) for c in coords]
+    if all(np.ndim(x) == 0 for x in (detail, roughness, lacunarity, off, gain)):
+        return _fractal_uniform(kind, coords, float(detail), float(roughness), float(lacunarity), float(off),
+                                float(gain), normalize)
     shape = np.broadcast_shapes(*[c.shape for c in coords], *[np.shape(x) for x in (detail, roughness, lacunarity,
                                                                                       off, gain)])
     coords = [np.broadcast_to(c, shape) for c in coords]
@@ -197,3 +218,53 @@ def fractal(kind: str, coords: list, detail, roughness, lacunarity, off, gain, n
             signal = np.where(on, s, signal)
         return value.astype(np.float32)
     raise ValueError(f"unknown noise type {kind!r}")
+
+
+def _fractal_uniform(kind, coords, detail, roughness, lacunarity, off, gain, normalize):
+    """:func:`fractal` with every parameter constant (the usual case): the octave loop without per-point masks
+    (the same arithmetic in float32, so the same values)."""
+    detail = min(max(detail, 0.0), 15.0)
+    rough = _F(max(roughness, 0.0))
+    lac, off, gain = _F(lacunarity), _F(off), _F(gain)
+    n = int(np.floor(detail))
+    rmd = _F(detail - np.floor(detail))
+    scale, amp = _F(1.0), _F(1.0)
+
+    def octave(sc):
+        return snoise(*[c * sc for c in coords])
+    if kind == "FBM":
+        total, maxamp = _F(0.0), _F(0.0)
+        for _i in range(n + 1):
+            total = total + octave(scale) * amp
+            maxamp = maxamp + amp
+            amp, scale = amp * rough, scale * lac
+        if normalize:
+            a = _F(0.5) * total / maxamp + _F(0.5)
+        else:
+            a = total
+        if rmd != 0:
+            total2 = total + octave(scale) * amp
+            b = _F(0.5) * total2 / (maxamp + amp) + _F(0.5) if normalize else total2
+            a = a + rmd * (b - a)
+        return np.asarray(a, np.float32)
+    if kind == "MULTIFRACTAL":
+        value = _F(1.0)
+        for _i in range(n + 1):
+            value = value * (amp * octave(scale) + _F(1.0))
+            amp, scale = amp * rough, scale * lac
+        if rmd != 0:
+            value = value * (rmd * amp * octave(scale) + _F(1.0))
+        return np.asarray(value, np.float32)
+    if kind == "HETERO_TERRAIN":
+        value = off + octave(scale)
+        scale = scale * lac
+        for _i in range(1, n + 1):
+            amp = amp * rough
+            value = value + (octave(scale) + off) * amp * value
+            scale = scale * lac
+        if rmd != 0:
+            value = value + rmd * (octave(scale) + off) * (amp * rough) * value
+        return np.asarray(value, np.float32)
+    # hybrid and ridged keep per-point state (a weight): the masked loop
+    shape = np.broadcast_shapes(*[c.shape for c in coords])
+    return fractal(kind, coords, np.full(shape, detail, np.float32), roughness, lacunarity, off, gain, normalize)
