@@ -448,4 +448,103 @@ INPUTS = [
     ("group reroute mute", group_reroute_mute()),
 ]
 
-FAMILIES = {"noise": NOISE, "textures": TEXTURES, "converters": CONVERTERS, "mixes": MIXES, "inputs": INPUTS}
+def _vabs(tree, out):
+    m = _node(tree, "ShaderNodeVectorMath", operation="ABSOLUTE")
+    _link(tree, out, m.inputs[0])
+    return m.outputs[0]
+
+
+def voronoi(dims="3D", feature="F1", metric="EUCLIDEAN", scale=5.0, output="Distance", detail=0.0, roughness=0.5,
+            lacunarity=2.0, smoothness=1.0, exponent=0.7, randomness=1.0, w=0.4, normalize=False, coords="Generated"):
+    def graph(tree, socket):
+        v = _node(tree, "ShaderNodeTexVoronoi", voronoi_dimensions=dims, feature=feature, distance=metric,
+                  normalize=normalize)
+        for ident, val in (("Scale", scale), ("Detail", detail), ("Roughness", roughness),
+                           ("Lacunarity", lacunarity), ("Smoothness", smoothness), ("Exponent", exponent),
+                           ("Randomness", randomness), ("W", w)):
+            _set(v, ident, val)
+        _link(tree, _coords(tree, coords), _in(v, "Vector"))
+        out = _out(v, output)
+        if output == "Position":
+            out = _vabs(tree, out)
+        elif output == "W":
+            out = _abs(tree, out)
+        _link(tree, out, socket)
+    return graph
+
+
+VORONOI = [
+    ("f1 3D", voronoi()), ("f1 3D color", voronoi(output="Color")), ("f1 3D position", voronoi(output="Position")),
+    ("f2 2D manhattan", voronoi("2D", "F2", "MANHATTAN")), ("f1 2D chebychev", voronoi("2D", metric="CHEBYCHEV")),
+    ("f1 3D minkowski", voronoi(metric="MINKOWSKI", exponent=0.7)),
+    ("smooth f1 3D", voronoi(feature="SMOOTH_F1", smoothness=0.8, output="Color")),
+    ("smooth f1 2D distance", voronoi("2D", "SMOOTH_F1", smoothness=0.5)),
+    ("edge 2D", voronoi("2D", "DISTANCE_TO_EDGE", randomness=0.8)), ("edge 3D", voronoi(feature="DISTANCE_TO_EDGE")),
+    ("n-sphere 3D", voronoi(feature="N_SPHERE_RADIUS", output="Radius")),
+    ("f1 4D", voronoi("4D", w=0.7, output="Color")), ("f2 4D w", voronoi("4D", "F2", w=0.35, output="W")),
+    ("f1 1D", voronoi("1D", w=1.3, output="Color")), ("edge 1D", voronoi("1D", "DISTANCE_TO_EDGE", w=2.1)),
+    ("f1 fractal normalized", voronoi(detail=2.5, roughness=0.6, normalize=True)),
+    ("f2 fractal color", voronoi("2D", "F2", detail=1.5, output="Color", normalize=True)),
+    ("edge fractal", voronoi(feature="DISTANCE_TO_EDGE", detail=2.0, lacunarity=2.5, normalize=True)),
+    ("f1 fractal position", voronoi("2D", detail=1.7, output="Position")),
+    ("f1 randomness", voronoi(randomness=0.4, scale=3.0, coords="Object")),
+]
+
+
+def wave(kind="BANDS", direction="X", profile="SIN", scale=2.0, distortion=0.0, detail=2.0, phase=0.0):
+    def graph(tree, socket):
+        t = _node(tree, "ShaderNodeTexWave", wave_type=kind, wave_profile=profile)
+        if kind == "BANDS":
+            t.bands_direction = direction
+        else:
+            t.rings_direction = direction
+        for ident, val in (("Scale", scale), ("Distortion", distortion), ("Detail", detail),
+                           ("Detail Scale", 1.5), ("Detail Roughness", 0.5), ("Phase Offset", phase)):
+            _set(t, ident, val)
+        _link(tree, t.outputs["Color"], socket)
+    return graph
+
+
+def magic(depth=2, scale=5.0, distortion=1.0, coords="Generated", stretch=1.0):
+    def graph(tree, socket):
+        t = _node(tree, "ShaderNodeTexMagic", turbulence_depth=depth)
+        _set(t, "Scale", scale)
+        _set(t, "Distortion", distortion)
+        m = _node(tree, "ShaderNodeVectorMath", operation="SCALE")
+        _link(tree, _coords(tree, coords), m.inputs[0])
+        _set(m, "Scale", stretch)
+        _link(tree, m.outputs[0], t.inputs["Vector"])
+        _link(tree, t.outputs["Color"], socket)
+    return graph
+
+
+def brick(scale=3.0, offset=0.5, offset_frequency=2, squash=1.0, squash_frequency=2, smooth=0.5, bias=0.0,
+          output="Color", mortar=0.03):
+    def graph(tree, socket):
+        t = _node(tree, "ShaderNodeTexBrick", offset=offset, offset_frequency=offset_frequency, squash=squash,
+                  squash_frequency=squash_frequency)
+        for ident, val in (("Scale", scale), ("Mortar Size", mortar), ("Mortar Smooth", smooth), ("Bias", bias),
+                           ("Brick Width", 0.5), ("Row Height", 0.25)):
+            _set(t, ident, val)
+        _set(t, "Color1", (0.8, 0.3, 0.1, 1))
+        _set(t, "Color2", (0.2, 0.5, 0.9, 1))
+        _set(t, "Mortar", (0.05, 0.05, 0.05, 1))
+        _link(tree, _coords(tree, "Object"), t.inputs["Vector"])
+        _link(tree, t.outputs[output], socket)
+    return graph
+
+
+PATTERNS = [
+    ("wave bands x", wave()), ("wave bands diagonal saw", wave(direction="DIAGONAL", profile="SAW", phase=0.7)),
+    ("wave rings spherical tri", wave("RINGS", "SPHERICAL", "TRI", scale=1.5)),
+    ("wave rings z distorted", wave("RINGS", "Z", distortion=3.0, detail=1.5)),
+    ("wave bands y distorted", wave(direction="Y", distortion=5.0, detail=0.0)),
+    ("magic depth 2", magic()), ("magic depth 5", magic(5, 3.0, 1.7)),
+    ("magic beyond two pi", magic(3, 0.3, 1.2, coords="Object", stretch=25.0)), ("magic depth 0", magic(0, 4.0, 0.0)),
+    ("brick", brick()), ("brick squashed", brick(4.0, 0.3, 3, 0.6, 2, 0.4, 0.2)),
+    ("brick mortar fac", brick(smooth=0.7, output="Fac", mortar=0.1)),
+]
+
+
+FAMILIES = {"noise": NOISE, "textures": TEXTURES, "converters": CONVERTERS, "mixes": MIXES, "inputs": INPUTS,
+            "voronoi": VORONOI, "patterns": PATTERNS}

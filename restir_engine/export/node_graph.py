@@ -475,6 +475,48 @@ def _gradient(g, node, f):
     return {"Color": color, "Fac": fac}
 
 
+def _voronoi(g, node, f):
+    ins = [g.inp(node, "Vector", "vector", f, default="generated")] + [
+        g.inp(node, k, "float", f) for k in ("W", "Scale", "Detail", "Roughness", "Lacunarity", "Smoothness",
+                                            "Exponent", "Randomness")]
+    params = {"dims": int(str(node.voronoi_dimensions)[0]), "feature": node.feature, "metric": node.distance,
+              "normalize": bool(getattr(node, "normalize", False))}
+    dist, color, pos, w, radius = g.emit("voronoi", params, ins, ("float", "color", "vector", "float", "float"))
+    return {"Distance": dist, "Color": color, "Position": pos, "W": w, "Radius": radius}
+
+
+def _wave(g, node, f):
+    ins = [g.inp(node, "Vector", "vector", f, default="generated")] + [
+        g.inp(node, k, "float", f) for k in ("Scale", "Distortion", "Detail", "Detail Scale", "Detail Roughness",
+                                            "Phase Offset")]
+    bands = node.wave_type == "BANDS"
+    params = {"type": node.wave_type, "direction": node.bands_direction if bands else node.rings_direction,
+              "profile": node.wave_profile}
+    color, fac = g.emit("wave", params, ins, ("color", "float"))
+    return {"Color": color, "Fac": fac}
+
+
+def _magic(g, node, f):
+    import bpy  # the wrap of the coordinates changed in Blender 5.2
+
+    ins = [g.inp(node, "Vector", "vector", f, default="generated"), g.inp(node, "Scale", "float", f),
+           g.inp(node, "Distortion", "float", f)]
+    params = {"depth": int(node.turbulence_depth), "wrap_scaled": tuple(bpy.app.version[:2]) >= (5, 2)}
+    color, fac = g.emit("magic", params, ins, ("color", "float"))
+    return {"Color": color, "Fac": fac}
+
+
+def _brick(g, node, f):
+    ins = [g.inp(node, "Vector", "vector", f, default="generated"), g.inp(node, "Color1", "color", f),
+           g.inp(node, "Color2", "color", f), g.inp(node, "Mortar", "color", f)] + [
+        g.inp(node, k, "float", f) for k in ("Scale", "Mortar Size", "Mortar Smooth", "Bias", "Brick Width",
+                                            "Row Height")]
+    params = {"offset": float(node.offset), "offset_frequency": int(node.offset_frequency),
+              "squash": float(node.squash), "squash_frequency": int(node.squash_frequency)}
+    color, fac = g.emit("brick", params, ins, ("color", "float"))
+    return {"Color": color, "Fac": fac}
+
+
 _HANDLERS = {
     "TEX_COORD": _texcoord, "UVMAP": _uvmap, "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
     "VERTEX_COLOR": _color_attribute, "ATTRIBUTE": _attribute, "FRESNEL": _fresnel, "LAYER_WEIGHT": _layer_weight,
@@ -492,4 +534,5 @@ _HANDLERS = {
     "COMBHSV": _combine(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "VALTORGB": _color_ramp, "CURVE_RGB": _rgb_curves, "CURVE_FLOAT": _float_curve, "TEX_IMAGE": _image,
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
+    "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic, "TEX_BRICK": _brick,
 }

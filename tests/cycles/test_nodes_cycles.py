@@ -20,6 +20,12 @@ from stats import Z_MAX, MARGIN, POWER_ERROR
 
 COLS, PX, CELL = 8, 16, 4
 REPS, SAMPLES = 4, 16
+#: families with hard edges inside pixels (brick mortar, Voronoi cells): their cells' spread differs from seed to
+#: seed, and 4 seeds estimate it too poorly for a 5-standard-error bound over hundreds of cells
+REPS_OF = {"patterns": 16, "voronoi": 16}
+#: Cycles at 16 samples is off by about 3 % on pixel-aligned brick mortar (its sample pattern, not the texture: at
+#: 512 samples it agrees with ours to 0.5 %); those families' references are rendered with more samples
+CYCLES_SAMPLES_OF = {"patterns": 256, "voronoi": 256}
 FLOAT_TOL = 1e-3
 #: cases whose pattern Cycles before 5.1 computes otherwise (its white noise colour in 3D and 4D); we follow 5.1+
 PRE_51_DIFFERENT = {"white noise 3D", "white noise 4D"}
@@ -53,8 +59,10 @@ def test_node_patterns_match_cycles(addon, family):
 
     def build():
         return node_planes([g for _n, g in cases], COLS, PX, name=family.capitalize())
-    ours = ours_cells(build, 0, SAMPLES, reduce, reps=REPS, integrator="PATH")
-    ref = cycles_reference(f"nodes_{family}", build, 0, SAMPLES, reduce, reps=REPS)
+    reps = REPS_OF.get(family, REPS)
+    ours = ours_cells(build, 0, SAMPLES, reduce, reps=reps, integrator="PATH")
+    ref = cycles_reference(f"nodes_{family}", build, 0, CYCLES_SAMPLES_OF.get(family, SAMPLES), reduce,
+                           reps=REPS if family in CYCLES_SAMPLES_OF else reps)
     per = (PX // CELL) ** 2 * 3
     ok = within(ours, ref)
     for i, (name, _g) in enumerate(cases):  # Blender 5.0 hashes 3D/4D white noise otherwise (5.2 LTS: matched)

@@ -97,3 +97,40 @@ def hash_floats_to_color(*xs) -> np.ndarray:
         return np.stack([hash_floats(x, y, z, w), hash_floats(z, x, w, y), hash_floats(w, z, y, x)])
     one, two = np.ones_like(xs[0]), np.full_like(xs[0], 2.0)
     return np.stack([hash_floats(*xs), hash_floats(*xs, one), hash_floats(*xs, two)])
+
+
+# -- PCG (Jarzynski and Olano's permuted congruential hashes of integer vectors; Voronoi in 2-4D) ---------------
+_PCG_MUL, _PCG_ADD = np.int32(1664525), np.int32(1013904223)
+
+
+def _pcg_mix(v: list) -> None:
+    """One mixing round, in place (int32 wrap-around)."""
+    if len(v) == 2:
+        v[0] += v[1] * _PCG_MUL
+        v[1] += v[0] * _PCG_MUL
+    elif len(v) == 3:
+        v[0] += v[1] * v[2]
+        v[1] += v[2] * v[0]
+        v[2] += v[0] * v[1]
+    else:
+        v[0] += v[1] * v[3]
+        v[1] += v[2] * v[0]
+        v[2] += v[0] * v[1]
+        v[3] += v[1] * v[2]
+
+
+def pcg(*cells) -> list:
+    """PCG of 2-4 int32 cell coordinates (arrays of one shape) -> that many float32 arrays in [0, 1)."""
+    with np.errstate(over="ignore"):
+        v = [np.asarray(c, np.int32) * _PCG_MUL + _PCG_ADD for c in np.broadcast_arrays(*cells)]
+        _pcg_mix(v)
+        v = [x ^ (x >> np.int32(16)) for x in v]  # arithmetic shift of the signed value
+        _pcg_mix(v)
+    return [(x & np.int32(0x7FFFFFFF)).astype(np.float32) * np.float32(1.0 / 2147483648.0) for x in v]
+
+
+def pcg_color(*cells) -> np.ndarray:
+    """A cell's colour (3, ...): 2D cells as the 3D hash of (x, y, 0), 4D cells the first three of their hash."""
+    if len(cells) == 2:
+        cells = (*cells, np.zeros_like(np.asarray(cells[0], np.int32)))
+    return np.stack(pcg(*cells)[:3])
