@@ -505,3 +505,72 @@ def node_materials_scene(size=(96, 64)):
     black_world(scene)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def bumped_materials_scene(size=(96, 64)):
+    """Shading normals from node graphs, lit: a floor bumped by a Voronoi F1 distance (and coloured by Brick), a
+    sphere bumped by Noise (Strength 0.7, over a Principled base), a sphere whose tangent-space Normal Map takes a
+    Noise colour mixed towards flat, and a cube with a world-space Normal Map of a Wave; an area light and a point
+    light."""
+    import node_graphs as ng
+    scene = reset()
+
+    def principled(name, color, rough):
+        m = bpy.data.materials.new(name)
+        enable_nodes(m)
+        b = m.node_tree.nodes["Principled BSDF"]
+        b.inputs["Base Color"].default_value = (*color, 1)
+        b.inputs["Roughness"].default_value = rough
+        return m, m.node_tree, b
+
+    floor, t, b = principled("BumpFloor", (0.7, 0.7, 0.7), 0.35)
+    vor = ng._node(t, "ShaderNodeTexVoronoi")
+    ng._set(vor, "Scale", 3.0)
+    bump = ng._node(t, "ShaderNodeBump")
+    ng._set(bump, "Distance", 0.3)
+    t.links.new(vor.outputs["Distance"], bump.inputs["Height"])
+    t.links.new(bump.outputs["Normal"], b.inputs["Normal"])
+    ng.brick(scale=2.0)(t, b.inputs["Base Color"])
+    plane("Floor", 4.0, (0, 0, 0), material=floor)
+    s1, t, b = principled("BumpSphere", (0.8, 0.4, 0.2), 0.3)
+    nz = ng._node(t, "ShaderNodeTexNoise")
+    ng._set(nz, "Scale", 6.0)
+    bump = ng._node(t, "ShaderNodeBump", invert=True)
+    ng._set(bump, "Strength", 0.7)
+    t.links.new(nz.outputs["Fac"], bump.inputs["Height"])
+    t.links.new(bump.outputs["Normal"], b.inputs["Normal"])
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(-0.75, 0.2, 0.5), segments=32, ring_count=16)
+    bpy.ops.object.shade_smooth()
+    bpy.context.active_object.data.materials.append(s1)
+    s2, t, b = principled("MappedSphere", (0.3, 0.5, 0.8), 0.25)
+    nz = ng._node(t, "ShaderNodeTexNoise")
+    ng._set(nz, "Scale", 4.0)
+    mix = ng._node(t, "ShaderNodeMix", data_type="RGBA")
+    mix.inputs["Factor"].default_value = 0.6
+    ng._in(mix, "A_Color").default_value = (0.5, 0.5, 1.0, 1.0)
+    t.links.new(nz.outputs["Color"], ng._in(mix, "B_Color"))
+    nm = ng._node(t, "ShaderNodeNormalMap", space="TANGENT")
+    t.links.new(ng._out(mix, "Result_Color"), nm.inputs["Color"])
+    t.links.new(nm.outputs["Normal"], b.inputs["Normal"])
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.45, location=(0.75, -0.1, 0.45), segments=32, ring_count=16)
+    bpy.ops.object.shade_smooth()
+    bpy.context.active_object.data.materials.append(s2)
+    s3, t, b = principled("WorldMappedCube", (0.6, 0.6, 0.3), 0.4)
+    wave = ng._node(t, "ShaderNodeTexWave")
+    ng._set(wave, "Scale", 3.0)
+    comb = ng._node(t, "ShaderNodeCombineXYZ")
+    t.links.new(wave.outputs["Fac"], comb.inputs["X"])
+    comb.inputs["Y"].default_value = 0.5
+    comb.inputs["Z"].default_value = 1.0
+    nm = ng._node(t, "ShaderNodeNormalMap", space="WORLD")
+    ng._set(nm, "Strength", 0.5)
+    t.links.new(comb.outputs["Vector"], nm.inputs["Color"])
+    t.links.new(nm.outputs["Normal"], b.inputs["Normal"])
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(0.0, 0.9, 0.25), rotation=(0, 0, 0.5))
+    bpy.context.active_object.data.materials.append(s3)
+    light("AREA", (-1.5, -1.5, 2.5), (math.radians(40), 0, math.radians(-45)), energy=150.0, size=1.0)
+    light("POINT", (1.5, -0.5, 1.6), (0, 0, 0), energy=60.0)
+    camera((0, -3.6, 2.2), (math.radians(62), 0, 0), lens=35)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

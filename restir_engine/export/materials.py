@@ -55,6 +55,8 @@ class MaterialRegistry:
 
     def uses_normal_maps(self, indices) -> bool:
         def mapped(row: dict) -> bool:
+            if row.get("program") is not None and "tangent_uv" in row["program"].reads:
+                return True
             return row.get("normal_tex", -1) >= 0 or any(mapped(self.rows[c]) for c, *_r in row.get("mix", ()))
         # (a Bump alone needs no tangents: its surface gradient comes from the triangle's positions and UVs)
         return any(mapped(self.rows[i]) for i in indices)
@@ -64,7 +66,7 @@ class MaterialRegistry:
         def textured(row: dict) -> bool:
             if max(row.get(k, -1) for k in ("base_tex", "emit_tex", "alpha_tex", "normal_tex", "bump_tex")) >= 0:
                 return True
-            if row.get("program") is not None and "uv" in row["program"].reads:
+            if row.get("program") is not None and {"uv", "tangent_uv"} & set(row["program"].reads):
                 return True
             return any(tex >= 0 or textured(self.rows[comp]) for comp, _w, tex, _s in row.get("mix", ()))
         return any(textured(self.rows[i]) for i in indices)
@@ -220,7 +222,7 @@ class MaterialRegistry:
                 row["diffuse_roughness"] = float(np.clip(dr, 0, 1))
             if "Alpha" in inp:
                 self._alpha(material, inp["Alpha"], row)
-            self._normal(material, node, row)
+            self._normal(material, node, row, g, varying)
             return self._with_program(row, g, varying)
         if t == "BSDF_GLASS":
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
@@ -241,7 +243,7 @@ class MaterialRegistry:
                                             "base_tex")
             dr = self._param(material, g, node.inputs["Roughness"], "float", "diffuse_roughness", varying)
             row["diffuse_roughness"] = float(np.clip(dr, 0, 1))
-            self._normal(material, node, row)
+            self._normal(material, node, row, g, varying)
             return self._with_program(row, g, varying)
         if t == "EMISSION":
             row = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
@@ -259,7 +261,7 @@ class MaterialRegistry:
             if "Anisotropy" in node.inputs and (node.inputs["Anisotropy"].is_linked
                                                 or abs(float(node.inputs["Anisotropy"].default_value)) > 1e-4):
                 self._warn(material, "Glossy BSDF anisotropy is not supported; rendered isotropic")
-            self._normal(material, node, row)
+            self._normal(material, node, row, g, varying)
             return self._with_program(row, g, varying)
         if t in {"MIX_SHADER", "ADD_SHADER"}:
             return self._mix(material, node, depth)
@@ -321,42 +323,61 @@ class MaterialRegistry:
         row["glass_multiscatter"] = row.get("multiscatter", 1.0)
 
     # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/materials/mix.py) ---------
-    def _normal(self, material, node, row: dict) -> None:
-        """A BSDF's Normal input: a tangent-space Normal Map node on an Image Texture -> normal_tex and
-        normal_strength; a Bump node whose Height is an Image Texture -> bump_tex, bump_strength, bump_distance
-        (its own Normal input may hold such a Normal Map); anything else is reported and ignored."""
+    def _normal(self, material, node, row: dict, g: GraphCompiler | None = None, varying: dict | None = None) -> None:
+        """A BSDF's Normal input. A tangent-space Normal Map of an Image Texture and a Bump of an Image Texture
+        (over nothing or such a Normal Map) -> the row's normal_tex / bump_tex fields (read at render time without
+        a node program); any other graph -> ``varying["normal"]``, the node program's normal (Normal Map and Bump
+        of any input)."""
         socket = node.inputs.get("Normal")
         if socket is None or not socket.is_linked:
             return
-        src = socket.links[0].from_node
-        if src.type == "BUMP":  # its height (if supported), then what its own Normal input holds
-            self._bump(material, src, row)
+        if self._image_normal(material, socket.links[0].from_node, row):
+            return
+        if g is None:
+            self._warn(material, f"the Normal input of '{node.name}' is not supported here; the mesh normal is used")
+            return
+        reg = g.value(socket, "vector", default="normal")
+        if reg.const is None:
+            varying["normal"] = reg
+
+    def _image_normal(self, material, src, row: dict) -> bool:
+        """Normal Map / Bump of plain Image Textures -> row fields; False (row unchanged) for anything else."""
+        bump = None
+        if src.type == "BUMP":
+            bump = src
             inner = src.inputs.get("Normal")
-            if inner is None or not inner.is_linked:
-                return
-            src = inner.links[0].from_node
-        if src.type == "NORMAL_MAP" and src.space == "TANGENT":
-            col = src.inputs["Color"]
-            img = col.links[0].from_node if col.is_linked else None
-            if img is not None and img.type == "TEX_IMAGE" and img.image is not None:
-                if src.uv_map:
-                    self._warn(material, f"'{src.name}' names UV map '{src.uv_map}'; the render UV map is used")
-                row["normal_tex"] = self._texture(material, img.image, closest=img.interpolation == "Closest")
-                row["normal_strength"] = self._float_input(material, src.inputs["Strength"])
-                return
-        self._warn(material, f"'{src.name}' ({src.type}) on the Normal input is not supported; the mesh normal is "
-                   "used (supported: a tangent-space Normal Map of an Image Texture, a Bump of an Image Texture)")
+            src = inner.links[0].from_node if inner is not None and inner.is_linked else None
+            height = bump.inputs["Height"]
+            img = height.links[0].from_node if height.is_linked else None
+            if img is None or img.type != "TEX_IMAGE" or img.image is None or img.inputs["Vector"].is_linked:
+                return False
+        nmap = None
+        if src is not None:
+            col = src.inputs.get("Color") if src.type == "NORMAL_MAP" else None
+            img = col.links[0].from_node if col is not None and col.is_linked else None
+            if (src.type != "NORMAL_MAP" or src.space != "TANGENT" or img is None or img.type != "TEX_IMAGE"
+                    or img.image is None or img.inputs["Vector"].is_linked or src.inputs["Strength"].is_linked):
+                return False
+            nmap = (src, img)
+        if bump is not None and not self._bump(material, bump, row):
+            return False
+        if nmap is not None:
+            src, img = nmap
+            if src.uv_map:
+                self._warn(material, f"'{src.name}' names UV map '{src.uv_map}'; the render UV map is used")
+            row["normal_tex"] = self._texture(material, img.image, closest=img.interpolation == "Closest")
+            row["normal_strength"] = self._float_input(material, src.inputs["Strength"])
+        return True
 
     def _bump(self, material, node, row: dict) -> bool:
-        """A Bump node with an Image Texture on Height (Color as luminance, or Alpha) -> row fields; False (with a
-        warning) when its height is anything else."""
+        """A Bump node with an Image Texture on Height (Color as luminance, or Alpha) -> row fields; False when
+        its height is anything else or its inputs are linked."""
         height = node.inputs["Height"]
         link = height.links[0] if height.is_linked else None
         img = link.from_node if link is not None else None
         if img is None or img.type != "TEX_IMAGE" or img.image is None:
-            what = "nothing" if img is None else f"'{img.name}' ({img.type})"
-            self._warn(material, f"Bump '{node.name}': its Height is {what}; the bump is ignored (supported: an "
-                       "Image Texture)")
+            return False
+        if node.inputs["Strength"].is_linked or node.inputs["Distance"].is_linked:
             return False
         sign = -1.0 if getattr(node, "invert", False) else 1.0
         alpha = link.from_socket.name == "Alpha"

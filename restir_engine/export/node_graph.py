@@ -517,6 +517,33 @@ def _brick(g, node, f):
     return {"Color": color, "Fac": fac}
 
 
+def _normal_map(g, node, f):
+    space = node.space
+    color = g.inp(node, "Color", "color", f)
+    strength = g.inp(node, "Strength", "float", f)
+    if space == "TANGENT":
+        if node.uv_map:
+            g.warn(f"'{node.name}' names UV map '{node.uv_map}'; the render UV map's tangents are used")
+        g.attribute("tangent_uv", "vector")  # (read by the operation; named so that the export makes tangents)
+    for name in ("normal", "backfacing"):
+        g.attribute(name, "vector" if name == "normal" else "float")
+    return {"Normal": g.emit("normal_map", {"space": space}, [strength, color], ("vector",))[0]}
+
+
+def _bump(g, node, f):
+    normal_in = g.inp(node, "Normal", "vector", f, default="normal")
+    height = node.inputs["Height"]
+    sub = GraphCompiler(g._textures, g._warn)
+    h = sub.value(height, "float", frame=f)
+    if h.const is not None:  # a constant height bumps nothing
+        return {"Normal": normal_in}
+    g.reads |= sub.reads | {"true_normal", "footprint"}
+    program = sub.program({"height": h})
+    ins = [g.inp(node, "Strength", "float", f), g.inp(node, "Distance", "float", f), normal_in]
+    params = {"height": program, "invert": bool(getattr(node, "invert", False))}
+    return {"Normal": g.emit("bump", params, ins, ("vector",))[0]}
+
+
 _HANDLERS = {
     "TEX_COORD": _texcoord, "UVMAP": _uvmap, "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
     "VERTEX_COLOR": _color_attribute, "ATTRIBUTE": _attribute, "FRESNEL": _fresnel, "LAYER_WEIGHT": _layer_weight,
@@ -534,5 +561,5 @@ _HANDLERS = {
     "COMBHSV": _combine(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "VALTORGB": _color_ramp, "CURVE_RGB": _rgb_curves, "CURVE_FLOAT": _float_curve, "TEX_IMAGE": _image,
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
-    "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic, "TEX_BRICK": _brick,
+    "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic, "TEX_BRICK": _brick,
 }

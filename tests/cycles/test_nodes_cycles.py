@@ -79,21 +79,24 @@ def test_node_patterns_match_cycles(addon, family):
     assert not blind, f"cannot see a 3 % error in: {blind}"
 
 
+@pytest.mark.parametrize("case", ["materials", "bumped"])
 @pytest.mark.parametrize("method", ["PATH", "RESTIR_DI"])
-def test_lit_node_materials_match_cycles(addon, method):
+def test_lit_node_materials_match_cycles(addon, method, case):
     """Node-driven Roughness, Metallic, Base Color, a Layer Weight Mix factor and a node-textured quad light, lit,
     1 bounce: 4 x 4 image cells against Cycles with the materials tests' bound (tests/stats.py), each cell able to
-    see a 3 % error where it is lit."""
-    from bpy_scenes import node_materials_scene
+    see a 3 % error where it is lit. "bumped": shading normals from Bump and Normal Map nodes of procedural
+    textures (bpy_scenes.bumped_materials_scene)."""
+    from bpy_scenes import bumped_materials_scene, node_materials_scene
+    build_scene = node_materials_scene if case == "materials" else bumped_materials_scene
     from stats import assert_cells_match, cell_means, image_cells, robust_var
     size = (96, 64)
     masks = image_cells(size, 4)
     settings = {"integrator": "PATH"} if method == "PATH" else {
         "integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "temporal_reuse": True,
         "spatial_neighbors": 5}
-    ours = ours_cells(lambda: node_materials_scene(size), 1, 32, lambda im: cell_means(im, masks), **settings)
-    ref = cycles_reference("nodes_lit_b1", lambda: node_materials_scene(size), 1, 128,
-                           lambda im: cell_means(im, masks))
+    ours = ours_cells(lambda: build_scene(size), 1, 32, lambda im: cell_means(im, masks), **settings)
+    ref = cycles_reference("nodes_lit_b1" if case == "materials" else "nodes_bumped_b1", lambda: build_scene(size),
+                           1, 128, lambda im: cell_means(im, masks))
     names = [f"cell {i}" for i in range(len(masks))]
     lit = [i for i in range(len(masks)) if ref.mean(0)[i] > 0.05]
     # the cells fine enough to see a 3 % error (glossy highlights of the lamp leave some too noisy at this

@@ -78,5 +78,8 @@ def test_bump_and_bump_over_normal_map_are_exported(addon):
     tree.links.new(noise.outputs["Fac"], bump.inputs["Height"])
     reg = MaterialRegistry(warnings)
     row = reg.rows[reg.material_index(mat)]
-    assert row.get("bump_tex", -1) < 0 and any("Bump" in w and "Height" in w for w in warnings)
-    assert row["normal_tex"] >= 0  # the Normal Map under an unsupported Bump still applies
+    # a procedural height: the whole Normal input becomes the node program's normal (Bump of Noise over the
+    # image's Normal Map), which needs the UV tangents
+    assert row.get("bump_tex", -1) < 0 and row.get("normal_tex", -1) < 0 and not warnings
+    assert "normal" in row["program"].outputs and "tangent_uv" in row["program"].reads
+    assert reg.uses_normal_maps([reg.index[mat.name_full]])

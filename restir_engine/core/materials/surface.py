@@ -22,6 +22,20 @@ from .textures import apply_texture, gradient, sample
 PARAM_FIELDS = ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness")
 
 
+def pixel_spread(camera) -> tuple:
+    """A pixel's footprint on a surface at distance t from the camera ≈ a + b t (scene units): the width of a
+    pixel on the image plane at unit distance (perspective) or on the view plane (orthographic)."""
+    if camera is None:
+        return (np.float32(0.0), np.float32(1e-3))
+    m = np.asarray(camera.ndc_to_cam, np.float64)
+    lo, hi = m @ np.array([0.0, -1.0, -1.0, 1.0]), m @ np.array([0.0, 1.0, -1.0, 1.0])
+    lo, hi = lo[:3] / lo[3], hi[:3] / hi[3]
+    if camera.ortho:
+        return (np.float32(abs(hi[1] - lo[1]) / max(camera.height, 1)), np.float32(0.0))
+    tan = abs(hi[1] / hi[2] - lo[1] / lo[2]) if abs(hi[2]) > 0 and abs(lo[2]) > 0 else 1.0
+    return (np.float32(0.0), np.float32(tan / max(camera.height, 1)))
+
+
 class Surface:
     """Hits of rays o + t·d on scene triangles ``prim`` at barycentrics (u, v): p, ng, ns (facing the ray),
     wo, the tangent frame (t, bt), wo_l, material index and BSDF params (textures applied)."""
@@ -37,7 +51,7 @@ class Surface:
         mat, scale = self._pick_mix_components(ctx, mat, d)
         ng = cols(ctx.geom_ng_rows, prim)
         ns = self._interpolated_normal(ctx, ng)
-        ns, mapped, smooth_n = self._mapped_normal(ctx, mat, ns, ng, d)
+        ns, mapped, smooth_n = self._mapped_normal(ctx, mat, ns, ng, d, t)
         # shading normal on the geometric normal's side, both facing the incoming ray
         s_ng = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
         s_ns = np.where(dot(ns, ng) < 0, -s_ng, s_ng)
@@ -104,24 +118,48 @@ class Surface:
             ns[:, bad] = ng[:, bad]
         return ns
 
-    def _mapped_normal(self, ctx, mat, ns, ng, d):
-        """Normal Map and Bump nodes applied to ``ns`` (in place). Returns (ns, the hits they changed or None, those
-        hits' smooth normals before mapping (3, k) or None)."""
+    def _mapped_normal(self, ctx, mat, ns, ng, d, t):
+        """Normal Map and Bump nodes applied to ``ns`` (in place): the image-only forms (normal_tex, bump_tex) and
+        node programs' "normal". Returns (ns, the hits they changed or None, those hits' smooth normals before
+        mapping (3, k) or None)."""
         mats, geom = ctx.scene.materials, ctx.scene.geometry
         prim, u, v = self.prim, self.b1, self.b2
         none = np.empty(0, np.intp)
         nmap = np.flatnonzero(mats.normal_tex[mat] >= 0) if ctx.normal_maps and geom.tangents is not None else none
         bump = np.flatnonzero(mats.bump_tex[mat] >= 0) if ctx.bump_maps and geom.uvs is not None else none
-        if not (len(nmap) or len(bump)):
+        programs = self._program_normals(ctx, mat, ns, ng, d, t) if ctx.has_programs else None
+        if not (len(nmap) or len(bump) or programs):
             return ns, None, None
-        mapped = np.union1d(nmap, bump)
+        rows, normals = programs or (none, None)
+        mapped = np.union1d(np.union1d(nmap, bump), rows)
         smooth_n = ns[:, mapped].copy()
         if len(nmap):
             ns[:, nmap] = normal_map(mats, geom, mat, prim, u, v, ns, nmap)
         if len(bump):  # about the normal facing the ray, as Cycles (then turned back like every normal)
             facing = np.where(dot(cols(ng, bump), cols(d, bump)) > 0, np.float32(-1.0), np.float32(1.0))
             ns[:, bump] = bump_map(mats, geom, mat, prim, u, v, ns[:, bump] * facing, bump) * facing
+        if len(rows):
+            ns[:, rows] = normals
         return ns, mapped, smooth_n
+
+    def _program_normals(self, ctx, mat, ns, ng, d, t):
+        """(hits, their normals (3, k)) where a node program computes the shading normal (Normal Map, Bump of any
+        graph), in the orientation of ``ns`` (the program sees and returns normals facing the ray); None where
+        no program does."""
+        mats, geom = ctx.scene.materials, ctx.scene.geometry
+        facing = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
+        spread = pixel_spread(ctx.scene.camera)
+        rows_all, normals = [], []
+        for rows, out in run_programs(mats, mat, lambda r: HitAttributes(
+                geom, self.prim[r], self.b1[r], self.b2[r], mats.textures, wo=-cols(d, r),
+                normal=cols(ns, r) * facing[r], true_normal=cols(ng, r) * facing[r],
+                footprint=spread[0] + spread[1] * np.asarray(t, np.float32)[r]), ("normal",)):
+            if "normal" in out:
+                rows_all.append(rows)
+                normals.append(out["normal"] * facing[rows])
+        if not rows_all:
+            return None
+        return np.concatenate(rows_all), np.concatenate(normals, axis=1)
 
     def _material_params(self, ctx, mat, scale) -> None:
         """The hits' BSDF parameters: a view of the material table, re-derived where a texture drives the base

@@ -4,8 +4,9 @@ World-space vectors are (3, n) float32 rows; normals face the viewer where the v
 exporter's programs read them): "position", "normal" (shading), "true_normal", "incoming" (towards the viewer),
 "backfacing" (1 or 0), "uv" (u, v, 0), "generated" (the object's texture space, [0, 1] over its box),
 "object" (object-space position), "object_normal", "reflection", "parametric", "object_location",
-"object_color", "object_alpha", "object_random", and "attr:<name>" / "attr_alpha:<name>" for a colour attribute
-(RGB and alpha, linear)."""
+"object_color", "object_alpha", "object_random", "attr:<name>" / "attr_alpha:<name>" for a colour attribute
+(RGB and alpha, linear), "tangent_uv" / "tangent_sign" (the UV map's interpolated tangent and bitangent sign, or
+None without tangents) and "footprint" (a pixel's width on the surface, scene units)."""
 from __future__ import annotations
 
 import numpy as np
@@ -20,7 +21,7 @@ class HitAttributes:
     (3, n) towards the viewer, ``normal`` and ``true_normal`` (3, n) facing it, when the caller has them;
     ``textures``: the material table's images."""
 
-    def __init__(self, tris, prim, b1, b2, textures, wo=None, normal=None, true_normal=None):
+    def __init__(self, tris, prim, b1, b2, textures, wo=None, normal=None, true_normal=None, footprint=None):
         self.tris, self.prim = tris, np.asarray(prim, np.intp)
         self.b1, self.b2 = np.asarray(b1, np.float32), np.asarray(b2, np.float32)
         self.textures = textures
@@ -32,6 +33,31 @@ class HitAttributes:
         if true_normal is not None:
             self._cache["true_normal"] = true_normal
         self._wo = wo
+        self._given = {"normal": normal, "true_normal": true_normal, "footprint": footprint}
+        if footprint is not None:
+            self._cache["footprint"] = np.broadcast_to(np.asarray(footprint, np.float32), self.b1.shape)
+
+    def shifted(self, delta) -> "HitAttributes":
+        """The same points moved by ``delta`` (3, n) in their triangles' planes (barycentrics moved, so that
+        positions, texture coordinates and attributes all move with them); normals and the view stay."""
+        v = np.take(self.tris.verts, self.prim, axis=0)
+        e1, e2 = (v[:, 1] - v[:, 0]).T, (v[:, 2] - v[:, 0]).T
+        g11, g12, g22 = dot(e1, e1), dot(e1, e2), dot(e2, e2)
+        r1, r2 = dot(e1, delta), dot(e2, delta)
+        det = g11 * g22 - g12 * g12
+        det = np.where(np.abs(det) > 1e-30, det, _F(1e30))
+        db1, db2 = (g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det
+        return HitAttributes(self.tris, self.prim, self.b1 + db1, self.b2 + db2, self.textures, wo=self._wo,
+                             normal=self.get("normal"), true_normal=self.get("true_normal"),
+                             footprint=self.get("footprint"))
+
+    def object_normal_to_world(self, n) -> np.ndarray:
+        """Object-space normals (3, n) in world space (the inverse transpose of each instance's matrix)."""
+        inst, objs = self._instances()
+        if inst is None:
+            return np.asarray(n, np.float32)
+        m = objs.world_to_object[inst][:, :, :3].astype(np.float32)  # world -> object; normals go with Mᵀ
+        return np.einsum("nji,jn->in", m, np.asarray(n, np.float32)).astype(np.float32)
 
     def __len__(self) -> int:
         return len(self.prim)
@@ -129,6 +155,17 @@ class HitAttributes:
             data = {"object_location": objs.location, "object_color": objs.color[:, :3],
                     "object_alpha": objs.color[:, 3], "object_random": objs.random}[name]
             return np.ascontiguousarray(data[inst].T, dtype=np.float32)
+        if name in {"tangent_uv", "tangent_sign"}:
+            tg = getattr(self.tris, "tangents", None)
+            if tg is None:
+                return None
+            t = np.take(tg, self.prim, axis=0)  # (n, 3 corners, 4): xyz, sign
+            if name == "tangent_sign":
+                return np.ascontiguousarray(t[:, 0, 3], dtype=np.float32)
+            tan = barycentric(t[:, 0, :3].T, t[:, 1, :3].T, t[:, 2, :3].T, self.b1, self.b2)
+            return (tan / np.maximum(norm(tan), _F(1e-30))).astype(np.float32)
+        if name == "footprint":
+            return np.full(n, _F(1e-3), np.float32)
         if name.startswith("attr:") or name.startswith("attr_alpha:"):
             key = name.split(":", 1)[1]
             data = (getattr(self.tris, "attributes", None) or {}).get(key)

@@ -13,12 +13,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import ops_math, ops_patterns, ops_texture
+from . import ops_math, ops_normals, ops_patterns, ops_texture
 
 #: every operation an instruction may name
-OPERATIONS = {**ops_math.OPERATIONS, **ops_texture.OPERATIONS, **ops_patterns.OPERATIONS}
+OPERATIONS = {**ops_math.OPERATIONS, **ops_texture.OPERATIONS, **ops_patterns.OPERATIONS,
+              **ops_normals.OPERATIONS}
 #: operations that read the hits (never folded into constants)
-READS_HITS = ops_texture.READS_HITS
+READS_HITS = ops_texture.READS_HITS | ops_normals.READS_HITS
 
 
 @dataclass
