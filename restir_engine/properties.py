@@ -183,6 +183,17 @@ SCENE_FIELDS = (
         "or 1/8 resolution to stay under it, then refines at full resolution "
         "(0 = always full resolution)", default=int(DEFAULT_BUDGET * 1000), min=0,
         soft_max=2000)),
+    Field("pixel_filter", EnumProperty, None, dict(
+        name="Pixel Filter", description="How camera samples spread over neighbouring pixels (as Cycles' Film > "
+        "Pixel Filter: samples are placed by the filter, each counting in its own pixel)",
+        items=[("BOX", "Box", "Each sample counts for its own pixel only (sharpest, most aliasing)", 0),
+               ("GAUSSIAN", "Gaussian", "A Gaussian of the given width (standard deviation: a quarter of it)", 1),
+               ("BLACKMAN_HARRIS", "Blackman-Harris", "The Blackman-Harris window (Cycles' default): less "
+                "blur than a Gaussian for the same noise", 2)],
+        default="BLACKMAN_HARRIS")),
+    Field("filter_width", FloatProperty, None, dict(
+        name="Width", description="Pixel filter width in pixels (the Box filter is always one pixel)",
+        default=1.5, min=0.01, soft_max=10.0, subtype="PIXEL")),
     Field("seed", IntProperty, int, dict(
         name="Seed", description="Noise pattern; different seeds give independent noise", default=0,
         min=0)),

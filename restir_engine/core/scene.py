@@ -249,6 +249,8 @@ class Camera:
     window: (x0, y0, w, h) pixel rectangle to render, y0 counted from the bottom row (border/crop)
     clip_start, clip_end: camera clipping distances in scene units
     blind: the camera object is scaled to zero and has no orientation; it sees nothing (a black frame)
+    pixel_filter: the film's filter (geometry.pixel_filter.PixelFilter) the camera samples land by; None = a box of
+    one pixel
     """
 
     cam_to_world: np.ndarray
@@ -260,6 +262,7 @@ class Camera:
     clip_start: float = 0.1
     clip_end: float = 1000.0
     blind: bool = False
+    pixel_filter: object = None
 
 
 @dataclass

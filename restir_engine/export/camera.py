@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.geometry.pixel_filter import PixelFilter
 from ..core.scene import Camera
 
 
@@ -74,7 +75,16 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
         raise ExportError(f"Camera '{cam_obj.name}' has a non-finite transform")
     return Camera(cam_to_world=c2w, ndc_to_cam=ndc_to_cam, width=width, height=height,
                   window=border_window(render, width, height), ortho=ortho,
-                  clip_start=clip_start, clip_end=clip_end, blind=blind)
+                  clip_start=clip_start, clip_end=clip_end, blind=blind, pixel_filter=film_filter(scene))
+
+
+def film_filter(scene) -> PixelFilter | None:
+    """The scene's pixel filter (Film > Pixel Filter); None for a one-pixel box."""
+    s = getattr(scene, "restir", None)
+    if s is None:
+        return None
+    f = PixelFilter(s.pixel_filter, s.filter_width)
+    return None if f.box else f
 
 
 def _orthonormal_camera_matrix(m: np.ndarray) -> tuple[np.ndarray, bool]:

@@ -238,6 +238,19 @@ class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):
         layout.prop(context.scene.render, "film_transparent")
 
 
+class RESTIR_PT_film(RestirPanel, bpy.types.Panel):
+    bl_label = "Film"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.split_layout()
+        s = context.scene.restir
+        layout.prop(s, "pixel_filter")
+        row = layout.row()
+        row.active = s.pixel_filter != "BOX"
+        row.prop(s, "filter_width")
+
+
 class RESTIR_PT_performance(RestirPanel, bpy.types.Panel):
     bl_label = "Performance"
     bl_options = {"DEFAULT_CLOSED"}
@@ -311,7 +324,7 @@ class RESTIR_PT_viewport_render_pass(bpy.types.Panel):
 
 
 PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_direct, RESTIR_PT_sampling_reuse, RESTIR_PT_sampling_indirect,
-          RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths, RESTIR_PT_performance,
+          RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths, RESTIR_PT_film, RESTIR_PT_performance,
           RESTIR_PT_passes)  # Render Properties
 VIEW_PANELS = (RESTIR_PT_viewport_render_pass,)  # the 3D view's header popovers
 

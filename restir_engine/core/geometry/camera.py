@@ -10,6 +10,19 @@ import numpy as np
 from ..scene import Camera
 
 
+def filter_offsets(cam: Camera):
+    """The function taking uniform numbers in [0, 1) to raster offsets from a pixel's corner under the camera's
+    film filter (the identity for a one-pixel box)."""
+    f = getattr(cam, "pixel_filter", None)
+    return (lambda u: u) if f is None else f.offsets
+
+
+def filter_margin(cam: Camera) -> float:
+    """Pixels by which masks of what camera rays may meet must grow: one, plus the filter's reach."""
+    f = getattr(cam, "pixel_filter", None)
+    return 1.0 + (0.0 if f is None else float(f.reach))
+
+
 def _xform(m: np.ndarray, pts: np.ndarray) -> np.ndarray:
     h = pts @ m[:3, :3].T + m[:3, 3]
     w = pts @ m[3, :3] + m[3, 3]
@@ -90,13 +103,14 @@ def project(cam: Camera, points: np.ndarray):
 
 
 def emitter_pixels(cam: Camera, tris: np.ndarray, centers: np.ndarray, radii: np.ndarray,
-                   margin: float = 1.0) -> np.ndarray:
+                   margin: float | None = None) -> np.ndarray:
     """(h, w) bool over the camera's window: the pixels that triangles (k, 3, 3) and spheres (centres (m, 3),
     radii (m,)) may cover, world space. A triangle marks the box of its projected corners, a sphere the box around
     the projections of its centre and of the six points at ± r along the world axes widened by half again (its
     outline lies within it), each widened by ``margin`` pixels; anything reaching behind the camera's plane marks
-    the whole window. Vectorized: the boxes are summed into a difference array."""
+    the whole window (``margin`` None: filter_margin). Vectorized: the boxes are summed into a difference array."""
     x0, y0, w, h = cam.window
+    margin = filter_margin(cam) if margin is None else margin
     boxes = []
     if len(tris):
         box = _projected_boxes(cam, tris, margin)
@@ -120,11 +134,12 @@ def emitter_pixels(cam: Camera, tris: np.ndarray, centers: np.ndarray, radii: np
     return _mark_boxes(cam, np.concatenate([b[0] for b in boxes]), np.concatenate([b[1] for b in boxes]))
 
 
-def box_pixels(cam: Camera, lo: np.ndarray, hi: np.ndarray, margin: float = 1.0) -> np.ndarray:
+def box_pixels(cam: Camera, lo: np.ndarray, hi: np.ndarray, margin: float | None = None) -> np.ndarray:
     """(h, w) bool over the camera's window: the pixels whose camera rays may meet something inside the world-space
     axis-aligned boxes ``lo`` / ``hi`` (k, 3): the box of each one's eight projected corners, widened by ``margin``
     pixels (the whole window when a box reaches behind the camera's plane). Outside, a camera ray meets nothing."""
     x0, y0, w, h = cam.window
+    margin = filter_margin(cam) if margin is None else margin
     if len(lo) == 0:
         return np.zeros((h, w), bool)
     lo, hi = np.asarray(lo, np.float32), np.asarray(hi, np.float32)

@@ -46,9 +46,10 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     j = pass_jitter(shift, s) if c.batch == 1 else np.concatenate([pass_jitter(shift, s + b) for b in range(c.batch)])
     px = (x0 + c.pixels % w).astype(np.float32)
     py = (y0 + c.pixels // w).astype(np.float32)
+    land = camera_mod.filter_offsets(ctx.scene.camera)  # uniform in the pixel -> the film filter's offsets
     hit_mask = None if masks.may_hit is None else masks.may_hit[c.pixels]
     lamp_seen = None if masks.lamps is None else masks.lamps[c.pixels]
-    c.hits = camera_paths.primary(ctx, px + j[:, 0], py + j[:, 1], hit_mask, lamp_seen)
+    c.hits = camera_paths.primary(ctx, px + land(j[:, 0]), py + land(j[:, 1]), hit_mask, lamp_seen)
     strata = plan.strata
     if strata == 1:
         return
@@ -61,8 +62,8 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     k0 = np.minimum((jx * g).astype(np.int64), g - 1) + g * np.minimum((jy * g).astype(np.int64), g - 1)
     k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
     jj = r.random((2,) + k.shape, dtype=np.float32)
-    em, al = camera_paths.seen_emission(ctx, (sx + ((k % g).astype(np.float32) + jj[0]) / g).ravel(),
-                                      (sy + ((k // g).astype(np.float32) + jj[1]) / g).ravel())
+    em, al = camera_paths.seen_emission(ctx, (sx + land(((k % g).astype(np.float32) + jj[0]) / g)).ravel(),
+                                      (sy + land(((k // g).astype(np.float32) + jj[1]) / g)).ravel())
     inv = np.float32(1.0 / strata)
     c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
     c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
