@@ -281,13 +281,18 @@ class RestirRenderEngine(bpy.types.RenderEngine):
 
     def _view(self, context):
         """(core camera of the 3D view at its full viewport resolution, key of the view)."""
+        from .export.camera import film_filter, thin_lens
         from .viewport import view_camera
-        pixel = max(1, int(self.get_preview_pixel_size(context.scene)))
+        scene = context.scene
+        pixel = max(1, int(self.get_preview_pixel_size(scene)))
         w, h = max(1, context.region.width // pixel), max(1, context.region.height // pixel)
         space = context.space_data
         rd = context.region_data
+        lens = None
+        if rd.view_perspective == "CAMERA" and scene.camera is not None:  # through the camera: its depth of field
+            lens = thin_lens(scene, scene.camera, np.linalg.inv(np.array(rd.view_matrix, np.float64)), [])
         key = (tuple(map(tuple, rd.view_matrix)), tuple(map(tuple, rd.window_matrix)), w, h)
-        return view_camera(rd, w, h, space.clip_start, space.clip_end), key
+        return view_camera(rd, w, h, space.clip_start, space.clip_end, film_filter(scene), lens), key
 
     def view_draw(self, context, depsgraph):
         """UI thread: hand the view to the worker, draw its newest image. Never waits for a pass."""

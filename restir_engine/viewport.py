@@ -63,13 +63,15 @@ _RAMP = np.array([[0.267, 0.005, 0.329], [0.229, 0.322, 0.546], [0.128, 0.567, 0
                   [0.993, 0.906, 0.144]], np.float32)
 
 
-def view_camera(region_data, width: int, height: int, clip_start: float, clip_end: float) -> Camera:
-    """Core camera of a 3D view: view_matrix is world->view, window_matrix the projection."""
+def view_camera(region_data, width: int, height: int, clip_start: float, clip_end: float, pixel_filter=None,
+                lens=None) -> Camera:
+    """Core camera of a 3D view: view_matrix is world->view, window_matrix the projection; the film's
+    ``pixel_filter`` and, looking through the scene camera, its ``lens`` (depth of field)."""
     view = np.array(region_data.view_matrix, np.float64)
     proj = np.array(region_data.window_matrix, np.float64)
     return Camera(cam_to_world=np.linalg.inv(view), ndc_to_cam=np.linalg.inv(proj), width=width, height=height,
                   window=(0, 0, width, height), ortho=not region_data.is_perspective,
-                  clip_start=clip_start, clip_end=clip_end)
+                  clip_start=clip_start, clip_end=clip_end, pixel_filter=pixel_filter, lens=lens)
 
 
 def scaled_camera(camera: Camera, divider: int) -> Camera:

@@ -18,6 +18,7 @@ STREAM_INITIAL = 6
 STREAM_PIXEL_OFFSET = 7  # per-pixel rotation of the pass sequence (keyed without the pass)
 STREAM_GI_TEMPORAL = 8
 STREAM_CHAIN = 9  # camera paths through smooth glass (camera_paths.follow_specular)
+STREAM_LENS = 11  # aperture samples of camera rays (depth of field)
 STREAM_PROBE = 10  # the AUTO indirect method's measurement of a frame without one (renderer.FrameRenderer._probe)
 STREAM_SPATIAL = 16  # + spatial pass index
 STREAM_GI_SPATIAL = 48  # + spatial pass index

@@ -251,6 +251,7 @@ class Camera:
     blind: the camera object is scaled to zero and has no orientation; it sees nothing (a black frame)
     pixel_filter: the film's filter (geometry.pixel_filter.PixelFilter) the camera samples land by; None = a box of
     one pixel
+    lens: the thin lens of depth of field (geometry.lens.Lens), or None for a pinhole
     """
 
     cam_to_world: np.ndarray
@@ -263,6 +264,7 @@ class Camera:
     clip_end: float = 1000.0
     blind: bool = False
     pixel_filter: object = None
+    lens: object = None  # geometry.lens.Lens for depth of field; None = pinhole
 
 
 @dataclass

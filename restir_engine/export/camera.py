@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.geometry.lens import Lens
 from ..core.geometry.pixel_filter import PixelFilter
 from ..core.scene import Camera
 
@@ -54,8 +55,6 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
         clip_start, clip_end = float(data.clip_start), float(data.clip_end)
         if data.type == "PANO":
             warnings.append(f"Camera '{cam_obj.name}': panoramic cameras are not supported; rendered as perspective")
-        if data.dof.use_dof:
-            warnings.append(f"Camera '{cam_obj.name}': depth of field is not supported; rendered as a pinhole")
     c2w, blind = _orthonormal_camera_matrix(np.array(cam_obj.matrix_world, dtype=np.float64))
     if blind:
         warnings.append(f"Camera '{cam_obj.name}' is scaled to zero on two or more axes: it has no orientation "
@@ -75,7 +74,40 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
         raise ExportError(f"Camera '{cam_obj.name}' has a non-finite transform")
     return Camera(cam_to_world=c2w, ndc_to_cam=ndc_to_cam, width=width, height=height,
                   window=border_window(render, width, height), ortho=ortho,
-                  clip_start=clip_start, clip_end=clip_end, blind=blind, pixel_filter=film_filter(scene))
+                  clip_start=clip_start, clip_end=clip_end, blind=blind, pixel_filter=film_filter(scene),
+                  lens=None if blind else thin_lens(scene, cam_obj, c2w, warnings))
+
+
+def thin_lens(scene, cam_obj, c2w: np.ndarray, warnings: list) -> Lens | None:
+    """Camera > Depth of Field as a thin lens (as Cycles): the aperture radius is the focal length / (2 F-stop)
+    in metres (orthographic: 1 / (2 F-stop)), in scene units through the scene's Unit Scale; the focus distance
+    is the Focus Object's depth along the view axis, else Focus Distance. None without depth of field."""
+    if cam_obj.type != "CAMERA":
+        return None
+    data = cam_obj.data
+    dof = data.dof
+    if not dof.use_dof or float(dof.aperture_fstop) <= 0:
+        return None
+    unit = float(getattr(scene.unit_settings, "scale_length", 1.0)) or 1.0
+    if data.type == "ORTHO":
+        radius = 1.0 / (2.0 * float(dof.aperture_fstop))
+    else:
+        radius = float(data.lens) * 1e-3 / (2.0 * float(dof.aperture_fstop)) / unit
+    if radius <= 0 or not np.isfinite(radius):
+        return None
+    focus = float(dof.focus_distance)
+    if dof.focus_object is not None:
+        target = np.array(dof.focus_object.matrix_world.translation, np.float64)
+        focus = abs(float(np.dot(-c2w[:3, 2], target - c2w[:3, 3])))
+        if getattr(dof, "focus_subtarget", ""):
+            warnings.append(f"Camera '{cam_obj.name}': the focus bone '{dof.focus_subtarget}' is not read; "
+                            "the focus object's origin is used")
+    if data.type == "PANO":
+        warnings.append(f"Camera '{cam_obj.name}': depth of field of a panoramic camera is not supported; "
+                        "rendered as a pinhole")
+        return None
+    return Lens(radius=radius, focus=max(focus, 1e-6), blades=int(dof.aperture_blades),
+                rotation=float(dof.aperture_rotation), ratio=max(float(dof.aperture_ratio), 1e-6))
 
 
 def film_filter(scene) -> PixelFilter | None:

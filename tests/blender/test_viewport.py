@@ -67,7 +67,8 @@ def test_view_camera_reproduces_the_scene_camera(addon):
     scene = cornell_box("EMISSIVE", (24, 24))
     dg = bpy.context.evaluated_depsgraph_get()
     final = export_scene(dg)
-    view = export_scene(dg, camera=view_camera(camera_view(scene, 24, 24), 24, 24, 0.1, 100.0))
+    from restir_engine.export.camera import film_filter
+    view = export_scene(dg, camera=view_camera(camera_view(scene, 24, 24), 24, 24, 0.1, 100.0, film_filter(scene)))
     a = render_frame(final, RenderSettings(samples=2, max_bounces=0, seed=3)).passes["Combined"]
     b = render_frame(view, RenderSettings(samples=2, max_bounces=0, seed=3)).passes["Combined"]
     assert np.allclose(a, b, atol=1e-4)

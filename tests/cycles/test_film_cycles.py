@@ -9,7 +9,7 @@ of the pixels, so the test sees the filter.
 import numpy as np
 import pytest
 from bpy_scenes import node_planes
-from cycles_compare import ours_cells
+from cycles_compare import cycles_reference, ours_cells
 from node_graphs import checker
 from stats import MARGIN, Z_MAX
 
@@ -58,3 +58,50 @@ def _filtered_cycles(case, build, kind, width):
         scene.cycles.filter_width = width
     return refs.cycles_cells(case, build, configure, lambda s: render_passes(s)["Combined"][..., :3], _pixels, 4,
                              256, 0)
+
+
+DOF_CASES = {"disk": dict(blades=0, rotation=0.0, ratio=1.0), "hexagon": dict(blades=6, rotation=0.4, ratio=1.6)}
+
+
+def dof_scene(size, aperture):
+    """The lit node-materials scene (bpy_scenes.node_materials_scene) through a 35 mm lens at f/0.1 focused on
+    the left sphere: the floor's checker, the other sphere and the textured quad light blur."""
+    from bpy_scenes import node_materials_scene
+    scene = node_materials_scene(size)
+    dof = scene.camera.data.dof
+    dof.use_dof = True
+    dof.focus_distance = 3.6
+    dof.aperture_fstop = 0.1
+    dof.aperture_blades = aperture["blades"]
+    dof.aperture_rotation = aperture["rotation"]
+    dof.aperture_ratio = aperture["ratio"]
+    return scene
+
+
+@pytest.mark.parametrize("aperture", sorted(DOF_CASES))
+@pytest.mark.parametrize("method", ["PATH", "RESTIR_DI"])
+def test_depth_of_field_matches_cycles(addon, method, aperture):
+    """Thin-lens depth of field (disk, and a rotated hexagon squeezed by the aperture ratio), 1 bounce, 8 x 8
+    image cells against Cycles with the materials tests' bound (tests/stats.py); ReSTIR DI in its unbiased mode
+    with temporal and spatial reuse; the pinhole image must fail in 3 cells or more (the test sees the blur)."""
+    from stats import assert_cells_match, cell_means, image_cells
+    size = (96, 64)
+    masks = image_cells(size, 8)
+    shape = DOF_CASES[aperture]
+    settings = {"integrator": "PATH"} if method == "PATH" else {
+        "integrator": "RESTIR", "direct_method": "RESTIR", "bias_correction": "UNBIASED", "temporal_reuse": True,
+        "spatial_neighbors": 5}
+    reduce = lambda im: cell_means(im, masks)  # noqa: E731
+    ours = ours_cells(lambda: dof_scene(size, shape), 1, 32, reduce, **settings)
+    ref = cycles_reference(f"dof_{aperture}_b1", lambda: dof_scene(size, shape), 1, 128, reduce)
+    names = [f"cell {i}" for i in range(len(masks))]
+    lit = [i for i in range(len(masks)) if ref.mean(0)[i] > 0.02]
+    assert_cells_match(ours[:, lit], ref[:, lit], [names[i] for i in lit])
+    if method == "PATH":
+        def pinhole():
+            scene = dof_scene(size, shape)
+            scene.camera.data.dof.use_dof = False
+            return scene
+        sharp = ours_cells(pinhole, 1, 32, reduce, reps=4, **settings)
+        z = np.abs(sharp.mean(0) - ref.mean(0)) / np.sqrt(sharp.var(0, ddof=1) / 4 + ref.var(0, ddof=1) / len(ref))
+        assert (z[lit] > Z_MAX).sum() >= 3, "the pinhole image is not told apart from the blurred one"

@@ -17,6 +17,12 @@ def filter_offsets(cam: Camera):
     return (lambda u: u) if f is None else f.offsets
 
 
+def has_lens(cam: Camera) -> bool:
+    """Whether the camera's rays leave from an aperture (depth of field): a pixel's rays then spread beyond the
+    pixel's pinhole cone, so masks built from projected boxes do not hold."""
+    return getattr(cam, "lens", None) is not None
+
+
 def filter_margin(cam: Camera) -> float:
     """Pixels by which masks of what camera rays may meet must grow: one, plus the filter's reach."""
     f = getattr(cam, "pixel_filter", None)
@@ -56,9 +62,14 @@ def _clip_planes_affine(cam: Camera):
     return out
 
 
-def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray):
+def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray, lens_uv=None):
     """Rays through raster points (x, y): origins on the near clip plane (3, n), unit directions
-    (3, n) and the distance to the far clip plane (n,)."""
+    (3, n) and the distance to the far clip plane (n,). With the camera's lens (depth of field) and aperture
+    samples ``lens_uv`` ((2, n) uniform), thin-lens rays (geometry/lens.py)."""
+    lens = getattr(cam, "lens", None)
+    if lens is not None and lens_uv is not None:
+        o, d, tmax = generate_rays(cam, x, y)
+        return lens.rays(cam, o, d, tmax, lens_uv[0], lens_uv[1])
     planes = _clip_planes_affine(cam)
     if planes is not None:  # float32 affine maps (the near plane's position error stays below 1e-6 relative)
         nx = (2.0 / cam.width) * x.astype(np.float32) - 1.0

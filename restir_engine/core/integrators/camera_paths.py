@@ -28,17 +28,19 @@ class PrimaryHits:
 
 
 def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray | None = None,
-            may_see_lamp: np.ndarray | None = None) -> PrimaryHits:
+            may_see_lamp: np.ndarray | None = None, lens_uv: np.ndarray | None = None) -> PrimaryHits:
     """Camera rays through raster points (x, y) (window pixels + jitter, y up). ``may_hit`` / ``may_see_lamp`` (n,)
     bool: False where the ray is known to meet no geometry / no lamp visible to the camera (projected boxes,
     camera.box_pixels and camera.emitter_pixels), which is then not traced against it; under a constant world a ray
-    that may meet neither is not generated at all (it sees the world's colour, or nothing on a transparent film)."""
+    that may meet neither is not generated at all (it sees the world's colour, or nothing on a transparent film).
+    ``lens_uv`` (2, n): aperture samples where the camera has a lens."""
     if may_hit is not None and ctx.world.image is None:
         need = may_hit if not len(ctx.scene.lamps.tris) else \
             np.ones(len(x), bool) if may_see_lamp is None else may_hit | may_see_lamp
         if not need.all():
             idx = np.flatnonzero(need)
-            sub = primary(ctx, x[idx], y[idx], may_hit[idx], None if may_see_lamp is None else may_see_lamp[idx])
+            sub = primary(ctx, x[idx], y[idx], may_hit[idx], None if may_see_lamp is None else may_see_lamp[idx],
+                          None if lens_uv is None else lens_uv[:, idx])
             transparent = ctx.film_transparent
             emitted = np.empty((3, len(x)), np.float32)
             emitted[:] = 0.0 if transparent else ctx.world.color[:, None]
@@ -47,7 +49,7 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
             alpha[idx] = sub.alpha
             return PrimaryHits(emitted, alpha, idx[sub.rows], sub.surf)
     cam = ctx.scene.camera
-    o, d, tmax = camera_mod.generate_rays(cam, x, y)
+    o, d, tmax = camera_mod.generate_rays(cam, x, y, lens_uv)
     if may_hit is None or may_hit.all():
         hits = ctx.geom_accel.intersect(o, d, tmax)
     else:
@@ -62,10 +64,11 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
     return PrimaryHits(emitted, alpha, rows, surf)
 
 
-def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
-    """What camera rays through raster points (x, y) see emitted (3, n) and their alpha (n,): the part of
-    :func:`primary` that needs no surface (extra rays per pixel for pixel coverage)."""
-    o, d, tmax = camera_mod.generate_rays(ctx.scene.camera, x, y)
+def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray, lens_uv: np.ndarray | None = None):
+    """What camera rays through raster points (x, y) (and aperture samples ``lens_uv``) see emitted (3, n) and
+    their alpha (n,): the part of :func:`primary` that needs no surface (extra rays per pixel for pixel
+    coverage)."""
+    o, d, tmax = camera_mod.generate_rays(ctx.scene.camera, x, y, lens_uv)
     return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax))
 
 

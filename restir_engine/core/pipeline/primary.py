@@ -14,7 +14,7 @@ from ..geometry import camera as camera_mod
 from ..integrators import camera_paths
 from ..restir.gbuffer import GBuffer
 from ..restir.target import ShadingTerms
-from ..sampling import STREAM_CAMERA, STREAM_CHAIN, STREAM_PIXEL_OFFSET, pass_jitter
+from ..sampling import STREAM_CAMERA, STREAM_CHAIN, STREAM_LENS, STREAM_PIXEL_OFFSET, pass_jitter
 from .plan import PassPlan
 from .work import Chunk, own
 
@@ -49,7 +49,9 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     land = camera_mod.filter_offsets(ctx.scene.camera)  # uniform in the pixel -> the film filter's offsets
     hit_mask = None if masks.may_hit is None else masks.may_hit[c.pixels]
     lamp_seen = None if masks.lamps is None else masks.lamps[c.pixels]
-    c.hits = camera_paths.primary(ctx, px + land(j[:, 0]), py + land(j[:, 1]), hit_mask, lamp_seen)
+    lens = plan.rng(STREAM_LENS, c.index) if camera_mod.has_lens(ctx.scene.camera) else None
+    lens_uv = None if lens is None else lens.random((2, len(px)), dtype=np.float32)
+    c.hits = camera_paths.primary(ctx, px + land(j[:, 0]), py + land(j[:, 1]), hit_mask, lamp_seen, lens_uv)
     strata = plan.strata
     if strata == 1:
         return
@@ -63,7 +65,8 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
     jj = r.random((2,) + k.shape, dtype=np.float32)
     em, al = camera_paths.seen_emission(ctx, (sx + land(((k % g).astype(np.float32) + jj[0]) / g)).ravel(),
-                                      (sy + land(((k // g).astype(np.float32) + jj[1]) / g)).ravel())
+                                      (sy + land(((k // g).astype(np.float32) + jj[1]) / g)).ravel(),
+                                      None if lens is None else lens.random((2, k.size), dtype=np.float32))
     inv = np.float32(1.0 / strata)
     c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
     c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
