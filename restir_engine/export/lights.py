@@ -70,9 +70,10 @@ def _area_shape(light) -> np.ndarray:
     return tris
 
 
-def _light_node_scale(light):
-    """RGB factor of a light node tree that is a constant Emission node (Color x Strength), 1 without
-    nodes, None when the tree does something else (textures, falloff nodes ...)."""
+def _light_node_scale(light, warnings: list, name: str):
+    """RGB factor of a light's node tree: its Emission node's Color x Strength, each folded to a constant through
+    whatever nodes feed it (RGB, Math, Mix, Blackbody, Light Falloff ...; core/materials/nodes); 1 without nodes.
+    A graph that varies over the light (a texture) is named in a warning and its sockets' own values are used."""
     tree = light.node_tree
     if tree is None or not getattr(light, "use_nodes", True):
         return np.ones(3)
@@ -81,9 +82,36 @@ def _light_node_scale(light):
     if not outs or not outs[0].inputs["Surface"].is_linked:
         return np.zeros(3)
     node = outs[0].inputs["Surface"].links[0].from_node
-    if node.type != "EMISSION" or any(i.is_linked for i in node.inputs):
-        return None
-    return np.array(node.inputs["Color"].default_value[:3], np.float64) * float(node.inputs["Strength"].default_value)
+    if node.type != "EMISSION":
+        warnings.append(f"Light '{name}': its node tree ends in '{node.name}' ({node.type}), not an Emission node; "
+                        "colour x power is used")
+        return np.ones(3)
+    from .node_graph import GraphCompiler
+    notes = []
+    g = GraphCompiler(lambda image, alpha: 0, notes.append)
+    color, strength = g.value(node.inputs["Color"], "color"), g.value(node.inputs["Strength"], "float")
+    warnings.extend(f"Light '{name}': {n}" for n in dict.fromkeys(notes))
+    out = []
+    for reg, sock in ((color, node.inputs["Color"]), (strength, node.inputs["Strength"])):
+        if reg.const is not None:
+            out.append(np.asarray(reg.constant_value(), np.float64))
+            continue
+        warnings.append(f"Light '{name}': its {sock.name} varies over the light (a texture?), which lights do not "
+                        "support; the socket's own value is used")
+        v = sock.default_value
+        out.append(np.array(v[:3] if sock.name == "Color" else v, np.float64))
+    return out[0] * out[1]
+
+
+def _lamp_power(light, name: str, warnings: list) -> np.ndarray:
+    """Colour x Power (W) x 2^Exposure, times the Temperature's colour where the light uses one and its node
+    tree's factor."""
+    power = np.array(light.color[:3], np.float64) * float(light.energy)
+    power *= 2.0 ** float(getattr(light, "exposure", 0.0))
+    if getattr(light, "use_temperature", False):
+        from ..core.lights.blackbody import blackbody_rgb
+        power *= blackbody_rgb(float(light.temperature)).astype(np.float64).reshape(3)
+    return power * _light_node_scale(light, warnings, name)
 
 
 def _area(tris: np.ndarray) -> float:
@@ -99,12 +127,7 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
             continue
         light = obj.data
         m = np.array(inst.matrix_world, np.float64)
-        power = np.array(light.color[:3], np.float64) * float(light.energy)
-        node_scale = _light_node_scale(light)
-        if node_scale is None:
-            warnings.append(f"Light '{obj.name}': its node tree is not a plain Emission node; colour x power is used")
-        else:
-            power = power * node_scale
+        power = _lamp_power(light, obj.name, warnings)
         if not np.isfinite(m).all() or not np.isfinite(power).all():
             warnings.append(f"Light '{obj.name}' has a non-finite transform or power and was skipped")
             continue

@@ -544,6 +544,21 @@ def _bump(g, node, f):
     return {"Normal": g.emit("bump", params, ins, ("vector",))[0]}
 
 
+def _blackbody(g, node, f):
+    return {"Color": g.emit("blackbody", {}, [g.inp(node, "Temperature", "float", f)], ("color",))[0]}
+
+
+def _light_falloff(g, node, f):
+    strength = g.inp(node, "Strength", "float", f)
+    if node.outputs["Linear"].is_linked or node.outputs["Constant"].is_linked:
+        g.warn(f"'{node.name}' (Light Falloff): Linear and Constant falloff are approximated by the physical "
+               "(quadratic) falloff")
+    smooth = g.inp(node, "Smooth", "float", f)
+    if smooth.const is None or float(smooth.const) != 0.0:
+        g.warn(f"'{node.name}' (Light Falloff): Smooth is not supported (treated as 0)")
+    return {"Quadratic": strength, "Linear": strength, "Constant": strength}
+
+
 _HANDLERS = {
     "TEX_COORD": _texcoord, "UVMAP": _uvmap, "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
     "VERTEX_COLOR": _color_attribute, "ATTRIBUTE": _attribute, "FRESNEL": _fresnel, "LAYER_WEIGHT": _layer_weight,
@@ -562,5 +577,5 @@ _HANDLERS = {
     "VALTORGB": _color_ramp, "CURVE_RGB": _rgb_curves, "CURVE_FLOAT": _float_curve, "TEX_IMAGE": _image,
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
-    "TEX_BRICK": _brick,
+    "TEX_BRICK": _brick, "BLACKBODY": _blackbody, "LIGHT_FALLOFF": _light_falloff,
 }

@@ -353,7 +353,16 @@ def principled_f0(attrs, params, ior, level):
     return f32(np.clip(r * r * 2 * np.maximum(f32(level), 0), 0, 1))
 
 
+def blackbody(attrs, params, temperature):
+    """Blackbody node: the colour of a black body at ``temperature`` kelvin (luminance 1, core/lights/blackbody)."""
+    from ...lights.blackbody import blackbody_rgb
+    t = f32(temperature)
+    got = blackbody_rgb(t)
+    return got.reshape(3, 1) if np.ndim(t) == 0 else got
+
+
 OPERATIONS = {
+    "blackbody": blackbody,
     "math": math, "vector_math": vector_math, "mix_float": mix_float, "mix_vector": mix_vector,
     "mix_color": mix_color, "map_range": map_range, "clamp": clamp, "invert": invert, "gamma": gamma,
     "bright_contrast": bright_contrast, "hue_saturation": hue_saturation, "separate": separate, "combine": combine,

@@ -1,0 +1,84 @@
+"""Lamp colour as Blender's light settings and node trees give it: Exposure, Temperature, and Emission Color and
+Strength folded through their nodes (RGB, Math, Mix, Blackbody); what cannot be folded is named."""
+import bpy
+import numpy as np
+import pytest
+
+
+def _lamp(name="Lamp"):
+    light = bpy.data.lights.new(name, "POINT")
+    light.energy = 10.0
+    light.color = (1.0, 0.5, 0.25)
+    return light
+
+
+def _power(light):
+    from restir_engine.export.lights import _lamp_power
+    warnings = []
+    return _lamp_power(light, light.name, warnings), warnings
+
+
+def test_blackbody_table_is_blenders_colour(addon):
+    from restir_engine.core.lights.blackbody import blackbody_rgb
+    light = _lamp("Blackbody probe")
+    light.use_temperature = True
+    rng = np.random.default_rng(3)
+    for t in np.exp(rng.uniform(np.log(900), np.log(35000), 12)):
+        light.temperature = float(t)
+        np.testing.assert_allclose(blackbody_rgb(t).ravel(), light.temperature_color, rtol=3e-3, atol=2e-3)
+
+
+def test_exposure_temperature_and_node_tree(addon):
+    light = _lamp("Lamp settings")
+    base = np.array([10.0, 5.0, 2.5])
+    got, warns = _power(light)
+    np.testing.assert_allclose(got, base, rtol=1e-6)
+    light.exposure = 1.5
+    np.testing.assert_allclose(_power(light)[0], base * 2 ** 1.5, rtol=1e-6)
+    light.exposure = 0.0
+    light.use_temperature = True
+    light.temperature = 3200.0
+    np.testing.assert_allclose(_power(light)[0], base * np.array(light.temperature_color), rtol=3e-3)
+    light.use_temperature = False
+    light.use_nodes = True
+    tree = light.node_tree
+    em = next(n for n in tree.nodes if n.type == "EMISSION")
+    rgb = tree.nodes.new("ShaderNodeRGB")
+    rgb.outputs[0].default_value = (1.0, 0.1, 0.1, 1.0)  # the third-party red lamp
+    math = tree.nodes.new("ShaderNodeMath")
+    math.operation = "MULTIPLY"
+    math.inputs[0].default_value = 2.0
+    math.inputs[1].default_value = 3.0
+    tree.links.new(rgb.outputs[0], em.inputs["Color"])
+    tree.links.new(math.outputs[0], em.inputs["Strength"])
+    got, warns = _power(light)
+    np.testing.assert_allclose(got, base * np.array([1.0, 0.1, 0.1]) * 6.0, rtol=1e-5)
+    assert not warns
+    bb = tree.nodes.new("ShaderNodeBlackbody")
+    bb.inputs["Temperature"].default_value = 2000.0
+    tree.links.new(bb.outputs[0], em.inputs["Color"])
+    light.use_temperature = True
+    light.temperature = 2000.0  # the same colour through the node
+    want = base * np.array(light.temperature_color) * 6.0
+    light.use_temperature = False
+    np.testing.assert_allclose(_power(light)[0], want, rtol=3e-3)
+    tex = tree.nodes.new("ShaderNodeTexNoise")
+    tree.links.new(tex.outputs["Color"], em.inputs["Color"])
+    got, warns = _power(light)
+    assert any("varies over the light" in w for w in warns)
+    np.testing.assert_allclose(got, base * np.array(em.inputs["Color"].default_value[:3]) * 6.0, rtol=1e-5)
+
+
+@pytest.mark.parametrize("output", ["Quadratic", "Linear"])
+def test_light_falloff(addon, output):
+    light = _lamp(f"Falloff {output}")
+    light.use_nodes = True
+    tree = light.node_tree
+    em = next(n for n in tree.nodes if n.type == "EMISSION")
+    fo = tree.nodes.new("ShaderNodeLightFalloff")
+    fo.inputs["Strength"].default_value = 4.0
+    tree.links.new(fo.outputs[output], em.inputs["Strength"])
+    got, warns = _power(light)
+    np.testing.assert_allclose(got, np.array([10.0, 5.0, 2.5]) * np.array(em.inputs["Color"].default_value[:3]) * 4,
+                               rtol=1e-6)
+    assert bool(warns) == (output != "Quadratic")
