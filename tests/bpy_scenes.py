@@ -574,3 +574,38 @@ def bumped_materials_scene(size=(96, 64)):
     black_world(scene)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def panorama_scene(kind, size=(64, 32)):
+    """A panoramic camera ``kind`` in a room of emission walls, one colour per direction, over a diffuse checker
+    floor they light, looking along +Y turned by 10°, with a bright tag ahead: what a pixel sees tells its
+    direction."""
+    import node_graphs as ng
+    scene = reset()
+    black_world(scene)
+    faces = [((0, 3, 0), (math.radians(90), 0, 0), (0.9, 0.2, 0.2)), ((0, -3, 0), (math.radians(90), 0, 0),
+             (0.2, 0.9, 0.2)), ((3, 0, 0), (0, math.radians(90), 0), (0.2, 0.3, 0.9)),
+             ((-3, 0, 0), (0, math.radians(90), 0), (0.9, 0.8, 0.2)), ((0, 0, 3), (0, 0, 0), (0.8, 0.3, 0.9)),
+             ((0, 0, -3), (0, 0, 0), None)]
+    for k, (loc, rot, color) in enumerate(faces):
+        if color is None:  # the floor: a diffuse checker lit by the walls
+            mat = bpy.data.materials.new("PanoFloor")
+            enable_nodes(mat)
+            ng.checker(4.0)(mat.node_tree, mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
+        else:
+            mat = emission(f"PanoWall{k}", color, 1.0)
+        plane(f"PanoWall{k}", 6.0, loc, rot, material=mat)
+    tag = emission("PanoTag", (1.0, 1.0, 1.0), 3.0)  # a bright square ahead and up-right: orientation
+    plane("PanoTag", 1.0, (1.0, 2.9, 0.8), (math.radians(90), 0, 0), material=tag)
+    camera((0.2, -0.3, 0.1), (math.radians(90), 0, math.radians(10)))
+    cam = scene.camera.data
+    cam.type = "PANO"
+    cam.panorama_type = kind
+    if kind == "EQUIRECTANGULAR":
+        cam.latitude_min, cam.latitude_max = math.radians(-70), math.radians(80)
+        cam.longitude_min, cam.longitude_max = math.radians(-150), math.radians(170)
+    elif kind == "FISHEYE_EQUIDISTANT":
+        cam.fisheye_fov = math.radians(200)
+    cam.clip_start = 0.01
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

@@ -252,6 +252,7 @@ class Camera:
     pixel_filter: the film's filter (geometry.pixel_filter.PixelFilter) the camera samples land by; None = a box of
     one pixel
     lens: the thin lens of depth of field (geometry.lens.Lens), or None for a pinhole
+    panorama: the panoramic projection (geometry.panorama.Panorama), or None
     """
 
     cam_to_world: np.ndarray
@@ -265,6 +266,7 @@ class Camera:
     blind: bool = False
     pixel_filter: object = None
     lens: object = None  # geometry.lens.Lens for depth of field; None = pinhole
+    panorama: object = None  # geometry.panorama.Panorama for a panoramic camera; None = perspective / orthographic
 
 
 @dataclass

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.geometry.lens import Lens
+from ..core.geometry.panorama import KINDS as PANORAMAS, Panorama
 from ..core.geometry.pixel_filter import PixelFilter
 from ..core.scene import Camera
 
@@ -53,8 +54,6 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
         data = cam_obj.data
         ortho = data.type == "ORTHO"
         clip_start, clip_end = float(data.clip_start), float(data.clip_end)
-        if data.type == "PANO":
-            warnings.append(f"Camera '{cam_obj.name}': panoramic cameras are not supported; rendered as perspective")
     c2w, blind = _orthonormal_camera_matrix(np.array(cam_obj.matrix_world, dtype=np.float64))
     if blind:
         warnings.append(f"Camera '{cam_obj.name}' is scaled to zero on two or more axes: it has no orientation "
@@ -75,7 +74,35 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
     return Camera(cam_to_world=c2w, ndc_to_cam=ndc_to_cam, width=width, height=height,
                   window=border_window(render, width, height), ortho=ortho,
                   clip_start=clip_start, clip_end=clip_end, blind=blind, pixel_filter=film_filter(scene),
-                  lens=None if blind else thin_lens(scene, cam_obj, c2w, warnings))
+                  lens=None if blind else thin_lens(scene, cam_obj, c2w, warnings),
+                  panorama=panorama(cam_obj, width, height, warnings))
+
+
+def panorama(cam_obj, width: int, height: int, warnings: list) -> Panorama | None:
+    """Camera > Panoramic as a Panorama (geometry/panorama.py), the sensor fitted to the frame as Blender fits it;
+    None for other cameras."""
+    if cam_obj.type != "CAMERA" or cam_obj.data.type != "PANO":
+        return None
+    data = cam_obj.data
+    kind = getattr(data, "panorama_type", "EQUIRECTANGULAR")
+    if kind not in PANORAMAS:
+        warnings.append(f"Camera '{cam_obj.name}': the {kind} panorama is not supported; rendered as "
+                        "equirectangular")
+        kind = "EQUIRECTANGULAR"
+    fit, sw, sh = data.sensor_fit, float(data.sensor_width), float(data.sensor_height)
+    if fit == "VERTICAL":
+        sensor = (sh * width / height, sh)
+    elif fit == "HORIZONTAL" or width >= height:
+        sensor = (sw, sw * height / width)
+    else:
+        sensor = (sw * width / height, sw)
+    return Panorama(kind=kind, fov=float(data.fisheye_fov), lens=float(data.fisheye_lens), sensor=sensor,
+                    latitude=(float(data.latitude_min), float(data.latitude_max)),
+                    longitude=(float(data.longitude_min), float(data.longitude_max)),
+                    polynomial=tuple(float(getattr(data, f"fisheye_polynomial_k{i}")) for i in range(5)),
+                    cylinder=(float(data.central_cylindrical_range_u_min), float(data.central_cylindrical_range_u_max),
+                              float(data.central_cylindrical_range_v_min), float(data.central_cylindrical_range_v_max),
+                              float(data.central_cylindrical_radius)))
 
 
 def thin_lens(scene, cam_obj, c2w: np.ndarray, warnings: list) -> Lens | None:

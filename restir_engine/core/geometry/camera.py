@@ -18,9 +18,32 @@ def filter_offsets(cam: Camera):
 
 
 def has_lens(cam: Camera) -> bool:
-    """Whether the camera's rays leave from an aperture (depth of field): a pixel's rays then spread beyond the
-    pixel's pinhole cone, so masks built from projected boxes do not hold."""
-    return getattr(cam, "lens", None) is not None
+    """Whether a pixel's rays may leave its pinhole cone of a perspective or orthographic projection (a lens for
+    depth of field, a panorama): masks built from projected boxes do not hold then."""
+    return getattr(cam, "lens", None) is not None or getattr(cam, "panorama", None) is not None
+
+
+def _panorama_rays(cam: Camera, pano, x, y):
+    """Rays of a panoramic camera from its position (advanced by the near clip distance); frame points off the
+    projection's image get tmax -1 (they see nothing)."""
+    u = np.asarray(x, np.float64) / cam.width
+    v = np.asarray(y, np.float64) / cam.height
+    dcam, valid = pano.directions(u, v)
+    c2w = np.asarray(cam.cam_to_world, np.float64)
+    d = (c2w[:3, :3].astype(np.float32) @ dcam).astype(np.float32)
+    o = (c2w[:3, 3].astype(np.float32)[:, None] + d * np.float32(cam.clip_start)).astype(np.float32)
+    tmax = np.where(valid, np.float32(cam.clip_end - cam.clip_start), np.float32(-1.0)).astype(np.float32)
+    return o, d, tmax
+
+
+def view_depth(cam: Camera, points: np.ndarray) -> np.ndarray:
+    """The depth of world points (3, n) as the Depth pass holds it: along the view axis, or for a panorama the
+    distance from the camera (its view has no one axis)."""
+    rel = np.asarray(points, np.float32) - position(cam)[:, None]
+    if getattr(cam, "panorama", None) is not None:
+        return np.sqrt((rel * rel).sum(axis=0)).astype(np.float32)
+    f = forward(cam)
+    return (f[0] * rel[0] + f[1] * rel[1] + f[2] * rel[2]).astype(np.float32)
 
 
 def filter_margin(cam: Camera) -> float:
@@ -66,6 +89,9 @@ def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray, lens_uv=None):
     """Rays through raster points (x, y): origins on the near clip plane (3, n), unit directions
     (3, n) and the distance to the far clip plane (n,). With the camera's lens (depth of field) and aperture
     samples ``lens_uv`` ((2, n) uniform), thin-lens rays (geometry/lens.py)."""
+    pano = getattr(cam, "panorama", None)
+    if pano is not None:
+        return _panorama_rays(cam, pano, x, y)
     lens = getattr(cam, "lens", None)
     if lens is not None and lens_uv is not None:
         o, d, tmax = generate_rays(cam, x, y)
@@ -99,7 +125,10 @@ def generate_rays(cam: Camera, x: np.ndarray, y: np.ndarray, lens_uv=None):
 def project(cam: Camera, points: np.ndarray):
     """Raster coordinates (n, 2) of world points (3, n) seen by ``cam`` (x right, y up, full-resolution
     pixels) and their planar depth along the camera axis (n,); depth <= 0 means behind the camera. The
-    matrices are combined in float64, the points transformed in float32."""
+    matrices are combined in float64, the points transformed in float32. A panorama: the distance from the camera
+    as the depth (-1 where the direction is off its image)."""
+    if getattr(cam, "panorama", None) is not None:
+        return _project_panorama(cam, points)
     w2c = np.linalg.inv(cam.cam_to_world.astype(np.float64))
     clip = (np.linalg.inv(cam.ndc_to_cam.astype(np.float64)) @ w2c).astype(np.float32)
     zrow = w2c[2].astype(np.float32)
@@ -111,6 +140,16 @@ def project(cam: Camera, points: np.ndarray):
     raster[:, 1] = (h[1] / w + 1) * np.float32(0.5 * cam.height)
     depth = -(zrow[0] * x + zrow[1] * y + zrow[2] * z + zrow[3])
     return raster, depth.astype(np.float32, copy=False)
+
+
+def _project_panorama(cam: Camera, points: np.ndarray):
+    w2c = np.linalg.inv(cam.cam_to_world.astype(np.float64))
+    p = np.asarray(points, np.float64)
+    rel = w2c[:3, :3] @ p + w2c[:3, 3:4]
+    u, v, ok = cam.panorama.frame_points(rel)
+    raster = np.stack([u * cam.width, v * cam.height], axis=1).astype(np.float32)
+    depth = np.where(ok, np.linalg.norm(rel, axis=0), -1.0).astype(np.float32)
+    return raster, depth
 
 
 def emitter_pixels(cam: Camera, tris: np.ndarray, centers: np.ndarray, radii: np.ndarray,

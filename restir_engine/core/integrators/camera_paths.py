@@ -11,7 +11,7 @@ from ..geometry import camera as camera_mod
 from ..geometry.accel import Hits
 from ..lights.table import emitted_radiance
 from ..materials.surface import Surface
-from ..sampling import cols, dot, finite
+from ..sampling import cols, finite
 from .pathtracer import _lamp_emission, lamp_hits, sample_rays
 from .trace_context import TraceContext
 
@@ -103,6 +103,11 @@ def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: n
         if em.size:
             emitted[:, em] += emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em],
                                                hits.v[em], -cols(d, em) if ctx.has_programs else None)
+    if tmax is not None and camera:  # frame points off a panorama's image (beyond a fisheye's circle): black
+        dead = tmax < 0
+        if dead.any():
+            emitted[:, dead] = 0.0
+            alpha[dead] = 0.0
     return finite(emitted), alpha
 
 
@@ -183,7 +188,7 @@ def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     hit = np.flatnonzero(hits.prim >= 0)
     if hit.size:
         s = Surface(ctx, hits.prim[hit], hits.u[hit], hits.v[hit], cols(o, hit), cols(d, hit), hits.t[hit])
-        depth[hit] = dot(s.p - camera_mod.position(cam)[:, None], camera_mod.forward(cam)[:, None])
+        depth[hit] = camera_mod.view_depth(cam, s.p)
         normal[hit] = s.ns.T
         motion = ctx.scene.motion
         inst = ctx.scene.geometry.instance

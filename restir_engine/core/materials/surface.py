@@ -27,6 +27,8 @@ def pixel_spread(camera) -> tuple:
     pixel on the image plane at unit distance (perspective) or on the view plane (orthographic)."""
     if camera is None:
         return (np.float32(0.0), np.float32(1e-3))
+    if getattr(camera, "panorama", None) is not None:  # about a full turn over the frame's width
+        return (np.float32(0.0), np.float32(2 * np.pi / max(camera.width, 1)))
     m = np.asarray(camera.ndc_to_cam, np.float64)
     lo, hi = m @ np.array([0.0, -1.0, -1.0, 1.0]), m @ np.array([0.0, 1.0, -1.0, 1.0])
     lo, hi = lo[:3] / lo[3], hi[:3] / hi[3]

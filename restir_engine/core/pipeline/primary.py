@@ -81,12 +81,10 @@ def gbuffer(ctx, chunks: list[Chunk], terms: np.ndarray, team) -> GBuffer:
     n = terms.shape[1]
     pix, depth = team.empty(n, np.int64), team.empty(n, np.float32)
     inst, mat = team.empty(n, np.int32), team.empty(n, np.int32)
-    origin, fwd = camera_mod.position(cam)[:, None], camera_mod.forward(cam)
     instance = ctx.scene.geometry.instance
     for c in own(chunks, team):
         sl, surf = c.surfaces, c.hits.surf
-        rel = terms[0:3, sl] - origin
-        depth[sl] = fwd[0] * rel[0] + fwd[1] * rel[1] + fwd[2] * rel[2]  # planar depth along the camera axis
+        depth[sl] = camera_mod.view_depth(cam, terms[0:3, sl])  # along the camera axis (a panorama: distance)
         pix[sl] = c.pixels[c.hits.rows]
         inst[sl] = instance[surf.prim] if instance is not None else 0
         mat[sl] = surf.mat
