@@ -254,6 +254,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         session = self._viewport
         session.budget = float(scene.restir.viewport_budget_ms) / 1000.0
         session.max_samples = int(scene.restir.viewport_samples)
+        session.time_limit = float(scene.restir.time_limit)
         if level == "NONE" and settings == self._viewport_settings_last:
             session.set_view(cam, key)
             return

@@ -173,6 +173,10 @@ SCENE_FIELDS = (
     Field("samples", IntProperty, int, dict(
         name="Samples", description="Iterations averaged per frame", default=16, min=1,
         soft_max=4096)),
+    Field("time_limit", FloatProperty, float, dict(
+        name="Time Limit", description="Seconds a render (each frame of an animation) or a still viewport may take: "
+        "it stops after the sample that reaches the limit, with fewer samples than asked for (0 = no limit)",
+        default=0.0, min=0.0, soft_max=3600.0, subtype="TIME_ABSOLUTE")),
     Field("viewport_samples", IntProperty, None, dict(
         name="Viewport Samples", description="Samples the Rendered viewport accumulates "
         "for a still view before it stops", default=MAX_VIEWPORT_SAMPLES, min=1,

@@ -206,6 +206,8 @@ class ViewportSession:
         self.redraw = redraw
         self.budget = float(budget)
         self.max_samples = int(max_samples)
+        self.time_limit = 0.0  # seconds a still view refines (0 = until max_samples)
+        self._refine_t0 = None  # when the current still view's refinement began (clock)
         self.clock = clock
         self.renderer: FrameRenderer | None = None
         self.stats = ViewportStats()
@@ -296,6 +298,11 @@ class ViewportSession:
             return False
         if self._view[1] != self._key or self._divider > 1:
             return True
+        if self.renderer.samples_done == 0:
+            self._refine_t0 = None
+        elif self.time_limit > 0 and self._refine_t0 is not None and \
+                self.clock() - self._refine_t0 >= self.time_limit:
+            return False
         return self.renderer.samples_done < self.max_samples
 
     def _run(self) -> None:
@@ -390,6 +397,10 @@ class ViewportSession:
         seconds = self.clock() - t0
         if not done:
             return
+        if navigation or self._divider > 1:
+            self._refine_t0 = None  # the view moved: its refinement starts again
+        elif self._refine_t0 is None:
+            self._refine_t0 = t0
         _x0, _y0, w, h = r.ctx.scene.camera.window
         if r.samples_done - before == 1:
             # the estimate sizes navigation passes, which render one sample: a batched refinement pass costs less per

@@ -71,6 +71,7 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
         col = layout.column(align=True)
         col.prop(s, "samples", text="Render Samples")
         col.prop(s, "viewport_samples")
+        col.prop(s, "time_limit")
         col.prop(s, "viewport_budget_ms")
         col.prop(s, "seed")
         layout.prop(s, "coverage_samples")

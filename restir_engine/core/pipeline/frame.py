@@ -401,12 +401,19 @@ class FrameRenderer:
             gi_terms=None if gb_gi is None else gb_gi.terms, gi_key=self.gi_light_key if gi_reused else None)
 
 
+def out_of_time(settings: RenderSettings, t0: float, done: int) -> bool:
+    """Whether a frame begun at perf_counter ``t0`` has used its Time Limit (after one pass at least)."""
+    return settings.time_limit > 0 and done > 0 and time.perf_counter() - t0 >= settings.time_limit
+
+
 def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
                  clock=None, processes: int | None = None) -> FrameResult:
     """Render one frame with the chosen integrator, in ``processes`` worker processes (None: the count that
     parallel.processes.process_count chooses for the thread count; 1: in this process), at most one per chunk of
     pixels. The same seed gives the same image either way.
 
+    A Time Limit (settings.time_limit) stops the frame after the pass that reaches it (fewer samples; which ones
+    is deterministic, how many depends on the machine).
     progress(fraction, message) is called as chunks finish; should_stop() is polled while they run,
     and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none). ``history`` is the
     result's history of the previous frame (rendered the same way; another kind is not reused).
@@ -441,9 +448,9 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     t0 = time.perf_counter()
     fr = FrameRenderer(scene, settings, history, clock)
     cancelled = False
-    while fr.samples_done < settings.samples:
+    while fr.samples_done < settings.samples and not out_of_time(settings, t0, fr.samples_done):
         s = fr.samples_done
-        batch = fr.batch_size(settings.samples - s)
+        batch = 1 if settings.time_limit > 0 else fr.batch_size(settings.samples - s)  # a limit: checked per sample
         report = None
         if progress:
             def report(f, s=s, b=batch):

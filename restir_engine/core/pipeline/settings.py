@@ -26,6 +26,7 @@ class RenderSettings:
     (di.CandidateSettings, reuse.SpatialSettings, TileSettings)."""
 
     samples: int = 16
+    time_limit: float = 0.0  # seconds a frame may render before it stops after the pass that ran past it; 0 = none
     seed: int = 0
     max_bounces: int = 4
     frame: int = 0

@@ -15,7 +15,7 @@ from ..parallel.processes import WorkerTeam
 from ..sampling import finite
 from . import methods
 from .film import Film, film_keys
-from .frame import Cancelled, FrameResult
+from .frame import Cancelled, FrameResult, out_of_time
 from .settings import RenderSettings, validate
 
 SURFACE_BYTES = 300  # per surface and pass: the target terms (DI's and GI's), the G-buffer, tables
@@ -76,7 +76,7 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         finally:  # every worker attached (or the team is gone): the name is no longer needed
             wire.unlink_segments([seg])
         done, cancelled = 0, False
-        while done < settings.samples:
+        while done < settings.samples and not out_of_time(settings, t0, done):
             poll = None
             if progress:
                 label = f"Sample {done + 1}/{settings.samples}"
@@ -85,7 +85,9 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
 
                 def poll(done=done, label=label):  # the leader's share of its pass: one sample's worth
                     progress((done + team.progress.value) / settings.samples, label)
-            replies = team.run(("pass", settings.samples - done), should_stop, on_poll=poll)
+            # with a time limit, one sample at a time: the limit is checked between passes
+            ask = 1 if settings.time_limit > 0 else settings.samples - done
+            replies = team.run(("pass", ask), should_stop, on_poll=poll)
             if replies is None:
                 cancelled = True
                 break

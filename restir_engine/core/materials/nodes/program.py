@@ -33,14 +33,31 @@ class Program:
     reads: tuple = ()
     vectors: tuple = ()  # the registers that hold vectors or colours (a constant one is kept as a (3, 1) column)
 
+    def _ops_for(self, fields) -> list:
+        """The instructions the outputs ``fields`` depend on (all of them for None), in order; cached."""
+        key = None if fields is None else tuple(sorted(f for f in fields if f in self.outputs))
+        cache = self.__dict__.setdefault("_slices", {})
+        if key not in cache:
+            if key is None:
+                cache[key] = list(self.ops)
+            else:
+                need = {self.outputs[f][0] for f in key}
+                keep = []
+                for op in reversed(self.ops):
+                    if need.intersection(op[1]):
+                        keep.append(op)
+                        need.update(op[2])
+                cache[key] = keep[::-1]
+        return cache[key]
+
     def run(self, attrs, fields=None) -> dict:
         """The outputs (all, or those named in ``fields``) at the batch's hits: floats (n,), colours (3, n),
-        float32."""
+        float32. Only the instructions those outputs depend on run."""
         regs = dict(self.consts)
         n = len(attrs)
         vectors = set(self.vectors)
         with np.errstate(all="ignore"):
-            for name, outs, ins, params in self.ops:
+            for name, outs, ins, params in self._ops_for(fields):
                 got = OPERATIONS[name](attrs, params, *[regs[i] for i in ins])
                 for o, g in zip(outs, (got,) if len(outs) == 1 else got):
                     regs[o] = g.reshape(3, 1) if o in vectors and np.ndim(g) == 1 else g
