@@ -266,7 +266,9 @@ def sky_image(name="Sky", h=64, w=128, sun=(0.0, 40.0)):
 
 def world_scene(kind="IMAGE", size=(96, 64), rotation_z=0.0):
     """Spheres (diffuse, rough Principled, metal) on a grey floor under the world: an environment image (sky with
-    a sun, :func:`sky_image`, its Mapping rotated by ``rotation_z`` radians) or a constant colour; no lamps."""
+    a sun, :func:`sky_image`, its Mapping rotated by ``rotation_z`` radians), a constant colour, a procedural
+    gradient sky ("GRADIENT": a Color Ramp over the direction's height, Strength from a Math node) or the sky image
+    multiplied by a colour by a Noise of the direction ("MIXED"); no lamps."""
     scene = reset()
     plane("Floor", 20, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
     for x, mat in ((-1.2, diffuse("D", (0.8, 0.3, 0.2))), (0.0, principled("P", (0.3, 0.6, 0.8), roughness=0.4)),
@@ -287,9 +289,41 @@ def world_scene(kind="IMAGE", size=(96, 64), rotation_z=0.0):
         tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
         tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
         tree.links.new(env.outputs["Color"], bg.inputs["Color"])
+    elif kind == "GRADIENT":  # a procedural sky: a ramp over the direction's height, strength through Math
+        coords = tree.nodes.new("ShaderNodeTexCoord")
+        sep = tree.nodes.new("ShaderNodeSeparateXYZ")
+        tree.links.new(coords.outputs["Generated"], sep.inputs["Vector"])
+        ramp = tree.nodes.new("ShaderNodeValToRGB")
+        ramp.color_ramp.elements[0].position = 0.45
+        ramp.color_ramp.elements[0].color = (0.05, 0.04, 0.03, 1)
+        ramp.color_ramp.elements[1].position = 0.8
+        ramp.color_ramp.elements[1].color = (0.5, 0.7, 1.0, 1)
+        remap = tree.nodes.new("ShaderNodeMapRange")
+        remap.inputs["From Min"].default_value = -1.0
+        tree.links.new(sep.outputs["Z"], remap.inputs["Value"])
+        tree.links.new(remap.outputs["Result"], ramp.inputs["Fac"])
+        tree.links.new(ramp.outputs["Color"], bg.inputs["Color"])
+        math_node = tree.nodes.new("ShaderNodeMath")
+        math_node.operation = "MULTIPLY"
+        math_node.inputs[0].default_value = 0.75
+        math_node.inputs[1].default_value = 2.0
+        tree.links.new(math_node.outputs[0], bg.inputs["Strength"])
+    elif kind == "MIXED":  # the sky image tinted by a noise of the direction
+        env = tree.nodes.new("ShaderNodeTexEnvironment")
+        env.image = sky_image()
+        noise = tree.nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Scale"].default_value = 2.0
+        mix = tree.nodes.new("ShaderNodeMix")
+        mix.data_type = "RGBA"
+        mix.blend_type = "MULTIPLY"
+        tree.links.new(noise.outputs["Fac"], mix.inputs["Factor"])
+        tree.links.new(env.outputs["Color"], mix.inputs[6])
+        mix.inputs[7].default_value = (1.0, 0.5, 0.2, 1.0)
+        tree.links.new(mix.outputs[2], bg.inputs["Color"])
     else:
         bg.inputs["Color"].default_value = (0.4, 0.5, 0.7, 1)
-    bg.inputs["Strength"].default_value = 1.0
+    if kind not in {"GRADIENT"}:
+        bg.inputs["Strength"].default_value = 1.0
     scene.world = world
     camera((0, -4.5, 1.6), (math.radians(75), 0, 0), lens=35)
     scene.render.resolution_x, scene.render.resolution_y = size

@@ -442,6 +442,17 @@ def _image(g, node, f):
     return {"Color": color, "Alpha": alpha}
 
 
+def _environment(g, node, f):
+    img = node.image
+    if img is None:
+        return {"Color": g.constant((1.0, 0.0, 1.0), "color")}
+    if node.projection != "EQUIRECTANGULAR":
+        g.warn(f"'{node.name}': the {node.projection} projection is approximated by equirectangular")
+    params = {"tex": g.texture(img, False), "interpolation": node.interpolation}
+    return {"Color": g.emit("environment", params, [g.inp(node, "Vector", "vector", f, default="generated")],
+                            ("color",))[0]}
+
+
 def _dims(node) -> int:
     return int(str(getattr(node, "noise_dimensions", "3D"))[0])
 
@@ -575,6 +586,7 @@ _HANDLERS = {
     "SEPHSV": _separate(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "COMBHSV": _combine(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "VALTORGB": _color_ramp, "CURVE_RGB": _rgb_curves, "CURVE_FLOAT": _float_curve, "TEX_IMAGE": _image,
+    "TEX_ENVIRONMENT": _environment,
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
     "TEX_BRICK": _brick, "BLACKBODY": _blackbody, "LIGHT_FALLOFF": _light_falloff,

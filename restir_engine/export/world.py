@@ -1,9 +1,10 @@
 """World background -> a constant radiance or an equirectangular environment image (W·sr⁻¹·m⁻², scene-linear).
 
-Supported: Background (Color x Strength) with a constant colour, or with an Environment Texture (equirectangular,
-its image read like material textures) whose Vector is unlinked or comes through a Mapping node (its rotation;
-Point/Vector/Texture types) from a Texture Coordinate node. Anything else is approximated by the world's colour and
-reported.
+Supported: Background (Color x Strength). A plain equirectangular Environment Texture (its Vector unlinked or
+through a Mapping node's rotation) is used as its image; any other graph of the Color and Strength (constants
+folded, or textures, gradients, mixes and maths of the direction: core/materials/nodes) is evaluated over the
+directions of an equirectangular image (BAKE_WIDTH x BAKE_WIDTH/2, or an environment texture's own resolution
+up to MAX_BAKE_WIDTH), which the world light then samples. Nodes the evaluator does not know are named.
 """
 from __future__ import annotations
 
@@ -13,6 +14,11 @@ import numpy as np
 
 from ..compat import uses_nodes
 from .materials import MaterialRegistry
+from .node_graph import GraphCompiler
+
+BAKE_WIDTH = 512
+MAX_BAKE_WIDTH = 2048
+_BAKE_CHUNK = 1 << 18
 
 
 def export_world(scene, warnings: list):
@@ -33,18 +39,57 @@ def export_world(scene, warnings: list):
         warnings.append(f"World '{world.name}': '{node.name}' is not a Background node; using the world colour")
         return np.array(world.color[:3], np.float32), None, None
     color_in, strength_in = node.inputs["Color"], node.inputs["Strength"]
-    if strength_in.is_linked:
-        warnings.append(f"World '{world.name}': a linked Strength is approximated by its value")
-    strength = float(strength_in.default_value)
-    if color_in.is_linked:
+    registry = MaterialRegistry(warnings)
+    if color_in.is_linked and not strength_in.is_linked:
         src = color_in.links[0].from_node
-        if src.type == "TEX_ENVIRONMENT" and src.image is not None and src.projection == "EQUIRECTANGULAR":
-            registry = MaterialRegistry(warnings)
+        if src.type == "TEX_ENVIRONMENT" and src.image is not None and src.projection == "EQUIRECTANGULAR" and \
+                _plain_mapping(src):
+            strength = float(strength_in.default_value)
             image = registry.textures[registry._texture(world, src.image)] * np.float32(strength)
             return np.zeros(3, np.float32), np.asarray(image, np.float32), _rotation(world, src, warnings)
-        warnings.append(f"World '{world.name}': '{src.name}' ({src.type}) drives the background; approximated by "
-                        "the constant colour (supported: an equirectangular Environment Texture)")
-    return (np.array(color_in.default_value[:3], np.float32) * strength).astype(np.float32), None, None
+    return _baked(world, registry, color_in, strength_in, warnings)
+
+
+def _plain_mapping(env) -> bool:
+    """Whether an Environment Texture's Vector is unlinked or a Mapping (unlinked inputs) of a Texture Coordinate."""
+    vec = env.inputs["Vector"]
+    if not vec.is_linked:
+        return True
+    node = vec.links[0].from_node
+    if node.type == "TEX_COORD":
+        return True
+    if node.type != "MAPPING" or any(s.is_linked for s in node.inputs if s.name != "Vector"):
+        return False
+    inner = node.inputs["Vector"]
+    return not inner.is_linked or inner.links[0].from_node.type == "TEX_COORD"
+
+
+def _baked(world, registry, color_in, strength_in, warnings: list):
+    """The Background's Color x Strength through their node graph: a constant, or an image over directions."""
+    notes = []
+    g = GraphCompiler(lambda image, alpha: registry._texture(world, image, alpha=alpha), notes.append)
+    color, strength = g.value(color_in, "color"), g.value(strength_in, "float")
+    warnings.extend(f"World '{world.name}': {n}" for n in dict.fromkeys(notes))
+    if color.const is not None and strength.const is not None:
+        c = np.asarray(color.constant_value(), np.float32) * np.float32(strength.constant_value())
+        return c.astype(np.float32), None, None
+    program = g.program({"color": color, "strength": strength})
+    sizes = [t.shape[1] for t in registry.textures]
+    w = int(min(MAX_BAKE_WIDTH, max([BAKE_WIDTH] + sizes)))
+    h = max(1, w // 2)
+    from ..core.materials.nodes.attributes import DirectionAttributes
+    rows, cols = np.meshgrid(np.arange(h), np.arange(w), indexing="ij")
+    u, v = (cols.ravel() + 0.5) / w, (rows.ravel() + 0.5) / h
+    phi, theta = (0.5 - u) * 2 * np.pi, (1.0 - v) * np.pi  # the world image's convention (core/lights/world.py)
+    dirs = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)]).astype(np.float32)
+    image = np.empty((h * w, 3), np.float32)
+    for lo in range(0, h * w, _BAKE_CHUNK):
+        hi = min(lo + _BAKE_CHUNK, h * w)
+        out = program.run(DirectionAttributes(dirs[:, lo:hi], registry.textures))
+        c = out["color"] if "color" in out else np.asarray(color.const, np.float32).reshape(3, 1)
+        s = out["strength"] if "strength" in out else np.float32(strength.const)
+        image[lo:hi] = np.broadcast_to(c * s, (3, hi - lo)).T
+    return np.zeros(3, np.float32), np.where(np.isfinite(image), image, 0).reshape(h, w, 3), None
 
 
 def _euler_xyz(rx: float, ry: float, rz: float) -> np.ndarray:

@@ -128,6 +128,18 @@ def test_world_light_matches_cycles(addon, kind, bounces):
     assert_cells_match(*cells, [f"cell {k}" for k in range(16)], power=[4, 5, 6] + list(range(8, 16)))
 
 
+@pytest.mark.parametrize("kind", ["GRADIENT", "MIXED"])
+def test_world_node_graphs_match_cycles(addon, kind):
+    """A world whose Background is a node graph of the direction (a Color Ramp sky with a Math strength; the sky
+    image multiplied by a colour through a Noise), evaluated over an equirectangular image at export
+    (export/world.py), seen and lighting the spheres, 1 bounce: per 4 x 4 image cell, every cell able to see a 3 %
+    error where it is not dark."""
+    from bpy_scenes import world_scene
+    ours, ref = path_vs_cycles_cells(f"world_{kind.lower()}_b1", lambda size: world_scene(kind, size), 1)
+    bright = [k for k in range(16) if ref.mean(0)[k] > 0.02]
+    assert_cells_match(ours, ref, [f"cell {k}" for k in range(16)], power=bright)
+
+
 def test_world_in_reservoirs_matches_cycles(addon):
     """The environment-image world of :func:`test_world_light_matches_cycles` with ReSTIR DI holding the world's
     samples in its reservoirs (World Light Resampled, spatial reuse; core/lights/world_points.py), direct light: per 4 x 4

@@ -174,3 +174,32 @@ class HitAttributes:
             vals = self._corners(data)  # (4, n)
             return np.ascontiguousarray(vals[:3]) if name.startswith("attr:") else np.ascontiguousarray(vals[3])
         raise KeyError(f"unknown hit attribute {name!r}")
+
+
+class DirectionAttributes:
+    """The attributes a world's node program reads for directions ``dirs`` (3, n) (unit, world space, pointing away
+    from the scene), as Cycles gives a world shader: the direction as position and texture coordinates
+    (Generated, Object), the opposite one as the normal and the incoming view; no surface (UV 0, not backfacing)."""
+
+    def __init__(self, dirs, textures):
+        self.dirs = np.ascontiguousarray(dirs, np.float32)
+        self.textures = textures
+
+    def __len__(self) -> int:
+        return self.dirs.shape[1]
+
+    def get(self, name: str):
+        n = len(self)
+        if name in {"position", "generated", "object"}:
+            return self.dirs
+        if name in {"normal", "true_normal", "incoming", "object_normal"}:
+            return -self.dirs
+        if name == "reflection":
+            return self.dirs
+        if name in {"uv", "parametric", "object_location", "object_color"} or name.startswith("attr:"):
+            return np.zeros((3, n), np.float32)
+        if name == "footprint":
+            return np.full(n, _F(1e-3), np.float32)
+        if name in {"tangent_uv", "tangent_sign"}:
+            return None
+        return np.zeros(n, np.float32)  # backfacing, object alpha / random, attribute alphas

@@ -174,6 +174,17 @@ def image_texture(attrs, params, vector):
     return np.ascontiguousarray(color, np.float32), alpha.astype(np.float32)
 
 
+def environment_texture(attrs, params, vector):
+    """Environment Texture node (equirectangular): the image at the direction ``vector``'s longitude and latitude
+    (u = 1/2 - atan2(y, x) / 2π, v = 1/2 + atan2(z, √(x² + y²)) / π), wrapping in u."""
+    d = np.broadcast_to(f32(vector), (3, len(attrs)))
+    u = _F(0.5) - np.arctan2(d[1], d[0]) / _F(2 * np.pi)
+    v = _F(0.5) + np.arctan2(d[2], np.hypot(d[0], d[1])) / _F(np.pi)
+    image = attrs.textures[params["tex"]]
+    return np.ascontiguousarray(sample_image(image, u, v, params.get("interpolation", "Linear"), "REPEAT").T,
+                                dtype=np.float32)
+
+
 # -- procedural textures --------------------------------------------------------------------------------------
 def _coords(dims: int, vector, w, scale):
     s = f32(scale)
@@ -297,9 +308,9 @@ def float_curve(attrs, params, fac, value):
 
 OPERATIONS = {
     "attribute": attribute, "fresnel": fresnel, "layer_weight": layer_weight, "mapping": mapping,
-    "vector_rotate": vector_rotate, "image": image_texture, "noise": noise_texture, "white_noise": white_noise,
+    "vector_rotate": vector_rotate, "image": image_texture, "environment": environment_texture, "noise": noise_texture, "white_noise": white_noise,
     "checker": checker, "gradient": gradient, "color_ramp": color_ramp, "rgb_curves": rgb_curves,
     "float_curve": float_curve,
 }
 #: operations that read the hits: never folded into constants at export
-READS_HITS = frozenset({"attribute", "fresnel", "layer_weight", "image"})
+READS_HITS = frozenset({"attribute", "fresnel", "layer_weight", "image", "environment"})
