@@ -196,7 +196,12 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             _TEMPORAL_HISTORY[key] = (scene.frame_current, result.history)
         for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):
             self.report({"WARNING"}, msg)
-        self._write(result.passes, core_scene.camera.window, scene, view_layer)
+        stamps = {}
+        kinds = pass_table.cryptomatte_kinds(view_layer)
+        if kinds and not result.cancelled:
+            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Cryptomatte")
+            stamps = self._cryptomatte(depsgraph, core_scene, settings, view_layer, kinds, result.passes)
+        self._write(result.passes, core_scene.camera.window, scene, view_layer, stamps)
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
                                                                   "world_method", "world_reason",
                                                                   "coverage_samples", "coverage_reason",
@@ -336,7 +341,27 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         if not session.last_error:
             self.update_stats("ReSTIR", session.stats.text())
 
-    def _write(self, images: dict, window, scene, view_layer):
+    @staticmethod
+    def _cryptomatte(depsgraph, core_scene, settings, view_layer, kinds, passes: dict) -> dict:
+        """Adds the Cryptomatte passes to ``passes``; returns their metadata fields (the manifests name the lights
+        too, as Cycles')."""
+        from .core.integrators.trace_context import build_context
+        from .core.pipeline import cryptomatte
+        ctx = build_context(core_scene, 0)
+        rays = min(max(int(settings.samples), 16), 64)  # rays per pixel for the coverages
+        images, manifests = cryptomatte.render_cryptomatte(ctx, kinds, int(view_layer.pass_cryptomatte_depth), rays,
+                                                           settings.seed, settings.frame)
+        passes.update(images)
+        from .export.meshes import _asset_name
+        lights = [inst.object for inst in depsgraph.object_instances if inst.object.type == "LIGHT"]
+        extra = {"object": [o.name for o in lights], "asset": [_asset_name(o) for o in lights]}
+        stamps = {}
+        for kind in kinds:
+            manifest = {**{n: f"{cryptomatte.name_hash(n):08x}" for n in extra.get(kind, ())}, **manifests[kind]}
+            stamps.update(cryptomatte.metadata(view_layer.name, kind, manifest))
+        return stamps
+
+    def _write(self, images: dict, window, scene, view_layer, stamps: dict | None = None):
         _x0, _y0, w, h = window
         result = self.begin_result(0, 0, w, h, layer=view_layer.name)
         layer = result.layers[0] if len(result.layers) == 1 else result.layers[view_layer.name]
@@ -346,3 +371,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                 continue
             _set_rect(rp, np.ascontiguousarray(images[core_name], dtype=np.float32).reshape(w * h, len(chans)))
         self.end_result(result)
+        if stamps:  # metadata (Cryptomatte manifests) go on the engine's whole result, written into EXR headers
+            whole = self.get_result()
+            for key, value in stamps.items():
+                whole.stamp_data_add_field(key, value)

@@ -35,9 +35,23 @@ PASSES = (
 )
 
 
+def cryptomatte_kinds(view_layer) -> list:
+    """The Cryptomatte layers the view layer asks for (View Layer Properties > Passes > Cryptomatte)."""
+    return [k for k in ("object", "material", "asset") if getattr(view_layer, f"use_pass_cryptomatte_{k}", False)]
+
+
+def cryptomatte_rows(view_layer) -> list:
+    """Pass rows of the Cryptomatte layers: ceil(Levels / 2) RGBA passes each (two ranks of (id, coverage))."""
+    from .core.pipeline.cryptomatte import PASS_PREFIX
+    levels = int(getattr(view_layer, "pass_cryptomatte_depth", 6))
+    return [(f"{PASS_PREFIX[k]}{i:02d}", "rgba", "COLOR", lambda sc, vl: True, f"{PASS_PREFIX[k]}{i:02d}")
+            for k in cryptomatte_kinds(view_layer) for i in range((levels + 1) // 2)]
+
+
 def enabled_passes(scene, view_layer):
-    """Rows of :data:`PASSES` enabled for this scene and view layer (stateless: safe on throwaway engines)."""
-    return [row for row in PASSES if row[3](scene, view_layer)]
+    """Rows of :data:`PASSES` enabled for this scene and view layer, then its Cryptomatte passes (stateless: safe
+    on throwaway engines)."""
+    return [row for row in PASSES if row[3](scene, view_layer)] + cryptomatte_rows(view_layer)
 
 
 def register_passes(engine, scene, view_layer):

@@ -49,6 +49,7 @@ class ObjectTable:
     world_to_object (k, 3, 4)  the inverse of the instance's world matrix (affine rows), float64
     texspace_lo, texspace_size (k, 3)  its texture space: Generated = (object position - lo) / size
     location (k, 3) world-space origin; color (k, 4) the object's Color (RGBA); random (k,) Object Info Random
+    names, assets (k,) the instance's object name and its top-most parent's (Cryptomatte)
     """
 
     world_to_object: np.ndarray
@@ -57,6 +58,8 @@ class ObjectTable:
     location: np.ndarray
     color: np.ndarray
     random: np.ndarray
+    names: tuple = ()
+    assets: tuple = ()
 
 
 @dataclass

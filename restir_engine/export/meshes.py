@@ -221,7 +221,7 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
         if arrays is None:
             continue
         blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name,
-                       instance_key(inst), (tuple(obj.color), object_random(inst))))
+                       instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, _asset_name(obj))))
 
     if not blocks:
         return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0, "instance_keys": [],
@@ -308,7 +308,15 @@ def _object_table(blocks) -> ObjectTable:
     return ObjectTable(world_to_object=inv, texspace_lo=lo, texspace_size=size,
                        location=mats[:, :3, 3].astype(np.float32),
                        color=np.array([b[5][0] for b in blocks], np.float32).reshape(len(blocks), 4),
-                       random=np.array([b[5][1] for b in blocks], np.float32))
+                       random=np.array([b[5][1] for b in blocks], np.float32),
+                       names=tuple(b[5][2] for b in blocks), assets=tuple(b[5][3] for b in blocks))
+
+
+def _asset_name(obj) -> str:
+    """The name of an object's top-most parent (itself without one): Cryptomatte's asset."""
+    while obj.parent is not None:
+        obj = obj.parent
+    return obj.name
 
 
 def _spans(blocks):

@@ -21,7 +21,8 @@ STANDARD_PANELS = (
     "RENDER_PT_color_management_white_balance", "RENDER_PT_color_management_working_space",
     "VIEWLAYER_PT_layer", "VIEWLAYER_PT_context_layer",
     # camera
-    "DATA_PT_context_camera", "DATA_PT_lens", "DATA_PT_camera", "DATA_PT_camera_display",
+    "DATA_PT_context_camera", "DATA_PT_lens", "DATA_PT_camera", "DATA_PT_camera_display", "DATA_PT_camera_dof",
+    "DATA_PT_camera_dof_aperture",
     "DATA_PT_camera_display_composition_guides", "DATA_PT_camera_safe_areas", "DATA_PT_camera_safe_areas_center_cut",
     "DATA_PT_camera_background_image", "DATA_PT_camera_stereoscopy", "DATA_PT_custom_props_camera",
     # lights
@@ -305,6 +306,11 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl.restir, "use_pass_gi_reservoir_ucw")
         col = layout.column(heading="Denoising", align=True)
         col.prop(vl.restir, "use_pass_denoising_data")
+        col = layout.column(heading="Cryptomatte", align=True)
+        col.prop(vl, "use_pass_cryptomatte_object", text="Object")
+        col.prop(vl, "use_pass_cryptomatte_material", text="Material")
+        col.prop(vl, "use_pass_cryptomatte_asset", text="Asset")
+        col.prop(vl, "pass_cryptomatte_depth", text="Levels")
 
 
 class RESTIR_PT_viewport_render_pass(bpy.types.Panel):
