@@ -50,6 +50,7 @@ class ObjectTable:
     texspace_lo, texspace_size (k, 3)  its texture space: Generated = (object position - lo) / size
     location (k, 3) world-space origin; color (k, 4) the object's Color (RGBA); random (k,) Object Info Random
     names, assets (k,) the instance's object name and its top-most parent's (Cryptomatte)
+    holdout (k,) bool: Object > Visibility > Holdout (transparent and black to camera rays, lit and lighting as usual)
     """
 
     world_to_object: np.ndarray
@@ -60,6 +61,7 @@ class ObjectTable:
     random: np.ndarray
     names: tuple = ()
     assets: tuple = ()
+    holdout: np.ndarray = None
 
 
 @dataclass
@@ -145,6 +147,7 @@ class MaterialTable:
     mix_weight: np.ndarray = None
     mix_tex: np.ndarray = None
     mix_sign: np.ndarray = None
+    holdout: np.ndarray = None  # (m,) bool: a Holdout shader (camera rays meeting it give alpha 0, black)
     program: np.ndarray = None
     programs: list = field(default_factory=list)
     textures: list = field(default_factory=list)
@@ -170,7 +173,7 @@ class MaterialTable:
             transmission=col("transmission", 0.0), glass_ior=col("glass_ior", 1.5),
             glass_reflect=col("glass_reflect", (1.0, 1.0, 1.0)), glass_refract=col("glass_refract", (1.0, 1.0, 1.0)),
             glass_alpha=col("glass_alpha", 0.0), glass_multiscatter=col("glass_multiscatter", 1.0),
-            diffuse_roughness=col("diffuse_roughness", 0.0),
+            diffuse_roughness=col("diffuse_roughness", 0.0), holdout=col("holdout", False, bool),
             **_mix_arrays(rows), **_programs(rows),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
 

@@ -25,6 +25,10 @@ MAX_MIX_DEPTH = 256
 MAGENTA = (1.0, 0.0, 1.0)
 
 
+#: a Holdout shader: black and emitting nothing; camera rays that meet it leave the pixel transparent (alpha 0)
+HOLDOUT_ROW = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "metallic": 0.0, "holdout": True}
+
+
 class MaterialRegistry:
     """Assigns table indices to Blender materials (index 0 is Blender's default grey) and
     collects textures; reports approximations through ``warnings``."""
@@ -231,6 +235,8 @@ class MaterialRegistry:
             return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transmission": 1.0, "glass_ior": max(ior, 1e-3),
                     "glass_reflect": tuple(c), "glass_refract": tuple(c), "glass_alpha": rough * rough,
                     "glass_multiscatter": self._multiscatter(material, node)}
+        if t == "HOLDOUT":
+            return dict(HOLDOUT_ROW)
         if t == "BSDF_TRANSPARENT":
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
             if min(c) < 0.999:

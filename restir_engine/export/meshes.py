@@ -221,7 +221,8 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
         if arrays is None:
             continue
         blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name,
-                       instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, _asset_name(obj))))
+                       instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, _asset_name(obj),
+                                                         bool(getattr(obj, "is_holdout", False)))))
 
     if not blocks:
         return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0, "instance_keys": [],
@@ -309,7 +310,8 @@ def _object_table(blocks) -> ObjectTable:
                        location=mats[:, :3, 3].astype(np.float32),
                        color=np.array([b[5][0] for b in blocks], np.float32).reshape(len(blocks), 4),
                        random=np.array([b[5][1] for b in blocks], np.float32),
-                       names=tuple(b[5][2] for b in blocks), assets=tuple(b[5][3] for b in blocks))
+                       names=tuple(b[5][2] for b in blocks), assets=tuple(b[5][3] for b in blocks),
+                       holdout=np.array([b[5][4] for b in blocks], bool))
 
 
 def _asset_name(obj) -> str:

@@ -231,3 +231,10 @@ def test_metaball_and_emission_texture(scene):
     assert table.n_geom == 2  # the plane's two triangles are lights, with the texture's mean in their power
     lum = 0.2126 * 0.5 + 0.7152 * 0.25 + 0.0722 * 1.0
     assert np.isclose(table.power[:2].sum(), np.pi * 2 * 2.0 * lum * 4.0, rtol=1e-4)
+
+
+def test_unrendered_motion_blur_is_named(scene):
+    plane("Floor", 2.0, (0, 0, 0))
+    assert not any("Motion blur" in w for w in export().warnings)
+    scene.render.use_motion_blur = True
+    assert sum("Motion blur" in w for w in export().warnings) == 1

@@ -61,7 +61,29 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
     emitted, alpha = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
     rows = np.flatnonzero(hits.prim >= 0)
     surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
+    held = holdout_hits(ctx, surf)
+    if held is not None:  # the pixel is transparent and black there
+        alpha[rows[held]] = 0.0
+        emitted[:, rows[held]] = 0.0
+        scale = np.ones(len(rows), np.float32)
+        scale[held] = 0.0
+        surf.params.scale(scale)
     return PrimaryHits(emitted, alpha, rows, surf)
+
+
+def holdout_hits(ctx: TraceContext, surf) -> np.ndarray | None:
+    """Indices of camera hits ``surf`` on a Holdout shader or a holdout object (Object > Visibility > Holdout);
+    None when there are none."""
+    mat_hold = getattr(ctx.scene.materials, "holdout", None)
+    objs = getattr(ctx.scene.geometry, "objects", None)
+    obj_hold = getattr(objs, "holdout", None)
+    held = np.zeros(len(surf.prim), bool)
+    if mat_hold is not None and mat_hold.any():
+        held |= mat_hold[surf.bsdf_mat]
+    inst = ctx.scene.geometry.instance
+    if obj_hold is not None and obj_hold.any() and inst is not None:
+        held |= obj_hold[inst[surf.prim]]
+    return np.flatnonzero(held) if held.any() else None
 
 
 def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray, lens_uv: np.ndarray | None = None):
