@@ -201,6 +201,14 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         if kinds and not result.cancelled:
             self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Cryptomatte")
             stamps = self._cryptomatte(depsgraph, core_scene, settings, view_layer, kinds, result.passes)
+        aovs = pass_table.shader_aovs(view_layer)
+        if aovs and not result.cancelled:
+            from .core.integrators.trace_context import build_context
+            from .core.pipeline.aovs import render_aovs
+            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Shader AOVs")
+            images = render_aovs(build_context(core_scene, 0), aovs, min(max(int(settings.samples), 16), 64),
+                                 settings.seed, settings.frame)
+            result.passes.update({f"AOV {name}": img for name, img in images.items()})
         self._write(result.passes, core_scene.camera.window, scene, view_layer, stamps)
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
                                                                   "world_method", "world_reason",

@@ -48,10 +48,20 @@ def cryptomatte_rows(view_layer) -> list:
             for k in cryptomatte_kinds(view_layer) for i in range((levels + 1) // 2)]
 
 
+def shader_aovs(view_layer) -> list:
+    """(name, "COLOR" | "VALUE") of the view layer's Shader AOVs (View Layer Properties > Shader AOV)."""
+    return [(a.name, a.type) for a in getattr(view_layer, "aovs", ()) if a.name and getattr(a, "is_valid", True)]
+
+
+def aov_rows(view_layer) -> list:
+    return [(name, "RGB" if kind == "COLOR" else "X", "COLOR" if kind == "COLOR" else "VALUE", lambda sc, vl: True,
+             f"AOV {name}") for name, kind in shader_aovs(view_layer)]
+
+
 def enabled_passes(scene, view_layer):
-    """Rows of :data:`PASSES` enabled for this scene and view layer, then its Cryptomatte passes (stateless: safe
-    on throwaway engines)."""
-    return [row for row in PASSES if row[3](scene, view_layer)] + cryptomatte_rows(view_layer)
+    """Rows of :data:`PASSES` enabled for this scene and view layer, then its Cryptomatte and Shader AOV passes
+    (stateless: safe on throwaway engines)."""
+    return [row for row in PASSES if row[3](scene, view_layer)] + cryptomatte_rows(view_layer) + aov_rows(view_layer)
 
 
 def register_passes(engine, scene, view_layer):

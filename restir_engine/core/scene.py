@@ -150,6 +150,8 @@ class MaterialTable:
     holdout: np.ndarray = None  # (m,) bool: a Holdout shader (camera rays meeting it give alpha 0, black)
     program: np.ndarray = None
     programs: list = field(default_factory=list)
+    aov_program: np.ndarray = None  # (m,) index into aov_programs (the material's AOV Output nodes) or -1
+    aov_programs: list = field(default_factory=list)
     textures: list = field(default_factory=list)
     names: list = field(default_factory=list)
 
@@ -174,7 +176,7 @@ class MaterialTable:
             glass_reflect=col("glass_reflect", (1.0, 1.0, 1.0)), glass_refract=col("glass_refract", (1.0, 1.0, 1.0)),
             glass_alpha=col("glass_alpha", 0.0), glass_multiscatter=col("glass_multiscatter", 1.0),
             diffuse_roughness=col("diffuse_roughness", 0.0), holdout=col("holdout", False, bool),
-            **_mix_arrays(rows), **_programs(rows),
+            **_mix_arrays(rows), **_programs(rows), **_programs(rows, "aov_program"),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
 
 
@@ -193,14 +195,15 @@ def _mix_arrays(rows: list[dict]) -> dict:
             "mix_sign": np.array(cols[3], np.float32)}
 
 
-def _programs(rows: list[dict]) -> dict:
-    """The program fields of :class:`MaterialTable` from rows' "program" entries (a Program or absent)."""
-    programs = [r["program"] for r in rows if r.get("program") is not None]
+def _programs(rows: list[dict], key: str = "program") -> dict:
+    """The program fields of :class:`MaterialTable` from rows' ``key`` entries (a Program or absent):
+    {key: index (m,), key + "s": the programs}."""
+    programs = [r[key] for r in rows if r.get(key) is not None]
     index, k = np.full(len(rows), -1, np.int32), 0
     for i, r in enumerate(rows):
-        if r.get("program") is not None:
+        if r.get(key) is not None:
             index[i], k = k, k + 1
-    return {"program": index, "programs": programs}
+    return {key: index, key + "s": programs}
 
 
 DEFAULT_MATERIAL = {"name": "(default grey)", "base_color": (0.8, 0.8, 0.8), "roughness": 0.5, "f0": 0.04}

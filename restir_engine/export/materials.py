@@ -48,6 +48,9 @@ class MaterialRegistry:
         if key not in self.index:
             row = self._convert(material)
             row["name"] = material.name
+            aov = self._aov_program(material)
+            if aov is not None:
+                row["aov_program"] = aov
             self.index[key] = len(self.rows)
             self.rows.append(row)
         return self.index[key]
@@ -70,8 +73,9 @@ class MaterialRegistry:
         def textured(row: dict) -> bool:
             if max(row.get(k, -1) for k in ("base_tex", "emit_tex", "alpha_tex", "normal_tex", "bump_tex")) >= 0:
                 return True
-            if row.get("program") is not None and {"uv", "tangent_uv"} & set(row["program"].reads):
-                return True
+            for key in ("program", "aov_program"):
+                if row.get(key) is not None and {"uv", "tangent_uv"} & set(row[key].reads):
+                    return True
             return any(tex >= 0 or textured(self.rows[comp]) for comp, _w, tex, _s in row.get("mix", ()))
         return any(textured(self.rows[i]) for i in indices)
 
@@ -89,9 +93,9 @@ class MaterialRegistry:
         names: set = set()
 
         def collect(row: dict) -> None:
-            prog = row.get("program")
-            if prog is not None:
-                names.update(r.split(":", 1)[1] for r in prog.reads if r.startswith("attr"))
+            for prog in (row.get("program"), row.get("aov_program")):
+                if prog is not None:
+                    names.update(r.split(":", 1)[1] for r in prog.reads if r.startswith("attr"))
             for comp, *_rest in row.get("mix", ()):
                 collect(self.rows[comp])
         for i in indices:
@@ -120,6 +124,21 @@ class MaterialRegistry:
             self._warn(material, "no surface shader connected to the Material Output; rendered black")
             return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
         return self._shader(material, outs[0].inputs["Surface"].links[0].from_node, depth=0)
+
+    def _aov_program(self, material):
+        """The material's AOV Output nodes as one program: fields "aov:<name>" (Color) and "aov_value:<name>"
+        (Value), constants included; None without AOV outputs."""
+        if not uses_nodes(material):
+            return None
+        nodes = [n for n in material.node_tree.nodes if n.type == "OUTPUT_AOV" and not n.mute and n.aov_name]
+        if not nodes:
+            return None
+        g = self._compiler(material)
+        outputs = {}
+        for node in nodes:
+            outputs[f"aov:{node.aov_name}"] = g.value(node.inputs["Color"], "color")
+            outputs[f"aov_value:{node.aov_name}"] = g.value(node.inputs["Value"], "float")
+        return g.program(outputs, constants=True)
 
     def _compiler(self, material) -> GraphCompiler:
         """A node-graph compiler for one row of ``material`` (images go to this registry's texture list)."""

@@ -311,6 +311,17 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl, "use_pass_cryptomatte_material", text="Material")
         col.prop(vl, "use_pass_cryptomatte_asset", text="Asset")
         col.prop(vl, "pass_cryptomatte_depth", text="Levels")
+        layout.label(text="Shader AOV")
+        row = layout.row()
+        if hasattr(bpy.types, "VIEWLAYER_UL_aov"):
+            row.template_list("VIEWLAYER_UL_aov", "aovs", vl, "aovs", vl, "active_aov_index", rows=3)
+        else:
+            row.template_list("UI_UL_list", "aovs", vl, "aovs", vl, "active_aov_index", rows=3)
+        ops = row.column(align=True)
+        ops.operator("scene.view_layer_add_aov", icon="ADD", text="")
+        ops.operator("scene.view_layer_remove_aov", icon="REMOVE", text="")
+        if vl.active_aov is not None:
+            layout.prop(vl.active_aov, "type")
 
 
 class RESTIR_PT_viewport_render_pass(bpy.types.Panel):

@@ -11,8 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry import camera as camera_mod
-from ..sampling import STREAM_LENS, STREAM_PIXEL_OFFSET, pass_jitter, rng
+from .own_rays import camera_ray_sets
 
 KINDS = ("object", "material", "asset")
 PASS_PREFIX = {"object": "CryptoObject", "material": "CryptoMaterial", "asset": "CryptoAsset"}
@@ -81,21 +80,10 @@ def render_cryptomatte(ctx, kinds, depth: int, samples: int, seed: int = 0, fram
     """{pass name: (h, w, 4) float32, row 0 at the bottom} for each kind in ``kinds`` with ceil(depth / 2)
     passes, and {kind: manifest dict}."""
     cam = ctx.scene.camera
-    x0, y0, w, h = cam.window
+    _x0, _y0, w, h = cam.window
     n_pix, k = w * h, max(1, int(samples))
-    pix = np.arange(n_pix)
-    shift = rng(seed, frame, 0, STREAM_PIXEL_OFFSET + STREAM_CRYPTO).bit_generator.random_raw(n_pix)
-    shift = shift.view(np.uint32).reshape(-1, 2)
-    land = camera_mod.filter_offsets(cam)
-    lens = rng(seed, frame, 0, STREAM_LENS + STREAM_CRYPTO) if camera_mod.has_lens(cam) else None
     prims = np.empty((k, n_pix), np.int64)
-    for s in range(k):
-        j = pass_jitter(shift, s)
-        x = (x0 + pix % w).astype(np.float32) + land(j[:, 0])
-        y = (y0 + pix // w).astype(np.float32) + land(j[:, 1])
-        o, d, tmax = camera_mod.generate_rays(cam, x, y, None if lens is None else
-                                              lens.random((2, n_pix), dtype=np.float32))
-        tmax = np.where(tmax < 0, np.float32(0), tmax)
+    for s, (o, d, tmax) in enumerate(camera_ray_sets(cam, k, seed, frame, STREAM_CRYPTO)):
         prims[s] = ctx.geom_accel.intersect(o, d, tmax).prim
     out, manifests = {}, {}
     ranks = max(1, int(depth))
