@@ -432,6 +432,24 @@ def group_reroute_mute():
     return graph
 
 
+def pass_index(output, value):
+    """Object Info's Object / Material Index over 8, the object's / material's Pass Index set to ``value``."""
+    def graph(tree, socket):
+        o = _node(tree, "ShaderNodeObjectInfo")
+        m = _node(tree, "ShaderNodeMath", operation="DIVIDE")
+        _link(tree, o.outputs[output], m.inputs[0])
+        m.inputs[1].default_value = 8.0
+        _link(tree, m.outputs[0], socket)
+
+    def setup(obj):
+        if output == "Object Index":
+            obj.pass_index = value
+        else:
+            obj.active_material.pass_index = value
+    graph.setup = setup
+    return graph
+
+
 INPUTS = [
     ("generated", coords("Generated")), ("object", coords("Object", scale=1.5)), ("uv", coords("UV")),
     ("object normal", coords("Normal")), ("reflection", coords("Reflection")),
@@ -446,6 +464,9 @@ INPUTS = [
     ("color attribute point", color_attribute()), ("color attribute corner", color_attribute("CORNER")),
     ("color attribute alpha", color_attribute("POINT", "Alpha")),
     ("group reroute mute", group_reroute_mute()),
+    ("camera", coords("Camera", scale=0.2)), ("window", coords("Window")),
+    ("tangent tilted", geometry("Tangent", 0.6)),
+    ("object index", pass_index("Object Index", 3)), ("material index", pass_index("Material Index", 5)),
 ]
 
 def _vabs(tree, out):

@@ -62,6 +62,7 @@ class ObjectTable:
     names: tuple = ()
     assets: tuple = ()
     holdout: np.ndarray = None
+    pass_index: np.ndarray = None  # (k,) float32 the object's Pass Index (Object Info > Object Index)
 
 
 @dataclass

@@ -58,6 +58,7 @@ def export_scene(depsgraph, camera_override=None, camera=None, mesh_cache: dict 
     if camera is None:
         camera = export_camera(depsgraph, camera_override, warnings)
     registry = MaterialRegistry(warnings)
+    registry.camera = camera  # what Texture Coordinate's Camera and Window outputs are relative to
     geometry, stats = export_geometry(depsgraph, registry, warnings, mesh_cache)
     geometry_warnings = list(warnings)
     out = export_shading(depsgraph, registry, geometry, camera, warnings)

@@ -142,8 +142,11 @@ class MaterialRegistry:
 
     def _compiler(self, material) -> GraphCompiler:
         """A node-graph compiler for one row of ``material`` (images go to this registry's texture list)."""
-        return GraphCompiler(lambda image, alpha: self._texture(material, image, alpha=alpha),
-                             lambda reason: self._warn(material, reason))
+        g = GraphCompiler(lambda image, alpha: self._texture(material, image, alpha=alpha),
+                          lambda reason: self._warn(material, reason))
+        g.camera = getattr(self, "camera", None)
+        g.material_index = float(getattr(material, "pass_index", 0))
+        return g
 
     def _param(self, material, g: GraphCompiler, socket, kind: str, field: str, varying: dict, row: dict | None = None,
                key_tex: str | None = None):

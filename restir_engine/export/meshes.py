@@ -222,7 +222,8 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
             continue
         blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name,
                        instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, _asset_name(obj),
-                                                         bool(getattr(obj, "is_holdout", False)))))
+                                                         bool(getattr(obj, "is_holdout", False)),
+                                                         float(getattr(obj, "pass_index", 0)))))
 
     if not blocks:
         return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0, "instance_keys": [],
@@ -311,7 +312,8 @@ def _object_table(blocks) -> ObjectTable:
                        color=np.array([b[5][0] for b in blocks], np.float32).reshape(len(blocks), 4),
                        random=np.array([b[5][1] for b in blocks], np.float32),
                        names=tuple(b[5][2] for b in blocks), assets=tuple(b[5][3] for b in blocks),
-                       holdout=np.array([b[5][4] for b in blocks], bool))
+                       holdout=np.array([b[5][4] for b in blocks], bool),
+                       pass_index=np.array([b[5][5] for b in blocks], np.float32))
 
 
 def _asset_name(obj) -> str:

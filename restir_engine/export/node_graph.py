@@ -56,6 +56,8 @@ class GraphCompiler:
         self._memo: dict = {}
         self._frames: dict = {}
         self.top = Frame()
+        self.camera = None        # the core Camera of Texture Coordinate's Camera / Window outputs (None: unknown)
+        self.material_index = 0.0  # the material's Pass Index (Object Info > Material Index)
 
     # -- registers --------------------------------------------------------------------------------------------
     def _new(self, kind: str, const=None) -> Reg:
@@ -223,7 +225,20 @@ def _texcoord(g, node, f):
     out = {"Generated": g.attribute("generated", "vector"), "Normal": g.attribute("object_normal", "vector"),
            "UV": g.attribute("uv", "vector"), "Object": g.attribute("object", "vector"),
            "Reflection": g.attribute("reflection", "vector")}
-    return out  # Camera and Window: reported by GraphCompiler.output
+    if g.camera is not None:
+        pos = g.attribute("position", "vector")
+        out["Camera"] = g.emit("camera_coords", {"camera": g.camera}, [pos], ("vector",))[0]
+        out["Window"] = g.emit("window_coords", {"camera": g.camera}, [pos], ("vector",))[0]
+    return out
+
+
+def _tangent(g, node, f):
+    if node.direction_type == "UV_MAP":
+        g.attribute("tangent_uv", "vector")
+        return {"Tangent": g.attribute("tangent_uv", "vector")}
+    if node.axis != "Z":
+        g.warn(f"'{node.name}': a radial tangent about {node.axis} is approximated by the one about Z")
+    return {"Tangent": g.attribute("tangent", "vector")}
 
 
 def _uvmap(g, node, f):
@@ -235,12 +250,14 @@ def _uvmap(g, node, f):
 def _geometry(g, node, f):
     return {"Position": g.attribute("position", "vector"), "Normal": g.attribute("normal", "vector"),
             "True Normal": g.attribute("true_normal", "vector"), "Incoming": g.attribute("incoming", "vector"),
-            "Parametric": g.attribute("parametric", "vector"), "Backfacing": g.attribute("backfacing", "float")}
+            "Parametric": g.attribute("parametric", "vector"), "Backfacing": g.attribute("backfacing", "float"),
+            "Tangent": g.attribute("tangent", "vector")}
 
 
 def _object_info(g, node, f):
     return {"Location": g.attribute("object_location", "vector"), "Color": g.attribute("object_color", "color"),
-            "Alpha": g.attribute("object_alpha", "float"), "Random": g.attribute("object_random", "float")}
+            "Alpha": g.attribute("object_alpha", "float"), "Random": g.attribute("object_random", "float"),
+            "Object Index": g.attribute("object_index", "float"), "Material Index": g.constant(g.material_index, "float")}
 
 
 def _color_attribute(g, node, f):
@@ -572,7 +589,7 @@ def _light_falloff(g, node, f):
 
 
 _HANDLERS = {
-    "TEX_COORD": _texcoord, "UVMAP": _uvmap, "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
+    "TEX_COORD": _texcoord, "TANGENT": _tangent, "UVMAP": _uvmap, "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
     "VERTEX_COLOR": _color_attribute, "ATTRIBUTE": _attribute, "FRESNEL": _fresnel, "LAYER_WEIGHT": _layer_weight,
     "VALUE": _value, "RGB": _rgb, "MAPPING": _mapping, "VECTOR_ROTATE": _vector_rotate, "MATH": _math,
     "VECT_MATH": _vector_math, "MIX": _mix, "MIX_RGB": _mix_rgb, "MAP_RANGE": _map_range, "CLAMP": _clamp,

@@ -166,6 +166,18 @@ class HitAttributes:
             return (tan / np.maximum(norm(tan), _F(1e-30))).astype(np.float32)
         if name == "footprint":
             return np.full(n, _F(1e-3), np.float32)
+        if name == "tangent":  # Geometry > Tangent: radial about the object's Z axis, as Cycles' default
+            g = self.get("generated")
+            d = np.stack([_F(0.5) - g[1], g[0] - _F(0.5), np.zeros(n, np.float32)])
+            d = self.object_normal_to_world(d)
+            nn = self.get("normal")
+            t = np.cross(d.T, nn.T).T
+            t = np.cross(nn.T, t.T).T
+            return (t / np.maximum(norm(t), _F(1e-30))).astype(np.float32)
+        if name == "object_index":
+            inst, objs = self._instances()
+            idx = None if inst is None else getattr(objs, "pass_index", None)
+            return np.zeros(n, np.float32) if idx is None else np.ascontiguousarray(idx[inst], dtype=np.float32)
         if name.startswith("attr:") or name.startswith("attr_alpha:"):
             key = name.split(":", 1)[1]
             data = (getattr(self.tris, "attributes", None) or {}).get(key)
@@ -196,7 +208,7 @@ class DirectionAttributes:
             return -self.dirs
         if name == "reflection":
             return self.dirs
-        if name in {"uv", "parametric", "object_location", "object_color"} or name.startswith("attr:"):
+        if name in {"uv", "parametric", "object_location", "object_color", "tangent"} or name.startswith("attr:"):
             return np.zeros((3, n), np.float32)
         if name == "footprint":
             return np.full(n, _F(1e-3), np.float32)

@@ -15,8 +15,28 @@ _F = np.float32
 
 
 def attribute(attrs, params):
-    """A hit attribute by name (:class:`~.attributes.HitAttributes`)."""
-    return attrs.get(params["name"])
+    """A hit attribute by name (:class:`~.attributes.HitAttributes`); zeros where the mesh lacks it (UV tangents)."""
+    got = attrs.get(params["name"])
+    return np.zeros((3, len(attrs)), np.float32) if got is None else got
+
+
+def camera_coords(attrs, params, position):
+    """Texture Coordinate > Camera: the position in the camera's frame, x right, y up, +z forward (scene units)."""
+    c2w = np.asarray(params["camera"].cam_to_world, np.float64)
+    w2c = np.linalg.inv(c2w).astype(np.float32)
+    p = np.broadcast_to(f32(position), (3, len(attrs)))
+    c = w2c[:3, :3] @ p + w2c[:3, 3:4]
+    return np.stack([c[0], c[1], -c[2]]).astype(np.float32)
+
+
+def window_coords(attrs, params, position):
+    """Texture Coordinate > Window: the position's place in the full frame, [0, 1]² from the bottom left, z 0."""
+    from ...geometry.camera import project
+    cam = params["camera"]
+    raster, _depth = project(cam, np.broadcast_to(f32(position), (3, len(attrs))))
+    z = np.zeros(len(attrs), np.float32)
+    return np.stack([raster[:, 0] / np.float32(cam.width), raster[:, 1] / np.float32(cam.height), z]).astype(
+        np.float32)
 
 
 def _fresnel_dielectric(cosi, eta):
@@ -307,10 +327,11 @@ def float_curve(attrs, params, fac, value):
 
 
 OPERATIONS = {
-    "attribute": attribute, "fresnel": fresnel, "layer_weight": layer_weight, "mapping": mapping,
+    "attribute": attribute, "camera_coords": camera_coords, "window_coords": window_coords, "fresnel": fresnel, "layer_weight": layer_weight, "mapping": mapping,
     "vector_rotate": vector_rotate, "image": image_texture, "environment": environment_texture, "noise": noise_texture, "white_noise": white_noise,
     "checker": checker, "gradient": gradient, "color_ramp": color_ramp, "rgb_curves": rgb_curves,
     "float_curve": float_curve,
 }
 #: operations that read the hits: never folded into constants at export
-READS_HITS = frozenset({"attribute", "fresnel", "layer_weight", "image", "environment"})
+READS_HITS = frozenset({"attribute", "fresnel", "layer_weight", "image", "environment", "camera_coords",
+                        "window_coords"})
