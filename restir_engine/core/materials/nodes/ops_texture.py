@@ -327,8 +327,9 @@ def float_curve(attrs, params, fac, value):
 
 
 OPERATIONS = {
-    "attribute": attribute, "camera_coords": camera_coords, "window_coords": window_coords, "fresnel": fresnel, "layer_weight": layer_weight, "mapping": mapping,
-    "vector_rotate": vector_rotate, "image": image_texture, "environment": environment_texture, "noise": noise_texture, "white_noise": white_noise,
+    "attribute": attribute, "camera_coords": camera_coords, "window_coords": window_coords, "fresnel": fresnel,
+    "layer_weight": layer_weight, "mapping": mapping, "vector_rotate": vector_rotate, "image": image_texture,
+    "environment": environment_texture, "noise": noise_texture, "white_noise": white_noise,
     "checker": checker, "gradient": gradient, "color_ramp": color_ramp, "rgb_curves": rgb_curves,
     "float_curve": float_curve,
 }
