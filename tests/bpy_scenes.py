@@ -268,7 +268,8 @@ def world_scene(kind="IMAGE", size=(96, 64), rotation_z=0.0):
     """Spheres (diffuse, rough Principled, metal) on a grey floor under the world: an environment image (sky with
     a sun, :func:`sky_image`, its Mapping rotated by ``rotation_z`` radians), a constant colour, a procedural
     gradient sky ("GRADIENT": a Color Ramp over the direction's height, Strength from a Math node) or the sky image
-    multiplied by a colour by a Noise of the direction ("MIXED"); no lamps."""
+    multiplied by a colour by a Noise of the direction ("MIXED") or lighting with the sky image and seen by the
+    camera as a flat colour (Light Path > Is Camera Ray, "CAMERA_RAY"); no lamps."""
     scene = reset()
     plane("Floor", 20, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
     for x, mat in ((-1.2, diffuse("D", (0.8, 0.3, 0.2))), (0.0, principled("P", (0.3, 0.6, 0.8), roughness=0.4)),
@@ -319,6 +320,16 @@ def world_scene(kind="IMAGE", size=(96, 64), rotation_z=0.0):
         tree.links.new(noise.outputs["Fac"], mix.inputs["Factor"])
         tree.links.new(env.outputs["Color"], mix.inputs[6])
         mix.inputs[7].default_value = (1.0, 0.5, 0.2, 1.0)
+        tree.links.new(mix.outputs[2], bg.inputs["Color"])
+    elif kind == "CAMERA_RAY":  # lit by the sky image, seen as a flat grey-blue backdrop (Light Path)
+        env = tree.nodes.new("ShaderNodeTexEnvironment")
+        env.image = sky_image()
+        path = tree.nodes.new("ShaderNodeLightPath")
+        mix = tree.nodes.new("ShaderNodeMix")
+        mix.data_type = "RGBA"
+        tree.links.new(path.outputs["Is Camera Ray"], mix.inputs["Factor"])
+        tree.links.new(env.outputs["Color"], mix.inputs[6])
+        mix.inputs[7].default_value = (0.2, 0.25, 0.35, 1.0)
         tree.links.new(mix.outputs[2], bg.inputs["Color"])
     else:
         bg.inputs["Color"].default_value = (0.4, 0.5, 0.7, 1)

@@ -432,6 +432,17 @@ def group_reroute_mute():
     return graph
 
 
+def light_path(output="Is Camera Ray"):
+    def graph(tree, socket):
+        lp = _node(tree, "ShaderNodeLightPath")
+        mix = _node(tree, "ShaderNodeMix", data_type="RGBA")
+        _link(tree, lp.outputs[output], mix.inputs["Factor"])
+        _in(mix, "A_Color").default_value = (0.9, 0.2, 0.1, 1.0)
+        _in(mix, "B_Color").default_value = (0.1, 0.4, 0.8, 1.0)
+        _link(tree, _out(mix, "Result_Color"), socket)
+    return graph
+
+
 def pass_index(output, value):
     """Object Info's Object / Material Index over 8, the object's / material's Pass Index set to ``value``."""
     def graph(tree, socket):
@@ -467,6 +478,7 @@ INPUTS = [
     ("camera", coords("Camera", scale=0.2)), ("window", coords("Window")),
     ("tangent tilted", geometry("Tangent", 0.6)),
     ("object index", pass_index("Object Index", 3)), ("material index", pass_index("Material Index", 5)),
+    ("light path camera", light_path()),
 ]
 
 def _vabs(tree, out):

@@ -337,4 +337,5 @@ class Scene:
     warnings: list = field(default_factory=list)
     world_image: np.ndarray | None = None     # (h, w, 3) equirectangular radiance (then world_radiance is unused)
     world_rotation: np.ndarray | None = None  # (3, 3) world -> environment texture frame (core/lights/world.py)
+    world_camera_view: tuple | None = None    # (radiance (3,), image or None) camera rays see instead, or None
     motion: Motion | None = None

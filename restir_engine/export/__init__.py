@@ -71,9 +71,10 @@ def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warn
     """The lamps, the world and the material table (after the geometry registered its materials in
     ``registry``) around ``geometry``."""
     lamps = export_lamps(depsgraph, registry, warnings)
-    world, world_image, world_rotation = export_world(depsgraph.scene, warnings)
+    world, world_image, world_rotation, camera_view = export_world(depsgraph.scene, warnings)
     world = clamped_radiance(world, "World", warnings).astype(np.float32)
     if world_image is not None:
         world_image = clamped_radiance(world_image, "World texture", warnings).astype(np.float32)
     return Scene(geometry=geometry, materials=registry.table(), lamps=lamps, camera=camera,
-                 world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings)
+                 world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings,
+                 world_camera_view=camera_view)

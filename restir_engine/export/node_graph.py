@@ -241,6 +241,21 @@ def _tangent(g, node, f):
     return {"Tangent": g.attribute("tangent", "vector")}
 
 
+def _light_path(g, node, f):
+    linked = [o.name for o in node.outputs if o.is_linked and o.name not in ("Is Camera Ray", "Ray Length")]
+    if linked:
+        g.warn(f"'{node.name}' (Light Path): {', '.join(linked)} approximated (camera hits read as a camera ray, "
+               "other hits as a reflection of depth 1)")
+    camera = g.attribute("is_camera_ray", "float")
+    one_minus = g.emit("one_minus", {}, [camera], ("float",))[0]
+    zero = g.constant(0.0, "float")
+    return {"Is Camera Ray": camera, "Is Shadow Ray": zero, "Is Diffuse Ray": one_minus, "Is Glossy Ray": zero,
+            "Is Singular Ray": zero, "Is Reflection Ray": one_minus, "Is Transmission Ray": zero,
+            "Is Volume Scatter Ray": zero, "Ray Length": g.attribute("ray_length", "float"),
+            "Ray Depth": one_minus, "Diffuse Depth": one_minus, "Glossy Depth": zero, "Transparent Depth": zero,
+            "Transmission Depth": zero, "Portal Depth": zero}
+
+
 def _uvmap(g, node, f):
     if node.uv_map:
         g.warn(f"'{node.name}' names UV map '{node.uv_map}'; the render UV map is used")
@@ -589,7 +604,7 @@ def _light_falloff(g, node, f):
 
 
 _HANDLERS = {
-    "TEX_COORD": _texcoord, "TANGENT": _tangent, "UVMAP": _uvmap, "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
+    "TEX_COORD": _texcoord, "TANGENT": _tangent, "LIGHT_PATH": _light_path, "UVMAP": _uvmap, "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
     "VERTEX_COLOR": _color_attribute, "ATTRIBUTE": _attribute, "FRESNEL": _fresnel, "LAYER_WEIGHT": _layer_weight,
     "VALUE": _value, "RGB": _rgb, "MAPPING": _mapping, "VECTOR_ROTATE": _vector_rotate, "MATH": _math,
     "VECT_MATH": _vector_math, "MIX": _mix, "MIX_RGB": _mix_rgb, "MAP_RANGE": _map_range, "CLAMP": _clamp,

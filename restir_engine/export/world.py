@@ -22,7 +22,13 @@ _BAKE_CHUNK = 1 << 18
 
 
 def export_world(scene, warnings: list):
-    """(constant radiance (3,), image (h, w, 3) radiance or None, rotation world -> texture (3, 3) or None)."""
+    """(constant radiance (3,), image (h, w, 3) radiance or None, rotation world -> texture (3, 3) or None, what
+    camera rays see instead: (radiance, image) or None)."""
+    got = _export_world(scene, warnings)
+    return got if len(got) == 4 else (*got, None)
+
+
+def _export_world(scene, warnings: list):
     world = scene.world
     none = (np.zeros(3, np.float32), None, None)
     if world is None:
@@ -72,8 +78,16 @@ def _baked(world, registry, color_in, strength_in, warnings: list):
     warnings.extend(f"World '{world.name}': {n}" for n in dict.fromkeys(notes))
     if color.const is not None and strength.const is not None:
         c = np.asarray(color.constant_value(), np.float32) * np.float32(strength.constant_value())
-        return c.astype(np.float32), None, None
+        return c.astype(np.float32), None, None, None
     program = g.program({"color": color, "strength": strength})
+    camera_view = None
+    if "is_camera_ray" in program.reads:  # Light Path > Is Camera Ray: what the camera sees, baked apart
+        camera_view = (np.zeros(3, np.float32), _bake(program, color, strength, registry, True))
+    return (np.zeros(3, np.float32), _bake(program, color, strength, registry, False), None, camera_view)
+
+
+def _bake(program, color, strength, registry, camera_ray: bool) -> np.ndarray:
+    """The world graph's Color x Strength over the directions of an equirectangular image (h, w, 3)."""
     sizes = [t.shape[1] for t in registry.textures]
     w = int(min(MAX_BAKE_WIDTH, max([BAKE_WIDTH] + sizes)))
     h = max(1, w // 2)
@@ -85,11 +99,11 @@ def _baked(world, registry, color_in, strength_in, warnings: list):
     image = np.empty((h * w, 3), np.float32)
     for lo in range(0, h * w, _BAKE_CHUNK):
         hi = min(lo + _BAKE_CHUNK, h * w)
-        out = program.run(DirectionAttributes(dirs[:, lo:hi], registry.textures))
+        out = program.run(DirectionAttributes(dirs[:, lo:hi], registry.textures, camera_ray))
         c = out["color"] if "color" in out else np.asarray(color.const, np.float32).reshape(3, 1)
         s = out["strength"] if "strength" in out else np.float32(strength.const)
         image[lo:hi] = np.broadcast_to(c * s, (3, hi - lo)).T
-    return np.zeros(3, np.float32), np.where(np.isfinite(image), image, 0).reshape(h, w, 3), None
+    return np.where(np.isfinite(image), image, 0).reshape(h, w, 3)
 
 
 def _euler_xyz(rx: float, ry: float, rz: float) -> np.ndarray:

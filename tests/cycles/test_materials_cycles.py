@@ -128,10 +128,11 @@ def test_world_light_matches_cycles(addon, kind, bounces):
     assert_cells_match(*cells, [f"cell {k}" for k in range(16)], power=[4, 5, 6] + list(range(8, 16)))
 
 
-@pytest.mark.parametrize("kind", ["GRADIENT", "MIXED"])
+@pytest.mark.parametrize("kind", ["GRADIENT", "MIXED", "CAMERA_RAY"])
 def test_world_node_graphs_match_cycles(addon, kind):
     """A world whose Background is a node graph of the direction (a Color Ramp sky with a Math strength; the sky
-    image multiplied by a colour through a Noise), evaluated over an equirectangular image at export
+    image multiplied by a colour through a Noise; the image lighting the scene behind a flat backdrop for camera
+    rays, by Light Path > Is Camera Ray), evaluated over an equirectangular image at export
     (export/world.py), seen and lighting the spheres, 1 bounce: per 4 x 4 image cell, every cell able to see a 3 %
     error where it is not dark."""
     from bpy_scenes import world_scene

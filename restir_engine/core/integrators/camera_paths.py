@@ -60,7 +60,8 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
             hits.prim[idx], hits.t[idx], hits.u[idx], hits.v[idx] = sub.prim, sub.t, sub.u, sub.v
     emitted, alpha = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
     rows = np.flatnonzero(hits.prim >= 0)
-    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows])
+    surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows],
+                   camera=True)
     held = holdout_hits(ctx, surf)
     if held is not None:  # the pixel is transparent and black there
         alpha[rows[held]] = 0.0
@@ -118,13 +119,13 @@ def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: n
         alpha[miss] = 0.0
     elif miss.any():
         m = np.flatnonzero(miss)
-        emitted[:, m] += ctx.world.radiance(cols(d, m))
+        emitted[:, m] += ctx.world.radiance(cols(d, m), camera=camera)
     if ctx.lights.n_geom:  # emissive surfaces (mesh emission is two-sided by default)
         prim = np.maximum(hits.prim, 0)
         em = np.flatnonzero((hits.prim >= 0) & (ctx.lights.geom_to_light[prim] >= 0))
         if em.size:
             emitted[:, em] += emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em],
-                                               hits.v[em], -cols(d, em) if ctx.has_programs else None)
+                                               hits.v[em], -cols(d, em) if ctx.has_programs else None, camera)
     if tmax is not None and camera:  # frame points off a panorama's image (beyond a fisheye's circle): black
         dead = tmax < 0
         if dead.any():

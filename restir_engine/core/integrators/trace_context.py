@@ -120,7 +120,8 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     cut = Cutout.of(geom, scene.materials)
     geom_accel = accels["geom"].with_cutout(cut, geom_ng_rows if cut else None) if "geom" in accels else \
         Accel(geom.verts, cut, geom_ng_rows if cut else None)
-    world = World(scene.world_radiance, getattr(scene, "world_image", None), getattr(scene, "world_rotation", None))
+    world = World(scene.world_radiance, getattr(scene, "world_image", None), getattr(scene, "world_rotation", None),
+                  getattr(scene, "world_camera_view", None))
     lights = LightTable(scene, max(radius, 1e-3))
     if world.sampled:  # the world's points may enter ReSTIR DI reservoirs (di.CandidateSettings.world_candidates)
         lights.attach_world(WorldSphere(world, (lo + hi) / 2, max(radius, 1e-3)))

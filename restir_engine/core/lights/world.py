@@ -3,7 +3,8 @@ sampling for next-event estimation (solid-angle pdfs, MIS against BSDF sampling 
 
 Radiance is W·sr⁻¹·m⁻², scene-linear. Image convention (Cycles' equirectangular mapping): for a direction d in the
 texture's frame, u = 1/2 - atan2(d_y, d_x)/(2π), v = 1 - acos(d_z)/π; the image's row 0 is its bottom (v = 0,
-straight down). ``rotation`` maps world directions into the texture's frame (a Mapping node's rotation).
+straight down). ``rotation`` maps world directions into the texture's frame (a Mapping node's rotation). ``camera_view`` (colour,
+image): what camera rays see where that differs from the light (a world graph reading Light Path > Is Camera Ray).
 Sampling an image picks a texel with probability ∝ its luminance times sin θ (one cumulative table over the texels),
 then a uniform point in it: pdf_ω = p(texel) · w h / (2π² sin θ), θ the direction's own polar angle. The luminance is taken
 as the largest of each texel and its 8 neighbours, so bilinear lookups never light a direction of pdf 0. A constant
@@ -25,7 +26,11 @@ class World:
     """``color`` (3,) constant radiance (used when ``image`` is None), ``image`` (h, w, 3) radiance (strength
     applied) or None, ``rotation`` (3, 3) world -> texture frame or None."""
 
-    def __init__(self, color, image: np.ndarray | None = None, rotation: np.ndarray | None = None):
+    def __init__(self, color, image: np.ndarray | None = None, rotation: np.ndarray | None = None,
+                 camera_view: tuple | None = None):
+        self.camera_view = None  # what camera rays see instead (Light Path > Is Camera Ray): a World, or None
+        if camera_view is not None:
+            self.camera_view = World(camera_view[0], camera_view[1], rotation)
         self.color = np.asarray(color, np.float32).reshape(3)
         self.image = None if image is None else np.ascontiguousarray(image, np.float32)
         self.rotation = None if rotation is None else np.asarray(rotation, np.float32)
@@ -62,8 +67,11 @@ class World:
         v = 1.0 - np.arccos(z) / np.pi
         return np.mod(u, 1.0), np.clip(v, 0.0, 1.0)
 
-    def radiance(self, d: np.ndarray) -> np.ndarray:
-        """Radiance (3, n) arriving from directions d (3, n) (need not be unit)."""
+    def radiance(self, d: np.ndarray, camera: bool = False) -> np.ndarray:
+        """Radiance (3, n) arriving from directions d (3, n) (need not be unit); ``camera``: as camera rays see it
+        (a world whose graph reads Light Path > Is Camera Ray)."""
+        if camera and self.camera_view is not None:
+            return self.camera_view.radiance(d)
         n = d.shape[1]
         if self.image is None:
             return np.broadcast_to(self.color[:, None], (3, n)).astype(np.float32)

@@ -42,8 +42,10 @@ class Surface:
     """Hits of rays o + t·d on scene triangles ``prim`` at barycentrics (u, v): p, ng, ns (facing the ray),
     wo, the tangent frame (t, bt), wo_l, material index and BSDF params (textures applied)."""
 
-    def __init__(self, ctx, prim, u, v, o, d, t):
+    def __init__(self, ctx, prim, u, v, o, d, t, camera: bool = False):
         geom = ctx.scene.geometry
+        self.camera = camera  # hits of camera rays (Light Path > Is Camera Ray in node programs)
+        self._t = t
         prim = prim.astype(np.intp)  # one index conversion for every gather below
         self.prim = prim
         self.b1, self.b2 = u, v
@@ -92,7 +94,8 @@ class Surface:
         uv = self._uv(geom, mixed) if geom.uvs is not None else None
         def attrs_of(rows):  # the mixed hits ``rows`` (indices into ``mixed``), for weights from node programs
             r = mixed[rows]
-            return HitAttributes(geom, prim[r], u[r], v[r], mats.textures, wo=-cols(d, r))
+            return HitAttributes(geom, prim[r], u[r], v[r], mats.textures, wo=-cols(d, r), camera_ray=self.camera,
+                                 ray_length=np.asarray(self._t, np.float32)[r])
         comp, w = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv, attrs_of)
         mat = mat.copy()
         mat[mixed] = comp
@@ -155,7 +158,8 @@ class Surface:
         for rows, out in run_programs(mats, mat, lambda r: HitAttributes(
                 geom, self.prim[r], self.b1[r], self.b2[r], mats.textures, wo=-cols(d, r),
                 normal=cols(ns, r) * facing[r], true_normal=cols(ng, r) * facing[r],
-                footprint=spread[0] + spread[1] * np.asarray(t, np.float32)[r]), ("normal",)):
+                footprint=spread[0] + spread[1] * np.asarray(t, np.float32)[r], camera_ray=self.camera,
+                ray_length=np.asarray(t, np.float32)[r]), ("normal",)):
             if "normal" in out:
                 rows_all.append(rows)
                 normals.append(out["normal"] * facing[rows])
@@ -187,7 +191,8 @@ class Surface:
         varying = []
         for rows, out in run_programs(mats, mat, lambda r: HitAttributes(
                 geom, self.prim[r], self.b1[r], self.b2[r], mats.textures, wo=cols(self.wo, r),
-                normal=cols(self.ns, r), true_normal=cols(self.ng, r)), PARAM_FIELDS):
+                normal=cols(self.ns, r), true_normal=cols(self.ng, r), camera_ray=self.camera,
+                ray_length=np.asarray(self._t, np.float32)[r]), PARAM_FIELDS):
             if not out:
                 continue
             tm = mat[rows]

@@ -21,7 +21,8 @@ class HitAttributes:
     (3, n) towards the viewer, ``normal`` and ``true_normal`` (3, n) facing it, when the caller has them;
     ``textures``: the material table's images."""
 
-    def __init__(self, tris, prim, b1, b2, textures, wo=None, normal=None, true_normal=None, footprint=None):
+    def __init__(self, tris, prim, b1, b2, textures, wo=None, normal=None, true_normal=None, footprint=None,
+                 camera_ray: bool = False, ray_length=None):
         self.tris, self.prim = tris, np.asarray(prim, np.intp)
         self.b1, self.b2 = np.asarray(b1, np.float32), np.asarray(b2, np.float32)
         self.textures = textures
@@ -34,6 +35,10 @@ class HitAttributes:
             self._cache["true_normal"] = true_normal
         self._wo = wo
         self._given = {"normal": normal, "true_normal": true_normal, "footprint": footprint}
+        self.camera_ray = bool(camera_ray)
+        self._cache["is_camera_ray"] = np.full(len(self.prim), _F(1.0 if camera_ray else 0.0), np.float32)
+        if ray_length is not None:
+            self._cache["ray_length"] = np.broadcast_to(np.asarray(ray_length, np.float32), self.b1.shape)
         if footprint is not None:
             self._cache["footprint"] = np.broadcast_to(np.asarray(footprint, np.float32), self.b1.shape)
 
@@ -49,7 +54,8 @@ class HitAttributes:
         db1, db2 = (g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det
         return HitAttributes(self.tris, self.prim, self.b1 + db1, self.b2 + db2, self.textures, wo=self._wo,
                              normal=self.get("normal"), true_normal=self.get("true_normal"),
-                             footprint=self.get("footprint"))
+                             footprint=self.get("footprint"), camera_ray=self.camera_ray,
+                             ray_length=self._cache.get("ray_length"))
 
     def object_normal_to_world(self, n) -> np.ndarray:
         """Object-space normals (3, n) in world space (the inverse transpose of each instance's matrix)."""
@@ -174,6 +180,8 @@ class HitAttributes:
             t = np.cross(d.T, nn.T).T
             t = np.cross(nn.T, t.T).T
             return (t / np.maximum(norm(t), _F(1e-30))).astype(np.float32)
+        if name == "ray_length":
+            return np.zeros(n, np.float32)
         if name == "object_index":
             inst, objs = self._instances()
             idx = None if inst is None else getattr(objs, "pass_index", None)
@@ -193,9 +201,10 @@ class DirectionAttributes:
     from the scene), as Cycles gives a world shader: the direction as position and texture coordinates
     (Generated, Object), the opposite one as the normal and the incoming view; no surface (UV 0, not backfacing)."""
 
-    def __init__(self, dirs, textures):
+    def __init__(self, dirs, textures, camera_ray: bool = False):
         self.dirs = np.ascontiguousarray(dirs, np.float32)
         self.textures = textures
+        self.camera_ray = camera_ray
 
     def __len__(self) -> int:
         return self.dirs.shape[1]
@@ -212,6 +221,10 @@ class DirectionAttributes:
             return np.zeros((3, n), np.float32)
         if name == "footprint":
             return np.full(n, _F(1e-3), np.float32)
+        if name == "is_camera_ray":
+            return np.full(n, _F(1.0 if self.camera_ray else 0.0), np.float32)
+        if name == "ray_length":
+            return np.full(n, _F(3.4e38), np.float32)
         if name in {"tangent_uv", "tangent_sign"}:
             return None
         return np.zeros(n, np.float32)  # backfacing, object alpha / random, attribute alphas
