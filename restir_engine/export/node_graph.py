@@ -604,7 +604,8 @@ def _light_falloff(g, node, f):
 
 
 _HANDLERS = {
-    "TEX_COORD": _texcoord, "TANGENT": _tangent, "LIGHT_PATH": _light_path, "UVMAP": _uvmap, "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
+    "TEX_COORD": _texcoord, "TANGENT": _tangent, "LIGHT_PATH": _light_path, "UVMAP": _uvmap,
+    "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
     "VERTEX_COLOR": _color_attribute, "ATTRIBUTE": _attribute, "FRESNEL": _fresnel, "LAYER_WEIGHT": _layer_weight,
     "VALUE": _value, "RGB": _rgb, "MAPPING": _mapping, "VECTOR_ROTATE": _vector_rotate, "MATH": _math,
     "VECT_MATH": _vector_math, "MIX": _mix, "MIX_RGB": _mix_rgb, "MAP_RANGE": _map_range, "CLAMP": _clamp,

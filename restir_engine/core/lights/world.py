@@ -3,8 +3,9 @@ sampling for next-event estimation (solid-angle pdfs, MIS against BSDF sampling 
 
 Radiance is W·sr⁻¹·m⁻², scene-linear. Image convention (Cycles' equirectangular mapping): for a direction d in the
 texture's frame, u = 1/2 - atan2(d_y, d_x)/(2π), v = 1 - acos(d_z)/π; the image's row 0 is its bottom (v = 0,
-straight down). ``rotation`` maps world directions into the texture's frame (a Mapping node's rotation). ``camera_view`` (colour,
-image): what camera rays see where that differs from the light (a world graph reading Light Path > Is Camera Ray).
+straight down). ``rotation`` maps world directions into the texture's frame (a Mapping node's rotation).
+``camera_view`` (colour, image): what camera rays see where that differs from the light (a world graph reading
+Light Path > Is Camera Ray).
 Sampling an image picks a texel with probability ∝ its luminance times sin θ (one cumulative table over the texels),
 then a uniform point in it: pdf_ω = p(texel) · w h / (2π² sin θ), θ the direction's own polar angle. The luminance is taken
 as the largest of each texel and its 8 neighbours, so bilinear lookups never light a direction of pdf 0. A constant
