@@ -16,6 +16,8 @@ from .own_rays import camera_ray_sets
 KINDS = ("object", "material", "asset")
 PASS_PREFIX = {"object": "CryptoObject", "material": "CryptoMaterial", "asset": "CryptoAsset"}
 STREAM_CRYPTO = 12
+#: pixels whose rays are ranked at once (k rays x this many int32 hit indices in memory)
+BLOCK_PIXELS = 1 << 16
 
 
 def murmur3_32(data: bytes, seed: int = 0) -> int:
@@ -82,17 +84,25 @@ def render_cryptomatte(ctx, kinds, depth: int, samples: int, seed: int = 0, fram
     cam = ctx.scene.camera
     _x0, _y0, w, h = cam.window
     n_pix, k = w * h, max(1, int(samples))
-    prims = np.empty((k, n_pix), np.int64)
-    for s, (o, d, tmax) in enumerate(camera_ray_sets(cam, k, seed, frame, STREAM_CRYPTO)):
-        prims[s] = ctx.geom_accel.intersect(o, d, tmax).prim
-    out, manifests = {}, {}
     ranks = max(1, int(depth))
+    tables = {kind: names_of(ctx.scene, kind) for kind in kinds}
+    tops = {kind: (np.full((n_pix, ranks), -1, np.int64), np.zeros((n_pix, ranks), np.float32)) for kind in kinds}
+    for lo in range(0, n_pix, BLOCK_PIXELS):
+        block = np.arange(lo, min(lo + BLOCK_PIXELS, n_pix))
+        prims = np.empty((k, len(block)), np.int32)
+        for s, (o, d, tmax) in enumerate(camera_ray_sets(cam, k, seed, frame, STREAM_CRYPTO, block)):
+            prims[s] = ctx.geom_accel.intersect(o, d, tmax).prim
+        for kind in kinds:
+            names, tri_name = tables[kind]
+            ids = np.where(prims >= 0, tri_name[np.maximum(prims, 0)], -1)  # (k, block pixels)
+            top_id, top_w = _ranked(ids, len(names), len(block), ranks, k)
+            tops[kind][0][block], tops[kind][1][block] = top_id, top_w
+    out, manifests = {}, {}
     for kind in kinds:
-        names, tri_name = names_of(ctx.scene, kind)
+        names, tri_name = tables[kind]
         used = np.unique(tri_name[tri_name >= 0])  # names on the geometry (not the lamps' own material rows)
         manifests[kind] = {names[i]: f"{name_hash(names[i]):08x}" for i in used}
-        ids = np.where(prims >= 0, tri_name[np.maximum(prims, 0)], -1)  # (k, pixels)
-        top_id, top_w = _ranked(ids, len(names), n_pix, ranks, k)
+        top_id, top_w = tops[kind]
         floats = np.array([hash_float(name_hash(nm)) for nm in names] + [0.0], np.float32)
         id_f = floats[np.where(top_id >= 0, top_id, len(names))]
         for p in range((ranks + 1) // 2):

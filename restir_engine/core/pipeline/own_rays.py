@@ -9,15 +9,21 @@ from ..geometry import camera as camera_mod
 from ..sampling import STREAM_LENS, STREAM_PIXEL_OFFSET, pass_jitter, rng
 
 
-def camera_ray_sets(cam, k: int, seed: int, frame: int, salt: int):
-    """Yields k times (origins (3, n), directions (3, n), tmax (n,)) for the window's n pixels in row-major order;
-    ``salt`` keys the streams (one per pass kind)."""
+def camera_ray_sets(cam, k: int, seed: int, frame: int, salt: int, pixels: np.ndarray | None = None):
+    """Yields k times (origins (3, n), directions (3, n), tmax (n,)) for the window's pixels in row-major order, or
+    for the window pixels ``pixels`` (the same rays as for the whole window); ``salt`` keys the streams (one per
+    pass kind)."""
     x0, y0, w, h = cam.window
-    n = w * h
-    pix = np.arange(n)
-    shift = rng(seed, frame, 0, STREAM_PIXEL_OFFSET + salt).bit_generator.random_raw(n).view(np.uint32).reshape(-1, 2)
+    shift = rng(seed, frame, 0, STREAM_PIXEL_OFFSET + salt).bit_generator.random_raw(w * h).view(np.uint32)
+    shift = shift.reshape(-1, 2)
+    pix = np.arange(w * h) if pixels is None else np.asarray(pixels, np.int64)
+    if pixels is not None:
+        shift = shift[pix]
+    n = len(pix)
     land = camera_mod.filter_offsets(cam)
-    lens = rng(seed, frame, 0, STREAM_LENS + salt) if camera_mod.has_lens(cam) else None
+    lens = None
+    if camera_mod.has_lens(cam):  # one stream per block of pixels: the same aperture samples however they are cut
+        lens = rng(seed, frame, 0, STREAM_LENS + salt, int(pix[0]) if n else 0)
     for s in range(max(1, int(k))):
         j = pass_jitter(shift, s)
         x = (x0 + pix % w).astype(np.float32) + land(j[:, 0])
