@@ -197,18 +197,18 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):
             self.report({"WARNING"}, msg)
         stamps = {}
-        kinds = pass_table.cryptomatte_kinds(view_layer)
-        if kinds and not result.cancelled:
-            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Cryptomatte")
-            stamps = self._cryptomatte(depsgraph, core_scene, settings, view_layer, kinds, result.passes)
-        aovs = pass_table.shader_aovs(view_layer)
-        if aovs and not result.cancelled:
+        kinds, aovs = pass_table.cryptomatte_kinds(view_layer), pass_table.shader_aovs(view_layer)
+        if (kinds or aovs) and not result.cancelled:
             from .core.integrators.trace_context import build_context
             from .core.pipeline.aovs import render_aovs
-            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Shader AOVs")
-            images = render_aovs(build_context(core_scene, 0), aovs, min(max(int(settings.samples), 16), 64),
-                                 settings.seed, settings.frame)
-            result.passes.update({f"AOV {name}": img for name, img in images.items()})
+            ctx = build_context(core_scene, 0)  # the first hits these passes trace (their own camera rays)
+            rays = min(max(int(settings.samples), 16), 64)  # rays per pixel
+            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Cryptomatte and Shader AOVs")
+            if kinds:
+                stamps = self._cryptomatte(ctx, depsgraph, settings, view_layer, kinds, rays, result.passes)
+            if aovs:
+                images = render_aovs(ctx, aovs, rays, settings.seed, settings.frame)
+                result.passes.update({f"AOV {name}": img for name, img in images.items()})
         self._write(result.passes, core_scene.camera.window, scene, view_layer, stamps)
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
                                                                   "world_method", "world_reason",
@@ -350,19 +350,16 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.update_stats("ReSTIR", session.stats.text())
 
     @staticmethod
-    def _cryptomatte(depsgraph, core_scene, settings, view_layer, kinds, passes: dict) -> dict:
+    def _cryptomatte(ctx, depsgraph, settings, view_layer, kinds, rays: int, passes: dict) -> dict:
         """Adds the Cryptomatte passes to ``passes``; returns their metadata fields (the manifests name the lights
         too, as Cycles')."""
-        from .core.integrators.trace_context import build_context
         from .core.pipeline import cryptomatte
-        ctx = build_context(core_scene, 0)
-        rays = min(max(int(settings.samples), 16), 64)  # rays per pixel for the coverages
         images, manifests = cryptomatte.render_cryptomatte(ctx, kinds, int(view_layer.pass_cryptomatte_depth), rays,
                                                            settings.seed, settings.frame)
         passes.update(images)
-        from .export.meshes import _asset_name
+        from .export.meshes import asset_name
         lights = [inst.object for inst in depsgraph.object_instances if inst.object.type == "LIGHT"]
-        extra = {"object": [o.name for o in lights], "asset": [_asset_name(o) for o in lights]}
+        extra = {"object": [o.name for o in lights], "asset": [asset_name(o) for o in lights]}
         stamps = {}
         for kind in kinds:
             manifest = {**{n: f"{cryptomatte.name_hash(n):08x}" for n in extra.get(kind, ())}, **manifests[kind]}

@@ -22,6 +22,9 @@ STREAM_LENS = 11  # aperture samples of camera rays (depth of field)
 STREAM_PROBE = 10  # the AUTO indirect method's measurement of a frame without one (renderer.FrameRenderer._probe)
 STREAM_SPATIAL = 16  # + spatial pass index
 STREAM_GI_SPATIAL = 48  # + spatial pass index
+# passes with camera rays of their own (pipeline/own_rays.py): (per-pixel shift, aperture) streams
+STREAM_CRYPTO_RAYS = (96, 97)
+STREAM_AOV_RAYS = (98, 99)
 
 
 def _sobol_2d(s: int) -> tuple[int, int]:

@@ -221,7 +221,7 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
         if arrays is None:
             continue
         blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name,
-                       instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, _asset_name(obj),
+                       instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, asset_name(obj),
                                                          bool(getattr(obj, "is_holdout", False)),
                                                          float(getattr(obj, "pass_index", 0)))))
 
@@ -316,7 +316,7 @@ def _object_table(blocks) -> ObjectTable:
                        pass_index=np.array([b[5][5] for b in blocks], np.float32))
 
 
-def _asset_name(obj) -> str:
+def asset_name(obj) -> str:
     """The name of an object's top-most parent (itself without one): Cryptomatte's asset."""
     while obj.parent is not None:
         obj = obj.parent

@@ -8,11 +8,10 @@ up to MAX_BAKE_WIDTH), which the world light then samples. Nodes the evaluator d
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..compat import uses_nodes
+from ..core.materials.nodes.ops_texture import euler_matrix
 from .materials import MaterialRegistry
 from .node_graph import GraphCompiler
 
@@ -48,26 +47,13 @@ def _export_world(scene, warnings: list):
     registry = MaterialRegistry(warnings)
     if color_in.is_linked and not strength_in.is_linked:
         src = color_in.links[0].from_node
-        if src.type == "TEX_ENVIRONMENT" and src.image is not None and src.projection == "EQUIRECTANGULAR" and \
-                _plain_mapping(src):
-            strength = float(strength_in.default_value)
-            image = registry.textures[registry._texture(world, src.image)] * np.float32(strength)
-            return np.zeros(3, np.float32), np.asarray(image, np.float32), _rotation(world, src, warnings)
+        if src.type == "TEX_ENVIRONMENT" and src.image is not None and src.projection == "EQUIRECTANGULAR":
+            plain, rotation = _plain_rotation(world, src, warnings)
+            if plain:
+                strength = float(strength_in.default_value)
+                image = registry.textures[registry._texture(world, src.image)] * np.float32(strength)
+                return np.zeros(3, np.float32), np.asarray(image, np.float32), rotation
     return _baked(world, registry, color_in, strength_in, warnings)
-
-
-def _plain_mapping(env) -> bool:
-    """Whether an Environment Texture's Vector is unlinked or a Mapping (unlinked inputs) of a Texture Coordinate."""
-    vec = env.inputs["Vector"]
-    if not vec.is_linked:
-        return True
-    node = vec.links[0].from_node
-    if node.type == "TEX_COORD":
-        return True
-    if node.type != "MAPPING" or any(s.is_linked for s in node.inputs if s.name != "Vector"):
-        return False
-    inner = node.inputs["Vector"]
-    return not inner.is_linked or inner.links[0].from_node.type == "TEX_COORD"
 
 
 def _baked(world, registry, color_in, strength_in, warnings: list):
@@ -106,33 +92,24 @@ def _bake(program, color, strength, registry, camera_ray: bool) -> np.ndarray:
     return np.where(np.isfinite(image), image, 0).reshape(h, w, 3)
 
 
-def _euler_xyz(rx: float, ry: float, rz: float) -> np.ndarray:
-    cx, sx, cy, sy, cz, sz = math.cos(rx), math.sin(rx), math.cos(ry), math.sin(ry), math.cos(rz), math.sin(rz)
-    rot_x = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    rot_y = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    rot_z = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
-    return rot_z @ rot_y @ rot_x
-
-
-def _rotation(world, env, warnings: list):
-    """World -> texture rotation from a Mapping node on the Environment Texture's Vector (None: identity)."""
+def _plain_rotation(world, env, warnings: list):
+    """(whether an Environment Texture's Vector is unlinked, a Texture Coordinate, or a Mapping of one with its
+    other inputs unlinked, the world -> texture rotation of that Mapping or None for the identity)."""
     vec = env.inputs["Vector"]
-    if not vec.is_linked:
-        return None
-    node = vec.links[0].from_node
-    if node.type == "TEX_COORD":
-        return None
-    if node.type != "MAPPING":
-        warnings.append(f"World '{world.name}': '{node.name}' ({node.type}) maps the environment; ignored")
-        return None
+    node = vec.links[0].from_node if vec.is_linked else None
+    if node is None or node.type == "TEX_COORD":
+        return True, None
+    if node.type != "MAPPING" or any(s.is_linked for s in node.inputs if s.name != "Vector"):
+        return False, None
+    inner = node.inputs["Vector"]
+    if inner.is_linked and inner.links[0].from_node.type != "TEX_COORD":
+        return False, None
     inp = node.inputs
-    if any(s.is_linked for s in inp if s.name in ("Rotation", "Scale", "Location")):
-        warnings.append(f"World '{world.name}': a linked Mapping input is approximated by its value")
-    rot = _euler_xyz(*[float(a) for a in inp["Rotation"].default_value])
+    rot = np.array(euler_matrix(np.array(inp["Rotation"].default_value[:], np.float32)), np.float64).reshape(3, 3)
     if "Scale" in inp and not np.allclose(inp["Scale"].default_value[:], 1.0):
         warnings.append(f"World '{world.name}': the Mapping node's Scale is ignored (rotation only)")
     if node.vector_type == "TEXTURE":
         rot = rot.T
     elif node.vector_type not in ("POINT", "VECTOR"):
         warnings.append(f"World '{world.name}': Mapping type {node.vector_type} approximated as Point")
-    return rot.astype(np.float32)
+    return True, rot.astype(np.float32)

@@ -54,16 +54,13 @@ def test_node_programs_render_the_same_in_worker_processes(addon):
     """Programs travel to the workers with the scene (ramp tables, images, hashes): the same image, bit for bit."""
     from node_graphs import MIXES, NOISE, TEXTURES
 
-    from restir_engine.core.parallel import processes
-    from restir_engine.core.renderer import RenderSettings, render_frame
+    from process_runs import one_and_two_processes
+
+    from restir_engine.core.renderer import RenderSettings
     node_planes([g for _n, g in NOISE[:3] + TEXTURES[-4:] + MIXES[:1]], 4, 16)
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     settings = RenderSettings(integrator="RESTIR", direct_method="RESTIR", samples=2, max_bounces=1, tile_pixels=512)
-    try:
-        one = render_frame(sc, settings, processes=1)
-        two = render_frame(sc, settings, processes=2)
-    finally:
-        processes.shutdown()
+    one, two = one_and_two_processes(sc, settings)
     assert two.stats["processes"] == 2
     assert one.passes["Combined"][..., :3].mean() > 0.05
     assert np.array_equal(one.passes["Combined"], two.passes["Combined"])

@@ -59,9 +59,9 @@ def test_cameras_render_the_same_in_worker_processes(addon, kind):
     """A panorama, and depth of field under a Blackman-Harris filter, travel to the workers with the scene: the
     same image from 1 and 2 processes, bit for bit (ReSTIR DI with reuse, 2 samples)."""
     import bpy
+    from process_runs import one_and_two_processes
 
-    from restir_engine.core.parallel import processes
-    from restir_engine.core.renderer import RenderSettings, render_frame
+    from restir_engine.core.renderer import RenderSettings
     from restir_engine.export import export_scene
     scene = panorama_scene(kind if kind != "DOF" else "EQUIRECTANGULAR", SIZE)
     if kind == "DOF":
@@ -72,10 +72,6 @@ def test_cameras_render_the_same_in_worker_processes(addon, kind):
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     assert (sc.camera.panorama is not None) == (kind != "DOF") and (sc.camera.lens is not None) == (kind == "DOF")
     settings = RenderSettings(integrator="RESTIR", direct_method="RESTIR", samples=2, max_bounces=1, tile_pixels=512)
-    try:
-        one = render_frame(sc, settings, processes=1)
-        two = render_frame(sc, settings, processes=2)
-    finally:
-        processes.shutdown()
+    one, two = one_and_two_processes(sc, settings)
     assert two.stats["processes"] == 2 and one.passes["Combined"][..., :3].mean() > 0.02
     assert np.array_equal(one.passes["Combined"], two.passes["Combined"])

@@ -18,9 +18,14 @@ def filter_offsets(cam: Camera):
 
 
 def has_lens(cam: Camera) -> bool:
-    """Whether a pixel's rays may leave its pinhole cone of a perspective or orthographic projection (a lens for
-    depth of field, a panorama): masks built from projected boxes do not hold then."""
-    return getattr(cam, "lens", None) is not None or getattr(cam, "panorama", None) is not None
+    """Whether the camera's rays leave from an aperture (depth of field): they take aperture samples."""
+    return getattr(cam, "lens", None) is not None
+
+
+def projected_masks_hold(cam: Camera) -> bool:
+    """Whether a pixel's rays stay in the pixel's cone of a perspective or orthographic projection (no lens, no
+    panorama), so that masks built from projected boxes hold."""
+    return getattr(cam, "lens", None) is None and getattr(cam, "panorama", None) is None
 
 
 def _panorama_rays(cam: Camera, pano, x, y):

@@ -76,6 +76,12 @@ class Surface:
         if self._varying is not None:  # α or F0 vary per hit there: their tables at each hit's own (α, μo, F0)
             self._per_hit_tables(self._varying)
 
+    def _attributes(self, ctx, r, wo, **given) -> HitAttributes:
+        """What node programs read at hits ``r`` (indices): the view ``wo`` (3, k) and whatever else is ``given``
+        (normals, footprint), whether they are camera hits, and the ray length."""
+        return HitAttributes(ctx.scene.geometry, self.prim[r], self.b1[r], self.b2[r], ctx.scene.materials.textures,
+                             wo=wo, camera_ray=self.camera, ray_length=np.asarray(self._t, np.float32)[r], **given)
+
     def _uv(self, geom, rows) -> np.ndarray:
         """(k, 2) texture coordinates of the hits ``rows``."""
         c = np.take(geom.uvs, self.prim[rows], axis=0)
@@ -94,8 +100,7 @@ class Surface:
         uv = self._uv(geom, mixed) if geom.uvs is not None else None
         def attrs_of(rows):  # the mixed hits ``rows`` (indices into ``mixed``), for weights from node programs
             r = mixed[rows]
-            return HitAttributes(geom, prim[r], u[r], v[r], mats.textures, wo=-cols(d, r), camera_ray=self.camera,
-                                 ray_length=np.asarray(self._t, np.float32)[r])
+            return self._attributes(ctx, r, -cols(d, r))
         comp, w = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv, attrs_of)
         mat = mat.copy()
         mat[mixed] = comp
@@ -151,15 +156,12 @@ class Surface:
         """(hits, their normals (3, k)) where a node program computes the shading normal (Normal Map, Bump of any
         graph), in the orientation of ``ns`` (the program sees and returns normals facing the ray); None where
         no program does."""
-        mats, geom = ctx.scene.materials, ctx.scene.geometry
         facing = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
         spread = pixel_spread(ctx.scene.camera)
         rows_all, normals = [], []
-        for rows, out in run_programs(mats, mat, lambda r: HitAttributes(
-                geom, self.prim[r], self.b1[r], self.b2[r], mats.textures, wo=-cols(d, r),
-                normal=cols(ns, r) * facing[r], true_normal=cols(ng, r) * facing[r],
-                footprint=spread[0] + spread[1] * np.asarray(t, np.float32)[r], camera_ray=self.camera,
-                ray_length=np.asarray(t, np.float32)[r]), ("normal",)):
+        for rows, out in run_programs(ctx.scene.materials, mat, lambda r: self._attributes(
+                ctx, r, -cols(d, r), normal=cols(ns, r) * facing[r], true_normal=cols(ng, r) * facing[r],
+                footprint=spread[0] + spread[1] * np.asarray(t, np.float32)[r]), ("normal",)):
             if "normal" in out:
                 rows_all.append(rows)
                 normals.append(out["normal"] * facing[rows])
@@ -189,10 +191,8 @@ class Surface:
         (indices) or None."""
         mats, geom = ctx.scene.materials, ctx.scene.geometry
         varying = []
-        for rows, out in run_programs(mats, mat, lambda r: HitAttributes(
-                geom, self.prim[r], self.b1[r], self.b2[r], mats.textures, wo=cols(self.wo, r),
-                normal=cols(self.ns, r), true_normal=cols(self.ng, r), camera_ray=self.camera,
-                ray_length=np.asarray(self._t, np.float32)[r]), PARAM_FIELDS):
+        for rows, out in run_programs(mats, mat, lambda r: self._attributes(
+                ctx, r, cols(self.wo, r), normal=cols(self.ns, r), true_normal=cols(self.ng, r)), PARAM_FIELDS):
             if not out:
                 continue
             tm = mat[rows]

@@ -6,10 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..materials.nodes.attributes import HitAttributes
-from ..sampling import cols
+from ..sampling import STREAM_AOV_RAYS, cols
 from .own_rays import camera_ray_sets
-
-STREAM_AOV = 13
 
 
 def render_aovs(ctx, aovs, samples: int, seed: int = 0, frame: int = 0) -> dict:
@@ -24,7 +22,7 @@ def render_aovs(ctx, aovs, samples: int, seed: int = 0, frame: int = 0) -> dict:
     k = max(1, int(samples))
     if index is not None and (index >= 0).any():
         fields = {name: (f"aov:{name}" if kind == "COLOR" else f"aov_value:{name}") for name, kind in aovs}
-        for o, d, tmax in camera_ray_sets(cam, k, seed, frame, STREAM_AOV):
+        for o, d, tmax in camera_ray_sets(cam, k, seed, frame, STREAM_AOV_RAYS):
             hits = ctx.geom_accel.intersect(o, d, tmax)
             rows = np.flatnonzero(hits.prim >= 0)
             prog = index[geom.material[hits.prim[rows]]]

@@ -48,7 +48,7 @@ def geometry_mask(ctx, camera) -> np.ndarray | None:
     camera.box_pixels); elsewhere it sees only lamps and the world, and is not traced. None when it would mark
     most of the window anyway."""
     derived = ctx.geom_derived
-    if derived is None or derived.boxes is None or camera_mod.has_lens(camera):
+    if derived is None or derived.boxes is None or not camera_mod.projected_masks_hold(camera):
         return None
     mask = camera_mod.box_pixels(camera, *derived.boxes).ravel()
     return None if mask.mean() > GEOMETRY_MASK_MAX else mask
@@ -59,7 +59,7 @@ def lamp_mask(ctx, camera) -> np.ndarray | None:
     triangles and sphere proxies, camera.emitter_pixels); elsewhere lamps are not intersected. None when it would
     mark most of the window anyway."""
     lamps = ctx.scene.lamps
-    if len(lamps.tris) == 0 or camera_mod.has_lens(camera):
+    if len(lamps.tris) == 0 or not camera_mod.projected_masks_hold(camera):
         return None
     vis = lamps.camera_visible
     mask = camera_mod.emitter_pixels(camera, lamps.tris.verts[vis], np.zeros((0, 3)), np.zeros(0)).ravel()
@@ -77,7 +77,7 @@ def _seen_lights(lights, lamps) -> np.ndarray:
 def coverage_pixels(camera, lights, lamps):
     """(h * w,) bool: the pixels near an emitter the camera can see, where the extra coverage rays pay (elsewhere
     the shaded ray's emission alone is the estimate: both unbiased); None (every pixel) from MANY_EMITTERS on."""
-    if lights.n_geom >= MANY_EMITTERS or camera_mod.has_lens(camera):
+    if lights.n_geom >= MANY_EMITTERS or not camera_mod.projected_masks_hold(camera):
         return None
     v = lights.tri_verts
     seen = _seen_lights(lights, lamps)

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..sampling import STREAM_CRYPTO_RAYS
 from .own_rays import camera_ray_sets
 
 KINDS = ("object", "material", "asset")
 PASS_PREFIX = {"object": "CryptoObject", "material": "CryptoMaterial", "asset": "CryptoAsset"}
-STREAM_CRYPTO = 12
 #: pixels whose rays are ranked at once (k rays x this many int32 hit indices in memory)
 BLOCK_PIXELS = 1 << 16
 
@@ -90,7 +90,7 @@ def render_cryptomatte(ctx, kinds, depth: int, samples: int, seed: int = 0, fram
     for lo in range(0, n_pix, BLOCK_PIXELS):
         block = np.arange(lo, min(lo + BLOCK_PIXELS, n_pix))
         prims = np.empty((k, len(block)), np.int32)
-        for s, (o, d, tmax) in enumerate(camera_ray_sets(cam, k, seed, frame, STREAM_CRYPTO, block)):
+        for s, (o, d, tmax) in enumerate(camera_ray_sets(cam, k, seed, frame, STREAM_CRYPTO_RAYS, block)):
             prims[s] = ctx.geom_accel.intersect(o, d, tmax).prim
         for kind in kinds:
             names, tri_name = tables[kind]

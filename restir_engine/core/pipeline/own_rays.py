@@ -6,15 +6,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry import camera as camera_mod
-from ..sampling import STREAM_LENS, STREAM_PIXEL_OFFSET, pass_jitter, rng
+from ..sampling import pass_jitter, rng
 
 
-def camera_ray_sets(cam, k: int, seed: int, frame: int, salt: int, pixels: np.ndarray | None = None):
+def camera_ray_sets(cam, k: int, seed: int, frame: int, streams: tuple, pixels: np.ndarray | None = None):
     """Yields k times (origins (3, n), directions (3, n), tmax (n,)) for the window's pixels in row-major order, or
-    for the window pixels ``pixels`` (the same rays as for the whole window); ``salt`` keys the streams (one per
-    pass kind)."""
+    for the window pixels ``pixels`` (the same rays as for the whole window); ``streams``: the pass kind's
+    (per-pixel shift, aperture) random streams (sampling.STREAM_*_RAYS)."""
     x0, y0, w, h = cam.window
-    shift = rng(seed, frame, 0, STREAM_PIXEL_OFFSET + salt).bit_generator.random_raw(w * h).view(np.uint32)
+    shift = rng(seed, frame, 0, streams[0]).bit_generator.random_raw(w * h).view(np.uint32)
     shift = shift.reshape(-1, 2)
     pix = np.arange(w * h) if pixels is None else np.asarray(pixels, np.int64)
     if pixels is not None:
@@ -22,8 +22,8 @@ def camera_ray_sets(cam, k: int, seed: int, frame: int, salt: int, pixels: np.nd
     n = len(pix)
     land = camera_mod.filter_offsets(cam)
     lens = None
-    if camera_mod.has_lens(cam):  # one stream per block of pixels: the same aperture samples however they are cut
-        lens = rng(seed, frame, 0, STREAM_LENS + salt, int(pix[0]) if n else 0)
+    if camera_mod.has_lens(cam):  # a stream per block of pixels, keyed by its first pixel
+        lens = rng(seed, frame, 0, streams[1], int(pix[0]) if n else 0)
     for s in range(max(1, int(k))):
         j = pass_jitter(shift, s)
         x = (x0 + pix % w).astype(np.float32) + land(j[:, 0])
