@@ -146,6 +146,29 @@ def test_a_worker_dying_in_a_render_ends_the_team_with_one_error_and_nothing_lef
     assert np.array_equal(after.passes["Combined"], render_frame(scene, settings, processes=1).passes["Combined"])
 
 
+@pytest.mark.skipif(not os.path.isdir("/dev/shm"), reason="shared-memory segments are listed in /dev/shm here")
+def test_a_worker_dead_before_a_message_is_sent_gives_the_same_one_error():
+    """A worker killed just before the next pass is sent (its pipe already closed): the send itself fails, and that
+    is the same WorkerFailed, with no process or segment left (it was a BrokenPipeError once, in CI)."""
+    settings = dataclasses.replace(SETTINGS["restir-di-unbiased"], samples=3)
+    scene = regression_room(*SIZE)
+    render_frame(scene, settings, processes=3)
+    team = processes.team(3)
+    names = _segments(team)
+    killed = []
+
+    def kill_before_pass_two(fraction, label):
+        if label.startswith("Sample 2/") and not killed:
+            os.kill(team.procs[1].pid, signal.SIGKILL)
+            team.procs[1].join(5.0)  # dead, and its end of the pipe closed, before the pass is sent
+            killed.append(True)
+
+    with pytest.raises(WorkerFailed, match=r"render worker process 1 \(pid \d+\) ended unexpectedly"):
+        render_frame(scene, settings, progress=kill_before_pass_two, processes=3)
+    assert killed and not any(p.is_alive() for p in team.procs)
+    assert not any(os.path.exists(f"/dev/shm/{n.lstrip('/')}") for n in names)
+
+
 def test_a_worker_that_died_between_renders_is_replaced():
     settings = SETTINGS["path-batched"]
     scene = regression_room(*SIZE)

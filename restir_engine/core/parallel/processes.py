@@ -128,8 +128,13 @@ class WorkerTeam:
         closed)."""
         if self.closed:
             raise WorkerFailed("the render worker processes were shut down")
-        for c in self.conns:
-            c.send(msg)
+        for i, c in enumerate(self.conns):
+            try:
+                c.send(msg)
+            except OSError:  # the worker's end is gone (it died before this message): one clear error
+                failure = self._died(i)
+                self.close(kill=True)
+                raise WorkerFailed(failure) from None
         replies = [None] * self.size
         pending = set(range(self.size))
         stopping, failure = False, None
