@@ -65,6 +65,20 @@ MIX_GRID = [[
     ("ADD", ("E", (1.0, 0.5, 0.2), 0.5, {}), ("P", (0.5, 0.5, 0.5), 0.4, {})),
 ]]
 
+# Principled Coat (one row, leaves as in SPHERE_GRID): a clear coat on red plastic, a tinted coat on white, a
+# lacquered metal, the coat alone on black (IOR 2, rough: the lobe and its energy compensation), a half-weight
+# tinted coat of IOR 1.3 on green, and a coated Principled inside a Mix shader.
+_COAT = {"Coat Weight": 1.0, "Coat Roughness": 0.15}
+COAT_GRID = [[
+    ("P", (0.8, 0.1, 0.1), 0.5, dict(_COAT)),
+    ("P", (0.8, 0.8, 0.8), 0.5, {"Coat Weight": 1.0, "Coat Roughness": 0.3, "Coat Tint": (0.9, 0.4, 0.2, 1.0)}),
+    ("P", (0.9, 0.7, 0.4), 0.4, {"Metallic": 1.0, "Coat Weight": 0.5, "Coat Roughness": 0.1}),
+    ("P", (0.0, 0.0, 0.0), 0.5, {"Coat Weight": 1.0, "Coat Roughness": 0.5, "Coat IOR": 2.0}),
+    ("P", (0.2, 0.7, 0.2), 0.6, {"Coat Weight": 0.5, "Coat IOR": 1.3, "Coat Roughness": 0.2,
+                                 "Coat Tint": (0.5, 0.8, 1.0, 1.0)}),
+    ("MIX", 0.5, ("P", (0.1, 0.2, 0.8), 0.4, dict(_COAT)), ("D", (0.7, 0.7, 0.7), 0.0, {})),
+]]
+
 
 def packed_image(name, rgb: np.ndarray):
     """A Non-Color float image made in memory from ``rgb`` (h, w, 3), row 0 at the bottom, alpha 1, packed."""

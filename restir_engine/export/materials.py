@@ -16,6 +16,7 @@ from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
 from ..core.materials.textures import NearestImage
 from .images import TEXTURES, srgb_bytes_to_linear, unreadable_file
+from .coat import base_albedo, coat_factors, coat_row, coat_set
 from .limits import clamped_radiance
 from .node_graph import GraphCompiler
 
@@ -212,8 +213,11 @@ class MaterialRegistry:
                        "the socket's value")
         return float(socket.default_value)
 
-    def _shader(self, material, node, depth: int) -> dict:
+    def _shader(self, material, node, depth: int, base_only: bool = False) -> dict:
+        """The row of shader ``node``; ``base_only``: a Principled BSDF without its coat (export/coat.py)."""
         t = node.type
+        if t == "BSDF_PRINCIPLED" and not base_only and coat_set(node):
+            return self._mix_program(material, node, depth)
         if t == "BSDF_PRINCIPLED":
             row: dict = {}
             inp = node.inputs
@@ -238,7 +242,7 @@ class MaterialRegistry:
             if "Anisotropic" in inp and (inp["Anisotropic"].is_linked or float(inp["Anisotropic"].default_value) > 0):
                 self._warn(material, "Principled 'Anisotropic' is not supported; rendered isotropic")
             self._emission(material, g, inp["Emission Color"], inp["Emission Strength"], row, varying)
-            for name in ("Coat Weight", "Sheen Weight", "Subsurface Weight"):
+            for name in ("Sheen Weight", "Subsurface Weight"):
                 if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
                     self._warn(material, f"Principled '{name}' is not supported and was ignored")
             if "Transmission Weight" in inp:
@@ -316,9 +320,9 @@ class MaterialRegistry:
         row["emission"] = (0.0, 0.0, 0.0)
 
     @staticmethod
-    def _with_program(row: dict, g: GraphCompiler, varying: dict) -> dict:
-        """The row with its node program (when some field varies)."""
-        prog = g.program(varying)
+    def _with_program(row: dict, g: GraphCompiler, varying: dict, keep=()) -> dict:
+        """The row with its node program (when some field varies; the fields in ``keep`` count as varying)."""
+        prog = g.program(varying, keep=keep)
         if prog is not None:
             row["program"] = prog
         return row
@@ -351,12 +355,13 @@ class MaterialRegistry:
         row["glass_multiscatter"] = row.get("multiscatter", 1.0)
 
     # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/materials/mix.py) ---------
-    def _normal(self, material, node, row: dict, g: GraphCompiler | None = None, varying: dict | None = None) -> None:
-        """A BSDF's Normal input. A tangent-space Normal Map of an Image Texture and a Bump of an Image Texture
-        (over nothing or such a Normal Map) -> the row's normal_tex / bump_tex fields (read at render time without
-        a node program); any other graph -> ``varying["normal"]``, the node program's normal (Normal Map and Bump
-        of any input)."""
-        socket = node.inputs.get("Normal")
+    def _normal(self, material, node, row: dict, g: GraphCompiler | None = None, varying: dict | None = None,
+                socket=None) -> None:
+        """A BSDF's Normal input (or ``socket``). A tangent-space Normal Map of an Image Texture and a Bump of an
+        Image Texture (over nothing or such a Normal Map) -> the row's normal_tex / bump_tex fields (read at render
+        time without a node program); any other graph -> ``varying["normal"]``, the node program's normal (Normal
+        Map and Bump of any input)."""
+        socket = node.inputs.get("Normal") if socket is None else socket
         if socket is None or not socket.is_linked:
             return
         if self._image_normal(material, socket.links[0].from_node, row):
@@ -473,6 +478,8 @@ class MaterialRegistry:
     def _mix_varies(self, node, seen: set) -> bool:
         """Whether a Mix/Add tree has a factor that varies over the surface other than a plain Image Texture
         (those go to the fixed texture path)."""
+        if coat_set(node):  # a coated Principled BSDF is a coat and a base component (export/coat.py)
+            return True
         if node.type not in {"MIX_SHADER", "ADD_SHADER"} or node.name in seen:
             return False
         seen.add(node.name)
@@ -491,7 +498,9 @@ class MaterialRegistry:
     def _mix_program(self, material, node, depth: int) -> dict:
         """A Mix/Add tree whose weights vary over the surface: each leaf's weight (the sum over its paths of the
         product of the factors along them, Fac clamped to [0, 1] as Cycles) and the weighted emission are outputs
-        of the mix row's node program ("mix:<k>" for component k, "emission"); components keep weight 1."""
+        of the mix row's node program ("mix:<k>" for component k, "emission"); components keep weight 1. A coated
+        Principled BSDF (``node`` itself, or a leaf) becomes two components, its coat and its base (export/coat.py),
+        the base's Coat Tint factor the program's "mix_tint:<k>"."""
         g = self._compiler(material)
         weights: dict = {}
         order: list = []
@@ -522,7 +531,25 @@ class MaterialRegistry:
         comps, outputs, emission = [], {}, None
         for name in order:
             leaf, w = weights[name]
-            row = self._shader(material, leaf, depth + 1)
+            coat = coat_factors(g, leaf) if coat_set(leaf) else None
+            row = self._shader(material, leaf, depth + 1, base_only=coat is not None)
+            tint = None
+            if coat is not None:  # the coat, then the base under it
+                coat_w, layer, tint, reflectance = coat
+                outputs[f"mix_pick:{len(comps)}"] = reflectance
+                outputs[f"mix_pick:{len(comps) + 1}"] = g.constant(max(base_albedo(row), 1e-3), "float")
+                index = self.add_row(dict(coat_row(self, material, leaf), name=f"{material.name} ({len(comps) + 1}, coat)"))
+                cw = g.emit("multiply", {}, [w, coat_w], ("float",))[0]
+                if cw.const is not None:
+                    comps.append((index, cw.constant_value(), -1, 0.0))
+                else:
+                    outputs[f"mix:{len(comps)}"] = cw
+                    comps.append((index, 1.0, -1, 0.0))
+                w = g.emit("multiply", {}, [w, layer], ("float",))[0]
+                if leaf is node:  # the coated BSDF itself: its alpha is the whole row's cut-out
+                    for key in ("alpha", "alpha_tex", "alpha_sign"):
+                        if key in row:
+                            out[key] = row.pop(key)
             if row.get("transparent"):
                 if w.const is None:
                     self._warn(material, "a Transparent BSDF under a varying Mix factor is not supported; rendered "
@@ -536,6 +563,8 @@ class MaterialRegistry:
             e = self._leaf_emission(g, leaf)
             if e is not None:
                 e = g.emit("scale", {}, [e, w], ("color",))[0]
+                if tint is not None:
+                    e = g.emit("multiply", {}, [e, tint], ("color",))[0]
                 emission = e if emission is None else g.emit("add", {}, [emission, e], ("color",))[0]
             if _has_bsdf(row):
                 comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, alpha=1.0, alpha_tex=-1,
@@ -544,6 +573,8 @@ class MaterialRegistry:
                 if prog is not None and prog.has("emission"):
                     comp["program"] = dataclasses.replace(prog, outputs={k: v for k, v in prog.outputs.items()
                                                                          if k != "emission"})
+                if tint is not None:
+                    outputs[f"mix_tint:{len(comps)}"] = tint
                 if w.const is not None:
                     comps.append((self.add_row(comp), w.constant_value(), -1, 0.0))
                 else:
@@ -555,7 +586,7 @@ class MaterialRegistry:
             else:
                 outputs["emission"] = emission
         out["mix"] = comps
-        return self._with_program(out, g, outputs)
+        return self._with_program(out, g, outputs, keep=[f for f in outputs if f.startswith("mix_pick:")])
 
     def _leaf_emission(self, g: GraphCompiler, leaf):
         """The emitted radiance of a Mix leaf as a register of ``g`` (None for a shader that does not emit)."""

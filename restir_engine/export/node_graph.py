@@ -102,10 +102,10 @@ class GraphCompiler:
             return self.emit("color_to_float" if reg.kind == "color" else "vector_to_float", {}, [reg], ("float",))[0]
         return self.emit("float_to_vector", {}, [reg], (kind,))[0]
 
-    def program(self, outputs: dict, constants: bool = False) -> Program | None:
-        """A Program computing ``outputs`` (field -> Reg) that vary (all of them with ``constants``); None when none
-        is left."""
-        varying = {f: r for f, r in outputs.items() if r is not None and (constants or r.const is None)}
+    def program(self, outputs: dict, constants: bool = False, keep=()) -> Program | None:
+        """A Program computing ``outputs`` (field -> Reg) that vary (all of them with ``constants``, and those named
+        in ``keep`` whether they vary or not); None when none is left."""
+        varying = {f: r for f, r in outputs.items() if r is not None and (constants or r.const is None or f in keep)}
         if not varying:
             return None
         return Program(ops=list(self.ops), consts=dict(self.consts),

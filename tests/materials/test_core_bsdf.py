@@ -187,7 +187,7 @@ def test_mix_picks_components_in_proportion_to_their_weights():
     n = 100_000
     xi = (np.arange(n, dtype=np.float32) + 0.5) / n
     for mat, expected, total in ((1, {3: 0.2, 4: 0.5, 5: 0.3}, 1.0), (2, {6: 0.75, 7: 0.25}, 2.0)):
-        comp, w = pick_components(mats, np.full(n, mat), np.arange(n), xi, np.full((n, 2), 0.3, np.float32))
+        comp, w, _tint = pick_components(mats, np.full(n, mat), np.arange(n), xi, np.full((n, 2), 0.3, np.float32))
         assert np.allclose(w, total)
         for k, p in expected.items():
             assert abs((comp == k).mean() - p) < 1e-4

@@ -179,6 +179,15 @@ class SurfaceParams:
         for rows in WEIGHT_ROWS:
             self.block[rows] *= factor
 
+    def tint(self, colour: np.ndarray) -> None:
+        """Multiply every lobe by ``colour`` (3, n) in place (scene-linear RGB per entry); a coloured factor makes
+        the dielectric layer coloured (its a_d, c_d rows stop being grey)."""
+        for rows in WEIGHT_ROWS:
+            block = self.block[rows]
+            block.reshape(-1, 3, block.shape[-1])[:] *= colour
+        if ((colour != colour[0]) & (self.block[PARAM_ROWS["diel"]] > 0)).any():
+            self.lobes = self.lobes | {"coloured_layer"}
+
     @staticmethod
     def from_material(base, metallic, roughness, f0_d, spec_tint=None, metal_f90=None, multiscatter=None,
                       diffuse_roughness=None):

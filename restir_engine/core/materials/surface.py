@@ -52,7 +52,7 @@ class Surface:
         self.p = (o + d * t).astype(np.float32, copy=False)
         mat = geom.material[prim].astype(np.intp)
         self.mat = mat  # the triangle's material (a Mix/Add shader stays itself here)
-        mat, scale = self._pick_mix_components(ctx, mat, d)
+        mat, scale, tint = self._pick_mix_components(ctx, mat, d)
         ng = cols(ctx.geom_ng_rows, prim)
         ns = self._interpolated_normal(ctx, ng)
         ns, mapped, smooth_n = self._mapped_normal(ctx, mat, ns, ng, d, t)
@@ -63,8 +63,8 @@ class Surface:
         self.ns = ns * s_ns
         self.wo = -d
         self.bsdf_mat = mat  # the material whose BSDF the hit uses
-        self._material_params(ctx, mat, scale)
-        self._glass(ctx, mat, scale, s_ng)
+        self._material_params(ctx, mat, scale, tint)
+        self._glass(ctx, mat, scale, tint, s_ng)
         self.t, self.bt = orthonormal_basis(self.ns)
         self._bump_shadowing(mapped, smooth_n, s_ng)
         self._view_frame()
@@ -89,24 +89,30 @@ class Surface:
 
     def _pick_mix_components(self, ctx, mat, d):
         """Mix/Add shaders: one component per hit, scaled by the weights' sum (core/materials/mix.py). Returns
-        (the material each hit uses (n,), the scale (n,) float32 or None where no hit is mixed)."""
+        (the material each hit uses (n,), the scale (n,) float32 or None where no hit is mixed, the picked
+        components' colour factors (3, n) or None where none has one)."""
         if not ctx.has_mix:
-            return mat, None
+            return mat, None, None
         mats, geom = ctx.scene.materials, ctx.scene.geometry
         mixed = np.flatnonzero(mats.mix_first[mat] >= 0)
         if not mixed.size:
-            return mat, None
+            return mat, None, None
         prim, u, v = self.prim, self.b1, self.b2
         uv = self._uv(geom, mixed) if geom.uvs is not None else None
         def attrs_of(rows):  # the mixed hits ``rows`` (indices into ``mixed``), for weights from node programs
             r = mixed[rows]
             return self._attributes(ctx, r, -cols(d, r))
-        comp, w = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv, attrs_of)
+        comp, w, colour = pick_components(mats, mat, mixed, hash_uniform(prim[mixed], u[mixed], v[mixed]), uv,
+                                          attrs_of)
         mat = mat.copy()
         mat[mixed] = comp
         scale = np.ones(len(mat), np.float32)
         scale[mixed] = w
-        return mat, scale
+        tint = None
+        if colour is not None:
+            tint = np.ones((3, len(mat)), np.float32)
+            tint[:, mixed] = colour
+        return mat, scale, tint
 
     def _interpolated_normal(self, ctx, ng) -> np.ndarray:
         """(3, n) unit shading normals: interpolated on smooth triangles, the corner normal on flat ones, the
@@ -169,9 +175,9 @@ class Surface:
             return None
         return np.concatenate(rows_all), np.concatenate(normals, axis=1)
 
-    def _material_params(self, ctx, mat, scale) -> None:
+    def _material_params(self, ctx, mat, scale, tint=None) -> None:
         """The hits' BSDF parameters: a view of the material table, re-derived where a texture drives the base
-        colour, scaled by the Mix weights."""
+        colour, scaled by the Mix weights and the picked components' colour factors (``tint`` (3, n) or None)."""
         mats, geom = ctx.scene.materials, ctx.scene.geometry
         self.params = ctx.material_params.gather(mat)
         if geom.uvs is not None:
@@ -184,6 +190,8 @@ class Surface:
         self._varying = self._node_params(ctx, mat) if ctx.has_programs else None
         if scale is not None:
             self.params.scale(scale)
+        if tint is not None:
+            self.params.tint(tint)
 
     def _node_params(self, ctx, mat):
         """BSDF parameters from the materials' node programs at their hits (core/materials/nodes): the hits'
@@ -218,7 +226,7 @@ class Surface:
         layer[rows] = microfacet_tables.layer_s(p.alpha, mu, p.f0r)
         self._albedo, self._layer = albedo, layer
 
-    def _glass(self, ctx, mat, scale, s_ng) -> None:
+    def _glass(self, ctx, mat, scale, tint, s_ng) -> None:
         """Smooth glass (core/materials/glass.py): picked per point with the material's transmission share; black
         for every evaluation, sampled as a delta closure by pathtracer.sample_rays."""
         self.glass = self.glass_front = self.glass_ior = self.glass_reflect = self.glass_refract = None
@@ -239,6 +247,8 @@ class Surface:
         self.glass_front = s_ng > 0  # the ray came from outside (against the outward normal)
         gm = mat[rows]
         w = np.ones(rows.size, np.float32) if scale is None else scale[rows]
+        if tint is not None:
+            w = w * tint[:, rows]
         self.glass_ior = np.ones(n, np.float32)
         self.glass_ior[rows] = mats.glass_ior[gm]
         self.glass_alpha = np.zeros(n, np.float32)
