@@ -72,12 +72,57 @@ _COAT = {"Coat Weight": 1.0, "Coat Roughness": 0.15}
 COAT_GRID = [[
     ("P", (0.8, 0.1, 0.1), 0.5, dict(_COAT)),
     ("P", (0.8, 0.8, 0.8), 0.5, {"Coat Weight": 1.0, "Coat Roughness": 0.3, "Coat Tint": (0.9, 0.4, 0.2, 1.0)}),
-    ("P", (0.9, 0.7, 0.4), 0.4, {"Metallic": 1.0, "Coat Weight": 0.5, "Coat Roughness": 0.1}),
+    ("P", (0.9, 0.7, 0.4), 0.4, {"Metallic": 1.0, "Coat Weight": 0.5, "Coat Roughness": 0.25}),
     ("P", (0.0, 0.0, 0.0), 0.5, {"Coat Weight": 1.0, "Coat Roughness": 0.5, "Coat IOR": 2.0}),
     ("P", (0.2, 0.7, 0.2), 0.6, {"Coat Weight": 0.5, "Coat IOR": 1.3, "Coat Roughness": 0.2,
                                  "Coat Tint": (0.5, 0.8, 1.0, 1.0)}),
     ("MIX", 0.5, ("P", (0.1, 0.2, 0.8), 0.4, dict(_COAT)), ("D", (0.7, 0.7, 0.7), 0.0, {})),
 ]]
+
+# Coats whose inputs vary or interact (coat_graph_spheres wires the graphs): Coat Weight from a Noise Texture, a
+# bumped Normal the coat follows, a bump on the Coat Normal alone, emission under a tinted coat, Coat Roughness
+# from a Noise Texture at IOR 1.8, a coat on a half-transparent (Alpha 0.6) base.
+COAT_GRAPH_GRID = [[
+    ("P", (0.8, 0.3, 0.1), 0.5, {"Coat Weight": 1.0, "Coat Roughness": 0.2}),
+    ("P", (0.3, 0.6, 0.8), 0.4, {"Coat Weight": 1.0, "Coat Roughness": 0.1}),
+    ("P", (0.7, 0.7, 0.7), 0.5, {"Coat Weight": 1.0, "Coat Roughness": 0.3}),
+    ("P", (0.1, 0.1, 0.1), 0.5, {"Coat Weight": 1.0, "Coat Roughness": 0.2, "Coat Tint": (0.3, 0.5, 1.0, 1.0),
+                                 "Emission Color": (1.0, 0.5, 0.2, 1.0), "Emission Strength": 2.0}),
+    ("P", (0.5, 0.5, 0.5), 0.5, {"Coat Weight": 1.0, "Coat IOR": 1.8}),
+    ("P", (0.8, 0.8, 0.2), 0.5, {"Coat Weight": 1.0, "Coat Roughness": 0.2, "Alpha": 0.6}),
+]]
+
+
+def coat_graph_spheres(size=(144, 24)):
+    """material_spheres of :data:`COAT_GRAPH_GRID` with its node graphs wired in (see there)."""
+    scene = material_spheres("AREA", size, COAT_GRAPH_GRID)
+
+    def node_tree(c):
+        tree = bpy.data.materials[f"M0{c}"].node_tree
+        return tree, tree.nodes["Principled BSDF"]
+
+    def noise(tree, scale):
+        n = tree.nodes.new("ShaderNodeTexNoise")
+        n.inputs["Scale"].default_value = scale
+        return n
+
+    def bump(tree, height, strength):
+        b = tree.nodes.new("ShaderNodeBump")
+        b.inputs["Strength"].default_value = strength
+        tree.links.new(height, b.inputs["Height"])
+        return b
+
+    tree, p = node_tree(0)
+    tree.links.new(noise(tree, 6.0).outputs["Fac"], p.inputs["Coat Weight"])
+    tree, p = node_tree(1)
+    vor = tree.nodes.new("ShaderNodeTexVoronoi")
+    vor.inputs["Scale"].default_value = 8.0
+    tree.links.new(bump(tree, vor.outputs["Distance"], 0.6).outputs["Normal"], p.inputs["Normal"])
+    tree, p = node_tree(2)
+    tree.links.new(bump(tree, noise(tree, 10.0).outputs["Fac"], 0.8).outputs["Normal"], p.inputs["Coat Normal"])
+    tree, p = node_tree(4)
+    tree.links.new(noise(tree, 4.0).outputs["Fac"], p.inputs["Coat Roughness"])
+    return scene
 
 
 def packed_image(name, rgb: np.ndarray):

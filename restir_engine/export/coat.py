@@ -33,7 +33,8 @@ def coat_factors(g, node):
     normal_socket = coat_normal_socket(node)
     normal = g.value(normal_socket, "vector", default="normal") if normal_socket is not None else \
         g.attribute("normal", "vector")
-    layer, factor, reflectance = g.emit("coat_layer", {}, [weight, g.value(inp["Coat IOR"], "float"), tint, normal],
+    layer, factor, reflectance = g.emit("coat_layer", {}, [weight, g.value(inp["Coat IOR"], "float"), tint, normal,
+                                                          g.value(inp["Coat Roughness"], "float")],
                                         ("float", "color", "float"))
     white = tint.const is not None and tint.constant_value() == (1.0, 1.0, 1.0)
     return weight, layer, None if white else factor, reflectance

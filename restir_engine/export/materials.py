@@ -1,10 +1,10 @@
 """Blender materials -> MaterialTable rows (Principled parameters, emission radiance, Mix/Add components).
 
 Supported exactly: Principled BSDF (Base Color, Metallic, Roughness, IOR, Specular IOR Level, Specular Tint,
-Emission Color x Strength; Multiscatter GGX or GGX), Diffuse BSDF, Emission, Glossy BSDF, Mix Shader (constant
-factor or an Image Texture's Color/Alpha) and Add Shader of these, and an Image Texture (UV) feeding Base Color /
-Color / Emission Color. Anything else is approximated by its closest parameters and reported once per render,
-naming the material and the reason.
+Emission Color x Strength, Coat (export/coat.py); Multiscatter GGX or GGX), Diffuse BSDF, Emission, Glossy BSDF, Mix
+Shader (constant factor or an Image Texture's Color/Alpha) and Add Shader of these, and an Image Texture (UV)
+feeding Base Color / Color / Emission Color. Anything else is approximated by its closest parameters and reported
+once per render, naming the material and the reason.
 """
 from __future__ import annotations
 

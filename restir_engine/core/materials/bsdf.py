@@ -1,5 +1,5 @@
-"""The Principled BSDF as Cycles builds it (Blender 4.x/5.x), without sheen, coat, transmission and anisotropy;
-vectorized.
+"""The Principled BSDF as Cycles builds it (Blender 4.x/5.x), without sheen, transmission and anisotropy (a Coat is a
+Mix of a coat and a base row: export/coat.py); vectorized.
 
 All directions are (3, n) rows (x, y, z) in the local shading frame (z = shading normal), unit length,
 ``wo`` towards the viewer, ``wi`` towards the light; colours are (3, n) rows (R, G, B), scene-linear.
