@@ -125,6 +125,39 @@ def coat_graph_spheres(size=(144, 24)):
     return scene
 
 
+def point_cloud_scene(size=(96, 64)):
+    """A point cloud made by Geometry Nodes (Mesh to Points on a 5 x 4 grid, radius 0.3; Cycles traces each point
+    as a sphere; the points carry no material: Blender's default) above a grey floor, and one
+    point cloud datablock of three points of radii 0.15-0.35 with a blue Diffuse, lit by an area light."""
+    scene = reset()
+    plane("Floor", 10, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=4, y_subdivisions=3, size=3.0, location=(-0.6, 0.5, 0.6))
+    grid = bpy.context.active_object
+    tree = bpy.data.node_groups.new("ToPoints", "GeometryNodeTree")
+    tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    gin, gout = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    to_points = tree.nodes.new("GeometryNodeMeshToPoints")
+    to_points.inputs["Radius"].default_value = 0.3
+    tree.links.new(gin.outputs[0], to_points.inputs["Mesh"])
+    tree.links.new(to_points.outputs[0], gout.inputs[0])
+    grid.modifiers.new("Points", "NODES").node_group = tree
+    cloud = bpy.data.pointclouds.new("Cloud") if hasattr(bpy.data, "pointclouds") else None
+    if cloud is not None and hasattr(cloud, "resize"):  # bpy 5.1+
+        cloud.resize(3)
+        cloud.attributes["position"].data.foreach_set("vector", np.array([1.6, -0.6, 0.35, 2.1, 0.4, 0.25, 1.2, 0.6,
+                                                                          0.5], np.float32))
+        cloud.attributes.new("radius", "FLOAT", "POINT").data.foreach_set("value", np.array([0.35, 0.25, 0.15],
+                                                                                             np.float32))
+        cloud.materials.append(diffuse("Cloud", (0.1, 0.3, 0.8)))
+        scene.collection.objects.link(bpy.data.objects.new("Cloud", cloud))
+    light("AREA", (-1.5, -2.0, 4.0), (math.radians(30), 0, math.radians(-20)), energy=150.0, size=2.0)
+    camera((0.3, -5.5, 3.0), (math.radians(62), 0, 0), lens=32)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene
+
+
 def packed_image(name, rgb: np.ndarray):
     """A Non-Color float image made in memory from ``rgb`` (h, w, 3), row 0 at the bottom, alpha 1, packed."""
     h, w = rgb.shape[:2]

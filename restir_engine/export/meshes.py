@@ -2,7 +2,8 @@
 
 Every visible instance in ``depsgraph.object_instances`` (modifiers, particles, geometry-node
 instances included; curves, text, surfaces and metaballs through their evaluated mesh) is
-triangulated with ``calc_loop_triangles`` and read with ``foreach_get``. Local-space arrays are
+triangulated with ``calc_loop_triangles`` and read with ``foreach_get``; point clouds become spheres
+(export/points.py). Local-space arrays are
 cached per evaluated datablock so instances of one mesh are read once; no Python loop over triangles.
 """
 from __future__ import annotations
@@ -10,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.scene import ObjectTable, TriangleSet
+from .points import read_points
 
-GEOMETRY_TYPES = {"MESH", "CURVE", "CURVES", "SURFACE", "FONT", "META"}
+GEOMETRY_TYPES = {"MESH", "CURVE", "CURVES", "SURFACE", "FONT", "META", "POINTCLOUD"}
 MAX_COORD = 1e7  # beyond this float32 precision makes ray offsets meaningless
 
 
@@ -169,10 +171,19 @@ def geometry_instances(depsgraph):
         yield inst, obj
 
 
+def slot_materials(obj) -> list:
+    """The materials of an object's slots (None for an empty slot); where it has no slots (a point cloud made by
+    Geometry Nodes), its data's materials."""
+    mats = [s.material for s in obj.material_slots]
+    if not mats and obj.type == "POINTCLOUD" and obj.data is not None:
+        mats = list(obj.data.materials)
+    return mats
+
+
 def slot_signature(depsgraph) -> tuple:
     """The material names in every exported instance's slots, in export order (equal signatures: the
     triangles' material indices are unchanged)."""
-    return tuple(tuple(s.material.name_full if s.material else "" for s in obj.material_slots)
+    return tuple(tuple(m.name_full if m else "" for m in slot_materials(obj))
                  for _inst, obj in geometry_instances(depsgraph))
 
 
@@ -188,11 +199,11 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
     slot_cache: dict = {}
     for inst, obj in geometry_instances(depsgraph):
         data = obj.data
-        key = data.as_pointer() if (obj.type == "MESH" and data is not None) else obj.as_pointer()
-        mats_key = (key, tuple(s.material.name_full if s.material else "" for s in obj.material_slots))
+        key = data.as_pointer() if (obj.type in {"MESH", "POINTCLOUD"} and data is not None) else obj.as_pointer()
+        materials = slot_materials(obj)
+        mats_key = (key, tuple(m.name_full if m else "" for m in materials))
         if mats_key not in slot_cache:
-            slot_cache[mats_key] = np.array([registry.material_index(s.material) for s in obj.material_slots] or [0],
-                                            np.int32)
+            slot_cache[mats_key] = np.array([registry.material_index(m) for m in materials] or [0], np.int32)
         slots_seen.append(mats_key[1])
         if key not in cache:
             want_uv = registry.uses_textures(slot_cache[mats_key])
@@ -202,6 +213,15 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
             kept = (key, data.name_full if data is not None else obj.name_full, want_uv, want_tangents, want_attrs)
             if mesh_cache is not None and kept in mesh_cache:
                 cache[key] = mesh_cache[kept]
+            elif obj.type == "POINTCLOUD":
+                cache[key] = read_points(data) if data is not None else None
+                reads += 1
+                if cache[key] is not None:
+                    warnings.append(f"Point cloud '{obj.name}': {len(data.points)} points rendered as spheres of "
+                                    f"{cache[key]['triangles_per_point']} triangles each (Cycles traces exact "
+                                    "spheres)")
+                if mesh_cache is not None:
+                    mesh_cache[kept] = cache[key]
             else:
                 try:
                     mesh = obj.to_mesh()
