@@ -511,11 +511,11 @@ def bump_scene(size=(96, 64)):
 
 
 def glass_material(name, kind, ior=1.45, color=(1.0, 1.0, 1.0), transmission=1.0, roughness=0.0):
-    """A glass: kind "GLASS" (Glass BSDF) or "PRINCIPLED" (Transmission Weight ``transmission``), smooth unless
-    ``roughness``."""
-    if kind == "GLASS":
+    """A glass: kind "GLASS" (Glass BSDF), "REFRACTION" (Refraction BSDF) or "PRINCIPLED" (Transmission Weight
+    ``transmission``), smooth unless ``roughness``."""
+    if kind in ("GLASS", "REFRACTION"):
         from harness.scenes import _replace_surface
-        m, g = _replace_surface(name, "ShaderNodeBsdfGlass")
+        m, g = _replace_surface(name, "ShaderNodeBsdfGlass" if kind == "GLASS" else "ShaderNodeBsdfRefraction")
         g.inputs["Color"].default_value = (*color, 1)
         g.inputs["Roughness"].default_value = roughness
         g.inputs["IOR"].default_value = ior
@@ -527,12 +527,12 @@ def glass_material(name, kind, ior=1.45, color=(1.0, 1.0, 1.0), transmission=1.0
     return m
 
 
-def glass_scene(size=(96, 64), only=None, window=False, roughness=None):
+def glass_scene(size=(96, 64), only=None, window=False, roughness=None, materials=None):
     """Three smooth glass spheres in front of a checkered wall on a grey floor, lit by an area light from above
     and the front: a Glass BSDF (IOR 1.45), a tinted Principled with Transmission 1 (IOR 1.5) and a red Principled
     with Transmission 0.5 (half glass, half diffuse under a clear coat of reflection); ``only``: just that one;
     ``window``: a 2 cm glass pane across the lower half of the view in front of them; ``roughness``: the three
-    spheres' roughness (r, r, r) instead of smooth."""
+    spheres' roughness (r, r, r) instead of smooth; ``materials``: three materials for the spheres instead."""
     scene = reset()
     plane("Floor", 8, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
     wall = principled("Checker wall", (1, 1, 1), roughness=1.0)
@@ -545,6 +545,8 @@ def glass_scene(size=(96, 64), only=None, window=False, roughness=None):
     specs = [(-1.1, glass_material("Glass", "GLASS", roughness=r[0])),
              (0.0, glass_material("Tinted", "PRINCIPLED", 1.5, (0.8, 0.9, 1.0), roughness=r[1])),
              (1.1, glass_material("Half", "PRINCIPLED", 1.5, (0.8, 0.3, 0.2), transmission=0.5, roughness=r[2]))]
+    if materials is not None:
+        specs = [(x, m()) for (x, _old), m in zip(specs, materials)]
     for x, mat in specs if only is None else [specs[only]]:
         bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(x, 0.0, 0.5), segments=48, ring_count=24)
         bpy.ops.object.shade_smooth()
@@ -559,6 +561,14 @@ def glass_scene(size=(96, 64), only=None, window=False, roughness=None):
     black_world(scene)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def refraction_scene(size=(96, 64)):
+    """glass_scene with Refraction BSDFs: smooth (IOR 1.45), tinted and rough (0.3), IOR 1.2 slightly rough (0.1)."""
+    return glass_scene(size, materials=[lambda: glass_material("Refraction", "REFRACTION"),
+                                        lambda: glass_material("Tinted refraction", "REFRACTION", 1.45,
+                                                               (0.9, 0.6, 0.3), roughness=0.3),
+                                        lambda: glass_material("Low refraction", "REFRACTION", 1.2, roughness=0.1)])
 
 
 def node_planes(graphs, cols: int, px: int = 16, name="Nodes"):

@@ -103,6 +103,9 @@ class MaterialTable:
     glass_reflect, glass_refract (m, 3) the tints of its reflection and its refraction
     glass_alpha (m,)    its GGX α (roughness²; below glass.ROUGH_ALPHA_MIN smooth, a delta closure)
     glass_multiscatter (m,) 1: Multiscatter GGX (energy compensated, Blender's default), 0: GGX
+    glass_beckmann (m,) 1: Beckmann's microfacet distribution (the Refraction BSDF's default), 0: GGX
+    glass_fresnel (m,)  1: the Fresnel term chooses reflection or refraction (Glass BSDF, Principled); 0: it always
+                        refracts, untinted by Fresnel (Refraction BSDF; total internal reflection absorbs)
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
@@ -138,6 +141,8 @@ class MaterialTable:
     glass_refract: np.ndarray = None
     glass_alpha: np.ndarray = None
     glass_multiscatter: np.ndarray = None
+    glass_fresnel: np.ndarray = None
+    glass_beckmann: np.ndarray = None
     alpha: np.ndarray = None
     alpha_tex: np.ndarray = None
     alpha_sign: np.ndarray = None
@@ -176,6 +181,7 @@ class MaterialTable:
             transmission=col("transmission", 0.0), glass_ior=col("glass_ior", 1.5),
             glass_reflect=col("glass_reflect", (1.0, 1.0, 1.0)), glass_refract=col("glass_refract", (1.0, 1.0, 1.0)),
             glass_alpha=col("glass_alpha", 0.0), glass_multiscatter=col("glass_multiscatter", 1.0),
+            glass_fresnel=col("glass_fresnel", 1.0), glass_beckmann=col("glass_beckmann", 0.0),
             diffuse_roughness=col("diffuse_roughness", 0.0), holdout=col("holdout", False, bool),
             **_mix_arrays(rows), **_programs(rows), **_programs(rows, "aov_program"),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

@@ -261,6 +261,14 @@ class MaterialRegistry:
             return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transmission": 1.0, "glass_ior": max(ior, 1e-3),
                     "glass_reflect": tuple(c), "glass_refract": tuple(c), "glass_alpha": rough * rough,
                     "glass_multiscatter": self._multiscatter(material, node)}
+        if t == "BSDF_REFRACTION":  # Cycles: microfacet refraction alone, no Fresnel term, no energy compensation
+            c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
+            ior = self._float_input(material, node.inputs["IOR"])
+            rough = float(np.clip(self._float_input(material, node.inputs["Roughness"]), 0, 1))
+            return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transmission": 1.0, "glass_ior": max(ior, 1e-3),
+                    "glass_reflect": (0.0, 0.0, 0.0), "glass_refract": tuple(c), "glass_alpha": rough * rough,
+                    "glass_multiscatter": 0.0, "glass_fresnel": 0.0,
+                    "glass_beckmann": float(getattr(node, "distribution", "GGX") == "BECKMANN")}
         if t == "HOLDOUT":
             return dict(HOLDOUT_ROW)
         if t == "BSDF_TRANSPARENT":

@@ -184,7 +184,9 @@ def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
         g = np.flatnonzero(s.glass)
         wg, weight, valid = sample_glass(cols(s.wo, g), cols(s.ns, g), cols(s.ng, g), s.glass_front[g],
                                          s.glass_ior[g], cols(s.glass_reflect, g), cols(s.glass_refract, g), u[0, g],
-                                         s.glass_alpha[g], u[1, g], u[2, g], s.glass_ms[g])
+                                         s.glass_alpha[g], u[1, g], u[2, g], s.glass_ms[g],
+                                         None if s.glass_fresnel is None else s.glass_fresnel[g],
+                                         None if s.glass_beckmann is None else s.glass_beckmann[g])
         wi[:, g] = wg
         wi_l[:, g] = 0.0
         wi_l[2, g] = 1.0  # unused for delta rows (their throughput is the weight)

@@ -230,7 +230,7 @@ class Surface:
         """Smooth glass (core/materials/glass.py): picked per point with the material's transmission share; black
         for every evaluation, sampled as a delta closure by pathtracer.sample_rays."""
         self.glass = self.glass_front = self.glass_ior = self.glass_reflect = self.glass_refract = None
-        self.glass_alpha = self.glass_ms = None
+        self.glass_alpha = self.glass_ms = self.glass_fresnel = self.glass_beckmann = None
         if not ctx.has_glass:
             return
         mats, prim, u, v = ctx.scene.materials, self.prim, self.b1, self.b2
@@ -255,6 +255,14 @@ class Surface:
         self.glass_alpha[rows] = mats.glass_alpha[gm]
         self.glass_ms = np.zeros(n, bool)
         self.glass_ms[rows] = mats.glass_multiscatter[gm] > 0
+        self.glass_fresnel = np.ones(n, bool)
+        fresnel = getattr(mats, "glass_fresnel", None)
+        if fresnel is not None:
+            self.glass_fresnel[rows] = fresnel[gm] > 0
+        self.glass_beckmann = np.zeros(n, bool)
+        beckmann = getattr(mats, "glass_beckmann", None)
+        if beckmann is not None:
+            self.glass_beckmann[rows] = beckmann[gm] > 0
         self.glass_reflect = np.zeros((3, n), np.float32)
         self.glass_reflect[:, rows] = mats.glass_reflect[gm].T * w
         self.glass_refract = np.zeros((3, n), np.float32)
@@ -358,7 +366,8 @@ class Surface:
         out._at = None if self._at is None else (self._at[0][idx], self._at[1][idx])
         out._albedo = None if self._albedo is None else self._albedo[idx]
         out._layer = None if self._layer is None else self._layer[idx]
-        for name in ("glass", "glass_front", "glass_ior", "glass_alpha", "glass_ms"):
+        for name in ("glass", "glass_front", "glass_ior", "glass_alpha", "glass_ms", "glass_fresnel",
+                     "glass_beckmann"):
             a = getattr(self, name)
             setattr(out, name, None if a is None else a[idx])
         for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l", "bump_n", "spec_n", "glass_reflect", "glass_refract"):
