@@ -571,6 +571,20 @@ def refraction_scene(size=(96, 64)):
                                         lambda: glass_material("Low refraction", "REFRACTION", 1.2, roughness=0.1)])
 
 
+def beckmann_glass_scene(size=(96, 64)):
+    """glass_scene with Glass BSDFs of the Beckmann distribution: roughness 0.3 (IOR 1.45), 0.5 tinted, 0.15 (IOR
+    1.2)."""
+    def beckmann(name, ior, color, roughness):
+        def make():
+            m = glass_material(name, "GLASS", ior, color, roughness=roughness)
+            m.node_tree.nodes["Glass BSDF"].distribution = "BECKMANN"
+            return m
+        return make
+    return glass_scene(size, materials=[beckmann("Beckmann", 1.45, (1, 1, 1), 0.3),
+                                        beckmann("Tinted Beckmann", 1.45, (0.9, 0.6, 0.3), 0.5),
+                                        beckmann("Low Beckmann", 1.2, (1, 1, 1), 0.15)])
+
+
 def node_planes(graphs, cols: int, px: int = 16, name="Nodes"):
     """Emission planes facing an orthographic camera, one per ``graphs`` entry in a grid of ``cols`` columns
     (row 0 at the top), each ``px`` pixels square: ``graph(tree, color_socket)`` wires nodes into the Emission

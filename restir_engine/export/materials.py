@@ -258,9 +258,11 @@ class MaterialRegistry:
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
             ior = self._float_input(material, node.inputs["IOR"])
             rough = float(np.clip(self._float_input(material, node.inputs["Roughness"]), 0, 1))
+            beckmann = getattr(node, "distribution", "MULTI_GGX") == "BECKMANN"  # single-scattering, as Cycles
             return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transmission": 1.0, "glass_ior": max(ior, 1e-3),
                     "glass_reflect": tuple(c), "glass_refract": tuple(c), "glass_alpha": rough * rough,
-                    "glass_multiscatter": self._multiscatter(material, node)}
+                    "glass_multiscatter": 0.0 if beckmann else self._multiscatter(material, node),
+                    "glass_beckmann": float(beckmann)}
         if t == "BSDF_REFRACTION":  # Cycles: microfacet refraction alone, no Fresnel term, no energy compensation
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
             ior = self._float_input(material, node.inputs["IOR"])
