@@ -287,6 +287,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         from .viewport import GI_RESERVOIR_PASSES, RESERVOIR_PASSES
         settings = settings_from_scene(scene)
         settings.samples = 1
+        settings.use_adaptive_sampling = False  # the viewport samples every pixel (its own refinement)
         settings.data_passes = False
         settings.reservoir_passes = _viewport_pass(context) in RESERVOIR_PASSES
         settings.gi_reservoir_passes = _viewport_pass(context) in GI_RESERVOIR_PASSES

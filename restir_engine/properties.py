@@ -177,6 +177,17 @@ SCENE_FIELDS = (
         name="Time Limit", description="Seconds a render (each frame of an animation) or a still viewport may take: "
         "it stops after the sample that reaches the limit, with fewer samples than asked for (0 = no limit)",
         default=0.0, min=0.0, soft_max=3600.0, subtype="TIME_ABSOLUTE")),
+    Field("use_adaptive_sampling", BoolProperty, bool, dict(
+        name="Noise Threshold", description="Adaptive sampling, as Cycles': pixels whose noise estimate falls "
+        "under the threshold stop taking samples, and the frame's work goes to the noisy ones (F12 and animation; "
+        "the viewport samples every pixel)", default=True)),
+    Field("adaptive_threshold", FloatProperty, float, dict(
+        name="Noise Threshold", description="The noise level at which a pixel stops: its relative difference "
+        "between all its samples and half of them (lower: less noise, more samples; 0 = automatic, 1/Samples)",
+        default=0.01, min=0.0, max=1.0, soft_min=0.001, precision=4, step=0.1)),
+    Field("adaptive_min_samples", IntProperty, int, dict(
+        name="Min Samples", description="Samples every pixel takes before adaptive sampling may stop it "
+        "(0 = automatic from the threshold: 64 at 0.01)", default=0, min=0, soft_max=4096)),
     Field("viewport_samples", IntProperty, None, dict(
         name="Viewport Samples", description="Samples the Rendered viewport accumulates "
         "for a still view before it stops", default=MAX_VIEWPORT_SAMPLES, min=1,
@@ -273,6 +284,9 @@ class RestirViewLayerSettings(bpy.types.PropertyGroup):
     use_pass_denoising_data: BoolProperty(name="Denoising Data", description="Denoising Albedo and Denoising Normal "
                                           "(first hit's albedo and camera-space normal, averaged over the samples), "
                                           "for the compositor's Denoise node", default=False, update=_update_passes)
+    use_pass_sample_count: BoolProperty(name="Sample Count", description="Samples each pixel took (with adaptive "
+                                        "sampling, Render Properties > Sampling > Noise Threshold)", default=False,
+                                        update=_update_passes)
 
 
 class RestirViewShadingSettings(bpy.types.PropertyGroup):

@@ -71,6 +71,14 @@ class RESTIR_PT_sampling(RestirPanel, bpy.types.Panel):
         layout.prop(s, "integrator")
         col = layout.column(align=True)
         col.prop(s, "samples", text="Render Samples")
+        row = col.row(heading="Noise Threshold", align=True)
+        row.prop(s, "use_adaptive_sampling", text="")
+        sub = row.row()
+        sub.active = s.use_adaptive_sampling
+        sub.prop(s, "adaptive_threshold", text="")
+        sub = col.row()
+        sub.active = s.use_adaptive_sampling
+        sub.prop(s, "adaptive_min_samples")
         col.prop(s, "viewport_samples")
         col.prop(s, "time_limit")
         col.prop(s, "viewport_budget_ms")
@@ -306,6 +314,9 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col.prop(vl.restir, "use_pass_gi_reservoir_ucw")
         col = layout.column(heading="Denoising", align=True)
         col.prop(vl.restir, "use_pass_denoising_data")
+        col = layout.column(heading="Sampling", align=True)
+        col.active = context.scene.restir.use_adaptive_sampling
+        col.prop(vl.restir, "use_pass_sample_count")
         col = layout.column(heading="Cryptomatte", align=True)
         col.prop(vl, "use_pass_cryptomatte_object", text="Object")
         col.prop(vl, "use_pass_cryptomatte_material", text="Material")

@@ -16,7 +16,7 @@ NOT_SCENE = {"frame": "scene.frame_current", "film_transparent": "scene.render.f
              "denoise_data": "the view layer's Denoising Data pass", "tile_pixels": "core tuning (chunk size)",
              "sample_batch": "core tuning (automatic)", "gi_target": "core measurements only"}
 # the core's defaults are the reference path tracer's; a new Blender scene defaults to ReSTIR with Auto methods
-CORE_DEFAULT_DIFFERS = {"integrator", "direct_method", "indirect_method"}
+CORE_DEFAULT_DIFFERS = {"integrator", "direct_method", "indirect_method", "use_adaptive_sampling"}
 
 
 def _fields():

@@ -23,6 +23,10 @@ def with_light_tiles(ctx, plan: PassPlan, chunks: list[Chunk], sampler: str, tea
     r_tiles = plan.rng(STREAM_TILES)
     if sampler == "SPATIAL":
         pos = team.empty((3, w * h), np.float32)
+        if plan.partial and team.leader:  # pixels adaptive sampling stopped: no surface this pass
+            pos[...] = np.nan
+        if plan.partial:
+            team.barrier()
         for c in own(chunks, team):
             pos[:, c.pixels[:len(c.pixels) // c.batch]] = np.nan  # a chunk's pixels: its span (batch 1 here)
             pos[:, c.pixels[c.hits.rows]] = c.hits.surf.p

@@ -3,8 +3,10 @@
 Accumulators are float64 (h, w, c) or (h, w) arrays over the camera window, row 0 at the *bottom* (Blender's pass
 order), kept in a pool between frames: a fresh array's pages are faulted in on first write, a reused one is only
 zeroed. Keys: emit, direct, indirect (RGB radiance, W·sr⁻¹·m⁻², scene-linear), alpha; res_m, res_w (DI reservoirs'
-M and W); gi_m, gi_w (GI reservoirs'); albedo, dnormal (denoising data: first-hit albedo, camera-space normal).
-Passes are their means over the samples done, float32 and finite.
+M and W); gi_m, gi_w (GI reservoirs'); albedo, dnormal (denoising data: first-hit albedo, camera-space normal);
+with adaptive sampling (pipeline/adaptive.py) count (each pixel's samples) and aux (twice the RGB of the samples in
+its half set). Passes are their means over each pixel's samples (the frame's samples where no count is kept),
+float32 and finite.
 """
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ import threading
 import numpy as np
 
 from ..materials.bsdf import denoising_albedo
+from .adaptive import in_half
 from ..parallel.pool import in_worker, pool
 from ..parallel.tasks import map_tasks
 from ..sampling import finite
@@ -44,14 +47,23 @@ class BufferPool:
 BUFFERS = BufferPool()
 
 
-def film_keys(gi: bool, denoise_data: bool) -> list[tuple[str, int]]:
+def film_keys(gi: bool, denoise_data: bool, adaptive: bool = False) -> list[tuple[str, int]]:
     """(accumulator key, channels) of a film, in allocation order (1: an (h, w) array)."""
     keys = [("emit", 3), ("direct", 3), ("indirect", 3), ("alpha", 1), ("res_m", 1), ("res_w", 1)]
     if gi:
         keys += [("gi_m", 1), ("gi_w", 1)]
     if denoise_data:
         keys += [("albedo", 3), ("dnormal", 3)]
+    if adaptive:
+        keys += [("count", 1), ("aux", 3)]
     return keys
+
+
+def _pixels(pixels: np.ndarray):
+    """A slice where ``pixels`` (sorted, unique) is a contiguous range, else the index array itself."""
+    if len(pixels) and int(pixels[-1]) - int(pixels[0]) + 1 == len(pixels):
+        return slice(int(pixels[0]), int(pixels[-1]) + 1)
+    return pixels
 
 
 class Film:
@@ -59,10 +71,10 @@ class Film:
     accumulators (default: the buffer pool's; a team's film passes views of one zero-filled shared segment, and
     then nothing returns to the pool)."""
 
-    def __init__(self, w: int, h: int, gi: bool, denoise_data: bool, zeros=None):
+    def __init__(self, w: int, h: int, gi: bool, denoise_data: bool, zeros=None, adaptive: bool = False):
         self.pooled = zeros is None
         z = zeros or BUFFERS.zeros
-        self.acc = {key: z((h, w, c) if c > 1 else (h, w)) for key, c in film_keys(gi, denoise_data)}
+        self.acc = {key: z((h, w, c) if c > 1 else (h, w)) for key, c in film_keys(gi, denoise_data, adaptive)}
         self.samples = 0
 
     def has(self, key: str) -> bool:
@@ -85,15 +97,22 @@ class Film:
                 return add_batch(c)
             # the (3, k) results are transposed into contiguous (k, 3) copies first: adding a transposed view
             # to (k, 3) rows runs NumPy's inner loop over 3 elements
-            span = slice(int(c.pixels[0]), int(c.pixels[-1]) + 1)  # a chunk is a contiguous pixel range
-            flat["emit"][span] += np.ascontiguousarray(c.hits.emitted.T)
+            span = _pixels(c.pixels)  # a slice where the chunk is a contiguous pixel range (no scatter)
+            emitted = np.ascontiguousarray(c.hits.emitted.T)
+            flat["emit"][span] += emitted
             flat["alpha"][span] += c.hits.alpha
             hit = c.hits.rows
-            pix = span if len(hit) == len(c.pixels) else c.pixels[hit]  # every pixel hit: a slice, no scatter
+            pix = span if len(hit) == len(c.pixels) else c.pixels[hit]  # every pixel hit: no scatter
             chain = None if c.chain is None else c.chain.throughput  # what the glass in front passes
+            rgb = emitted.astype(np.float64) if "aux" in flat else None  # the sample's RGB (adaptive sampling)
             for key, value in (("direct", c.direct), ("indirect", c.indirect)):
                 if value is not None:
-                    flat[key][pix] += np.ascontiguousarray((value if chain is None else value * chain).T)
+                    v = np.ascontiguousarray((value if chain is None else value * chain).T)
+                    flat[key][pix] += v
+                    if rgb is not None:
+                        rgb[hit] += v
+            if rgb is not None:
+                add_adaptive(c.pixels, rgb)
             if resampled:
                 flat["res_m"][pix] += c.res.M
                 flat["res_w"][pix] += c.res.W
@@ -106,45 +125,75 @@ class Film:
                 flat["albedo"][pix] += np.ascontiguousarray((albedo if chain is None else albedo * chain).T)
                 flat["dnormal"][pix] += np.ascontiguousarray((world_to_cam @ surf.ns).T)
 
+        def add_adaptive(pixels, rgb):
+            """One more sample of ``pixels`` (unique) with RGB ``rgb`` (k, 3): the count, and twice the RGB
+            into aux where it is the pixel's sample in the half set."""
+            count = flat["count"][pixels]
+            half = in_half(count)
+            flat["count"][pixels] = count + 1.0
+            sel = pixels[half]
+            flat["aux"][sel] += 2.0 * rgb[half]
+
         def add_batch(c):
             """A chunk of ``batch`` samples per pixel (no reservoirs or glass chains: those passes do not batch):
             each result summed over the samples of its pixel."""
             n = len(c.pixels) // c.batch
-            span = slice(int(c.pixels[0]), int(c.pixels[0]) + n)
-            flat["emit"][span] += c.hits.emitted.reshape(3, c.batch, n).sum(axis=1).T
+            base = c.pixels[:n]
+            span = _pixels(base)
+            emitted = c.hits.emitted.reshape(3, c.batch, n)
+            flat["emit"][span] += emitted.sum(axis=1).T
             flat["alpha"][span] += c.hits.alpha.reshape(c.batch, n).sum(axis=0)
+            rgb = np.ascontiguousarray(emitted.transpose(1, 2, 0), dtype=np.float64) if "aux" in flat else None
 
-            def add_rows(key, value):  # (3, hits) values of the hit rows, summed into their pixels
+            def add_rows(key, value, light=False):  # (3, hits) values of the hit rows, summed into their pixels
                 dense = np.zeros((len(c.pixels), 3), np.float32)
                 dense[c.hits.rows] = value.T
-                flat[key][span] += dense.reshape(c.batch, n, 3).sum(axis=0)
+                dense = dense.reshape(c.batch, n, 3)
+                flat[key][span] += dense.sum(axis=0)
+                if light and rgb is not None:
+                    rgb[...] += dense
 
             for key, value in (("direct", c.direct), ("indirect", c.indirect)):
                 if value is not None:
-                    add_rows(key, value)
+                    add_rows(key, value, light=True)
+            if rgb is not None:
+                for b in range(c.batch):  # the samples of the pass, in order
+                    add_adaptive(base, rgb[b])
             if "albedo" in flat and len(c.hits.rows):
                 add_rows("albedo", denoising_albedo(c.hits.surf))
                 add_rows("dnormal", world_to_cam @ c.hits.surf.ns)
 
         map_tasks(add, chunks, stop)
 
+    def _inverse_counts(self):
+        """1 / samples: a scalar, or (h, w) float32 per pixel where each pixel's count is kept."""
+        if "count" in self.acc:
+            return (1.0 / np.maximum(self.acc["count"], 1.0)).astype(np.float32)
+        return np.float32(1.0 / max(1, self.samples))
+
     def combined(self) -> np.ndarray:
         """The running mean of Combined (h, w, 4) float32: emission + direct + indirect, and alpha."""
-        inv = 1.0 / max(1, self.samples)
+        inv = self._inverse_counts()
         h, w = self.acc["alpha"].shape
         out = np.empty((h, w, 4), np.float32)
         np.add(self.acc["emit"], self.acc["direct"], out=out[..., :3], casting="unsafe")
         out[..., :3] += self.acc["indirect"]
-        out[..., :3] *= np.float32(inv)
+        out[..., :3] *= inv if np.ndim(inv) == 0 else inv[..., None]
         np.multiply(self.acc["alpha"], inv, out=out[..., 3], casting="unsafe")
         return finite(out)
 
     def mean(self, key: str) -> np.ndarray:
         """The running mean of accumulator ``key`` as (h, w, c) float32 (c = 1 for scalar ones), finite."""
         a = self.acc[key]
-        out = np.multiply(a, np.float32(1.0 / max(1, self.samples)), out=np.empty(a.shape, np.float32),
-                          casting="unsafe")
+        inv = self._inverse_counts()
+        if np.ndim(inv) and a.ndim == 3:
+            inv = inv[..., None]
+        out = np.multiply(a, inv, out=np.empty(a.shape, np.float32), casting="unsafe")
         return finite(out if out.ndim == 3 else out[..., None])
+
+    def sample_counts(self) -> np.ndarray | None:
+        """(h, w, 1) float32: each pixel's samples, where adaptive sampling keeps them (else None)."""
+        return None if "count" not in self.acc else self.acc["count"].astype(np.float32)[..., None]
 
     def passes(self, reservoirs: bool) -> dict:
         """{pass name: (h, w, c) float32} of the light passes, and the reservoir passes where ``reservoirs`` (DI)
@@ -158,6 +207,8 @@ class Film:
         if "gi_m" in self.acc:
             jobs["GI Reservoir M"] = lambda: mean("gi_m")
             jobs["GI Reservoir UCW"] = lambda: mean("gi_w")
+        if "count" in self.acc:
+            jobs["Sample Count"] = self.sample_counts
         if "albedo" in self.acc:
             jobs["Denoising Albedo"] = lambda: mean("albedo")
             jobs["Denoising Normal"] = lambda: mean("dnormal")

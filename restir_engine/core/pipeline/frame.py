@@ -24,7 +24,7 @@ from ..integrators.context_cache import context_for, fingerprint
 from ..integrators.method_choice import GI_MIN_SHARE
 from ..modes import DirectMethod, Integrator
 from ..parallel.pool import quiet_float_errors, thread_count
-from ..parallel.tasks import Progress, Stopped, spans
+from ..parallel.tasks import Progress, Stopped, chunk_size, spans
 from ..parallel.team import Solo
 from ..profile import NullClock
 from ..restir import di, gi
@@ -33,6 +33,7 @@ from ..restir.target import WIDTH, ShadingTerms
 from ..sampling import finite
 from ..scene import Scene
 from . import coverage as coverage_mod
+from .adaptive import AdaptiveSampling
 from . import direct, methods, paths, primary, reuse, shade
 from .data_passes import render_data_passes
 from .film import Film
@@ -175,7 +176,11 @@ class FrameRenderer:
                                          coverage_mod.lamp_mask(self.ctx, camera))
         _x0, _y0, w, h = camera.window
         self.release()
-        self.film = Film(w, h, self.gi is not None, self.settings.denoise_data, self.film_zeros)
+        st = self.settings
+        self.film = Film(w, h, self.gi is not None, st.denoise_data, self.film_zeros, st.use_adaptive_sampling)
+        # adaptive sampling: which pixels the next passes sample (pipeline/adaptive.py)
+        self.adaptive = AdaptiveSampling(w, h, st.samples, st.adaptive_threshold, st.adaptive_min_samples) \
+            if st.use_adaptive_sampling else None
         self._surfaces_per_chunk = None  # surfaces per chunk and sample in the last pass (batch_size)
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
         self.gi_skipped = 0  # samples whose pass kept path-traced indirect light (GI_MIN_SHARE)
@@ -188,6 +193,11 @@ class FrameRenderer:
     @property
     def samples_done(self) -> int:
         return self.film.samples
+
+    @property
+    def converged(self) -> bool:
+        """Adaptive sampling stopped every pixel: the frame needs no more passes."""
+        return self.adaptive is not None and self.adaptive.finished
 
     def has_pass_data(self, key: str) -> bool:
         """Whether the film accumulates ``key`` (film.py lists the keys)."""
@@ -248,10 +258,12 @@ class FrameRenderer:
         if not self._can_batch():
             return 1
         if st.sample_batch > 0:
-            return max(1, min(remaining, int(st.sample_batch)))
-        if self._surfaces_per_chunk is None:
+            batch = max(1, min(remaining, int(st.sample_batch)))
+        elif self._surfaces_per_chunk is None:
             return 1
-        return max(1, min(remaining, MAX_BATCH, int(st.tile_pixels // max(self._surfaces_per_chunk, 1.0))))
+        else:
+            batch = max(1, min(remaining, MAX_BATCH, int(st.tile_pixels // max(self._surfaces_per_chunk, 1.0))))
+        return batch if self.adaptive is None else self.adaptive.cap(self.samples_done, batch)
 
     def _can_batch(self) -> bool:
         """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
@@ -282,6 +294,8 @@ class FrameRenderer:
         hist = self.prev_history
         first_with_history = st.temporal_reuse and s == 0 and hist is not None
         return PassPlan(
+            window_step=chunk_size(w * h, st.tile_pixels), partial=self.adaptive is not None and
+            self.adaptive.active is not None,
             seed=st.seed, frame=st.frame, sample=s, batch=max(1, int(batch)), resampled=resampled,
             reusing=self.method == DirectMethod.RESTIR, temporal=first_with_history and hist.res is not None, gi=gi_on,
             gi_temporal=first_with_history and hist.gi_res is not None, probe=probe,
@@ -307,7 +321,9 @@ class FrameRenderer:
         st, ctx, clock, team = self.settings, self.ctx, self.clock, self.team
         plan = self._plan(batch, cap)
         _x0, _y0, w, h = ctx.scene.camera.window
-        chunks = make_chunks(spans(w * h, st.tile_pixels), plan.batch)
+        active = None if self.adaptive is None else self.adaptive.pixels()
+        chunks = make_chunks(spans(w * h, st.tile_pixels), plan.batch) if active is None else \
+            make_chunks([active[sl] for sl in spans(len(active), st.tile_pixels)], plan.batch)
         team.begin_pass(first=plan.sample == 0, chunks=len(chunks))
         mine = own(chunks, team)  # the chunks this process computes (all of them when it renders alone)
         # chunk tasks of the pass, for progress (reuse maps over about as many surface chunks per pass)
@@ -368,6 +384,9 @@ class FrameRenderer:
         with run.stage("passes"):
             world_to_cam = np.ascontiguousarray(ctx.scene.camera.cam_to_world[:3, :3].T, dtype=np.float32)
             self.film.accumulate(mine, plan.resampled, world_to_cam, run.stop)
+        if self.adaptive is not None and self.adaptive.due(plan.sample + plan.batch):
+            team.barrier()  # every process's samples are in the film
+            self.adaptive.check(self.film, plan.sample + plan.batch)
         return plan.batch
 
     def _gi_outcome(self, plan: PassPlan, chunks) -> bool:
@@ -448,7 +467,7 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     t0 = time.perf_counter()
     fr = FrameRenderer(scene, settings, history, clock)
     cancelled = False
-    while fr.samples_done < settings.samples and not out_of_time(settings, t0, fr.samples_done):
+    while fr.samples_done < settings.samples and not fr.converged and not out_of_time(settings, t0, fr.samples_done):
         s = fr.samples_done
         batch = 1 if settings.time_limit > 0 else fr.batch_size(settings.samples - s)  # a limit: checked per sample
         report = None
@@ -490,6 +509,8 @@ def frame_stats(fr: FrameRenderer, scene: Scene, clock) -> dict:
              "indirect_reason": fr.indirect.reason,
              "gi_skipped_passes": fr.gi_skipped,
              "gi_spatial_radius": fr.gi.radius if fr.gi is not None else None}
+    if fr.adaptive is not None:
+        stats["adaptive"] = fr.adaptive.stats()
     if clock is not None:
         stats["stages"] = clock.stages
     return stats

@@ -37,6 +37,7 @@ class PassPlan:
     world_resampled: the world's points are in the DI reservoirs (else the world is light-sampled at shading)
     continuing:  the path continuation has something to add (bounces, or the BSDF ray's emission)
     strata:      camera rays per pixel for the emission seen directly (coverage.coverage)
+    partial:     the pass samples only the pixels adaptive sampling left active (the others keep their film)
     """
 
     seed: int
@@ -55,6 +56,8 @@ class PassPlan:
     strata: int
     candidates: di.CandidateSettings | None = None
     light_tiles: bool = False
+    window_step: int = 0  # pixels per chunk of a pass over the whole window (per-pixel streams: primary.py)
+    partial: bool = False  # adaptive sampling: the pass samples only the pixels still active
 
     def rng(self, stream: int, chunk: int = 0, sample: int | None = None):
         """The random stream ``stream`` of chunk ``chunk`` in this pass (``sample`` overrides the pass index)."""

@@ -41,8 +41,7 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     s = plan.sample
     r = plan.rng(STREAM_CAMERA, c.index)
     span = len(c.pixels) // c.batch
-    shift = plan.rng(STREAM_PIXEL_OFFSET, c.index, sample=0).bit_generator.random_raw(span)
-    shift = shift.view(np.uint32).reshape(-1, 2)
+    shift = pixel_shifts(plan, c.pixels[:span])
     j = pass_jitter(shift, s) if c.batch == 1 else np.concatenate([pass_jitter(shift, s + b) for b in range(c.batch)])
     px = (x0 + c.pixels % w).astype(np.float32)
     py = (y0 + c.pixels // w).astype(np.float32)
@@ -70,6 +69,26 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     inv = np.float32(1.0 / strata)
     c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
     c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
+
+
+def pixel_shifts(plan: PassPlan, pixels: np.ndarray) -> np.ndarray:
+    """(n, 2) uint32: the digital shifts of window ``pixels`` (increasing), the same in every pass whatever chunk a
+    pixel falls in: drawn per chunk of the frame's whole-window layout (plan.window_step pixels each, in pixel
+    order), which a pass of every pixel uses, and looked up from there by a pass of fewer (adaptive sampling)."""
+    step = plan.window_step
+    assert step > 0, "the plan names its whole-window chunk size"
+    first, last = int(pixels[0]) // step, int(pixels[-1]) // step
+    if first == last and int(pixels[-1]) - int(pixels[0]) + 1 == len(pixels) and int(pixels[0]) % step == 0:
+        raw = plan.rng(STREAM_PIXEL_OFFSET, first, sample=0).bit_generator.random_raw(len(pixels))
+        return raw.view(np.uint32).reshape(-1, 2)
+    out = np.empty(len(pixels), np.uint64)
+    owner = pixels // step
+    for u in np.unique(owner):  # the few layout chunks the pixels fall in
+        sel = np.flatnonzero(owner == u)
+        local = pixels[sel] - int(u) * step
+        raw = plan.rng(STREAM_PIXEL_OFFSET, int(u), sample=0).bit_generator.random_raw(int(local[-1]) + 1)
+        out[sel] = raw[local]
+    return out.view(np.uint32).reshape(-1, 2)
 
 
 def gbuffer(ctx, chunks: list[Chunk], terms: np.ndarray, team) -> GBuffer:

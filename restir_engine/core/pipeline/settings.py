@@ -27,6 +27,9 @@ class RenderSettings:
 
     samples: int = 16
     time_limit: float = 0.0  # seconds a frame may render before it stops after the pass that ran past it; 0 = none
+    use_adaptive_sampling: bool = False  # pixels whose noise estimate fell under the threshold stop (adaptive.py)
+    adaptive_threshold: float = 0.01  # the Noise Threshold; 0 = automatic (adaptive.threshold_for)
+    adaptive_min_samples: int = 0  # samples before the first check; 0 = automatic (adaptive.min_samples_for)
     seed: int = 0
     max_bounces: int = 4
     frame: int = 0

@@ -49,9 +49,9 @@ def slot_bytes(pixels: int, st: RenderSettings) -> int:
     return int((pixels * (per + PIXEL_BYTES)) * SLACK) + FIXED_BYTES
 
 
-def film_bytes(w: int, h: int, gi: bool, denoise_data: bool) -> int:
+def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = False) -> int:
     from ..parallel.team import ALIGN
-    return sum(-(-(w * h * c * 8) // ALIGN) * ALIGN for _key, c in film_keys(gi, denoise_data)) + ALIGN
+    return sum(-(-(w * h * c * 8) // ALIGN) * ALIGN for _key, c in film_keys(gi, denoise_data, adaptive)) + ALIGN
 
 
 def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
@@ -64,8 +64,9 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         cam = scene.camera
         _x0, _y0, w, h = cam.window
         gi = methods.gi_possible(settings)
-        film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data))
-        film = Film(w, h, gi, settings.denoise_data, zeros)
+        adaptive = settings.use_adaptive_sampling
+        film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data, adaptive))
+        film = Film(w, h, gi, settings.denoise_data, zeros, adaptive)
         slots = team.ensure_slots(slot_bytes(w * h, settings))
         usable = isinstance(history, SharedHistory) and history.team == team.id and history.fits(cam)
         seg, packed = wire.pack(scene)
@@ -91,7 +92,10 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
             if replies is None:
                 cancelled = True
                 break
-            done += int(replies[0])
+            rendered, converged = replies[0]
+            done += int(rendered)
+            if converged:  # adaptive sampling stopped every pixel
+                break
         token = team.next_token()
         out = team.run(("finish", token))[0]
         if done == 0:

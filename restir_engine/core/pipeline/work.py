@@ -41,9 +41,12 @@ class Chunk:
 
 
 def make_chunks(span_list, batch: int) -> list[Chunk]:
-    """One chunk per pixel span, each holding its span ``batch`` times (one copy per sample of the pass)."""
-    return [Chunk(i, np.arange(sl.start, sl.stop) if batch == 1 else np.tile(np.arange(sl.start, sl.stop), batch),
-                  batch) for i, sl in enumerate(span_list)]
+    """One chunk per pixel span (a slice, or an increasing array of window pixels: the pixels adaptive sampling
+    left active), each holding its span ``batch`` times (one copy per sample of the pass)."""
+    def pixels(sl):
+        return np.arange(sl.start, sl.stop) if isinstance(sl, slice) else np.asarray(sl, np.int64)
+    return [Chunk(i, pixels(sl) if batch == 1 else np.tile(pixels(sl), batch), batch)
+            for i, sl in enumerate(span_list)]
 
 
 def place(chunks: list[Chunk], team) -> int:

@@ -5,7 +5,8 @@ Messages (tuples from the rendering process; each is answered with ("ok", pickle
 ("error", text)):
   ("frame", frame)  build the frame's renderer: the scene (wire.pack), settings, the history token it may reuse,
                     the film's and the arena slots' segments
-  ("pass", left)    render the next sample pass (at most ``left`` samples); payload: the samples it rendered
+  ("pass", left)    render the next sample pass (at most ``left`` samples); payload: (the samples it rendered,
+                    whether adaptive sampling stopped every pixel)
   ("finish", token) end the frame: keep its history under ``token``; the leader's payload: the frame's stats, data
                     passes and whether the film has reservoir passes
   ("ping",)         answer once started (the core imported)
@@ -88,7 +89,7 @@ class _Worker:
                 self.progress.value = fraction
         if not fr.sample_pass(report, self.team.stopping, batch):
             return None
-        return batch
+        return batch, fr.converged
 
     def finish(self, token: int):
         from .frame import frame_stats
