@@ -30,10 +30,10 @@ def threshold_for(threshold: float, samples: int) -> float:
 
 
 def min_samples_for(min_samples: int, threshold: float) -> int:
-    """Samples every pixel takes before the first check: the setting, or (0 = automatic) ⌈16 / threshold^0.3⌉, at
-    least MIN_FLOOR."""
+    """Samples every pixel takes before the first check: the setting, or (0 = automatic) ⌈16 / threshold^0.3⌉; at
+    least MIN_FLOOR either way."""
     if min_samples > 0:
-        return int(min_samples)
+        return max(MIN_FLOOR, int(min_samples))
     return max(MIN_FLOOR, int(math.ceil(16.0 / threshold ** 0.3)))
 
 
