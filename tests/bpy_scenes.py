@@ -571,6 +571,36 @@ def refraction_scene(size=(96, 64)):
                                         lambda: glass_material("Low refraction", "REFRACTION", 1.2, roughness=0.1)])
 
 
+def absorbing_glass_scene(size=(96, 64)):
+    """glass_scene with smooth Glass BSDFs (IOR 1.45) filled with Volume Absorption: amber (Color (0.9, 0.5, 0.2),
+    Density 2 per metre of the 1 m spheres), blue through a Mix Shader of two absorptions (Color (0.2, 0.4, 0.9),
+    Density 3 at factor 0.5 with Density 0), and a Principled glass with a dense green (Color (0.3, 0.9, 0.3),
+    Density 4)."""
+    def absorbing(name, kind, color, density, mix=False):
+        def make():
+            m = glass_material(name, kind)
+            tree = m.node_tree
+            out = next(n for n in tree.nodes if n.type == "OUTPUT_MATERIAL")
+            vol = tree.nodes.new("ShaderNodeVolumeAbsorption")
+            vol.inputs["Color"].default_value = (*color, 1)
+            vol.inputs["Density"].default_value = density
+            if not mix:
+                tree.links.new(vol.outputs[0], out.inputs["Volume"])
+                return m
+            clear = tree.nodes.new("ShaderNodeVolumeAbsorption")
+            clear.inputs["Density"].default_value = 0.0
+            mixer = tree.nodes.new("ShaderNodeMixShader")
+            mixer.inputs[0].default_value = 0.5
+            tree.links.new(clear.outputs[0], mixer.inputs[1])
+            tree.links.new(vol.outputs[0], mixer.inputs[2])
+            tree.links.new(mixer.outputs[0], out.inputs["Volume"])
+            return m
+        return make
+    return glass_scene(size, materials=[absorbing("Amber", "GLASS", (0.9, 0.5, 0.2), 2.0),
+                                        absorbing("Blue", "GLASS", (0.2, 0.4, 0.9), 3.0, mix=True),
+                                        absorbing("Green", "PRINCIPLED", (0.3, 0.9, 0.3), 4.0)])
+
+
 def beckmann_glass_scene(size=(96, 64)):
     """glass_scene with Glass BSDFs of the Beckmann distribution: roughness 0.3 (IOR 1.45), 0.5 tinted, 0.15 (IOR
     1.2)."""

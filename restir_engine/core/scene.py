@@ -106,6 +106,9 @@ class MaterialTable:
     glass_beckmann (m,) 1: Beckmann's microfacet distribution (the Refraction BSDF's default), 0: GGX
     glass_fresnel (m,)  1: the Fresnel term chooses reflection or refraction (Glass BSDF, Principled); 0: it always
                         refracts, untinted by Fresnel (Refraction BSDF; total internal reflection absorbs)
+    absorption  (m, 3)  the material's Volume Absorption coefficient σa, per scene unit of length ((1 − Color) x Density,
+                        as Cycles): a ray that travels inside the closed mesh and leaves it through its surface keeps
+                        exp(−σa · distance) of its light (0: no volume)
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
@@ -153,6 +156,7 @@ class MaterialTable:
     mix_weight: np.ndarray = None
     mix_tex: np.ndarray = None
     mix_sign: np.ndarray = None
+    absorption: np.ndarray = None
     holdout: np.ndarray = None  # (m,) bool: a Holdout shader (camera rays meeting it give alpha 0, black)
     program: np.ndarray = None
     programs: list = field(default_factory=list)
@@ -183,6 +187,7 @@ class MaterialTable:
             glass_alpha=col("glass_alpha", 0.0), glass_multiscatter=col("glass_multiscatter", 1.0),
             glass_fresnel=col("glass_fresnel", 1.0), glass_beckmann=col("glass_beckmann", 0.0),
             diffuse_roughness=col("diffuse_roughness", 0.0), holdout=col("holdout", False, bool),
+            absorption=col("absorption", (0.0, 0.0, 0.0)),
             **_mix_arrays(rows), **_programs(rows), **_programs(rows, "aov_program"),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])
 

@@ -122,9 +122,47 @@ class MaterialRegistry:
         outs = [n for n in tree.nodes if n.type == "OUTPUT_MATERIAL" and n.is_active_output
                 and n.target in {"ALL", "CYCLES"}] or [n for n in tree.nodes if n.type == "OUTPUT_MATERIAL"]
         if not outs or not outs[0].inputs["Surface"].is_linked:
-            self._warn(material, "no surface shader connected to the Material Output; rendered black")
+            volume_too = bool(outs) and "Volume" in outs[0].inputs and outs[0].inputs["Volume"].is_linked
+            self._warn(material, "no surface shader connected to the Material Output; rendered black" +
+                       (" (its volume is not rendered)" if volume_too else ""))
             return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
-        return self._shader(material, outs[0].inputs["Surface"].links[0].from_node, depth=0)
+        row = self._shader(material, outs[0].inputs["Surface"].links[0].from_node, depth=0)
+        volume = outs[0].inputs.get("Volume") if hasattr(outs[0].inputs, "get") else None
+        if volume is not None and volume.is_linked:
+            sigma = self._absorption(material, volume.links[0].from_node)
+            if sigma is not None and max(sigma) > 0:
+                row["absorption"] = sigma
+        return row
+
+    def _absorption(self, material, node):
+        """The Volume Absorption coefficient σa (3,) per scene unit of the shader on a Material Output's Volume
+        socket, as Cycles: (1 − Color) x Density, summed over Add Shaders, weighted by Mix Shader factors; what is
+        not absorption (scattering, emission, Principled Volume) is named and not rendered."""
+        while node is not None and node.type == "REROUTE":
+            node = node.inputs[0].links[0].from_node if node.inputs[0].is_linked else None
+        if node is None or node.mute:
+            return None
+        if node.type == "VOLUME_ABSORPTION":
+            color = np.maximum(np.array(self._color_input(material, node.inputs["Color"], None, {}, (0.8,) * 3),
+                                        np.float64), 0.0)
+            density = max(self._float_input(material, node.inputs["Density"]), 0.0)
+            return tuple(float(v) for v in (1.0 - color) * density)
+        if node.type in {"ADD_SHADER", "MIX_SHADER"}:
+            shaders = [i for i in node.inputs if i.type == "SHADER"]
+            weights = [1.0, 1.0]
+            if node.type == "MIX_SHADER":
+                fac = min(max(self._float_input(material, node.inputs[0]), 0.0), 1.0)
+                weights = [1.0 - fac, fac]
+            total = np.zeros(3)
+            for sock, w in zip(shaders, weights):
+                if sock.is_linked and w > 0:
+                    part = self._absorption(material, sock.links[0].from_node)
+                    if part is not None:
+                        total += w * np.asarray(part)
+            return tuple(float(v) for v in total)
+        self._warn(material, f"volume shader '{node.name}' ({node.type}) is not rendered: only Volume Absorption "
+                   "inside closed meshes is")
+        return None
 
     def _aov_program(self, material):
         """The material's AOV Output nodes as one program: fields "aov:<name>" (Color) and "aov_value:<name>"

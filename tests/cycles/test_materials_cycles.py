@@ -277,6 +277,22 @@ def test_refraction_bsdf_matches_cycles(addon):
     assert_cells_match(ours, ref, [f"cell {k}" for k in range(16)], power=[4, 5, 6, 7, 8, 9, 10, 11])
 
 
+def test_volume_absorption_matches_cycles(addon):
+    """Glass spheres filled with Volume Absorption (amber, blue through a Mix Shader, a dense green inside a
+    Principled glass: σa = (1 − Color) x Density per metre, as Cycles), per 4 x 4 image cell against Cycles (4
+    bounces, the path tracer; ReSTIR DI as the path tracer treats glass); the cells through the spheres able to see
+    a 3 % error. Before, the Volume socket was ignored without a word: the spheres rendered clear."""
+    from bpy_scenes import absorbing_glass_scene
+    size = (96, 64)
+    build = lambda: absorbing_glass_scene(size)  # noqa: E731
+    ours, ref = both("volume_absorption", build, 4, 128, 256, by_masks(image_cells(size)), integrator="PATH")
+    names = [f"cell {k}" for k in range(16)]
+    assert_cells_match(ours, ref, names, power=[4, 5, 6, 7])
+    ours = ours_cells(build, 4, 64, by_masks(image_cells(size)), integrator="RESTIR", direct_method="RESTIR",
+                      bias_correction="UNBIASED", indirect_method="PATH")
+    assert_cells_match(ours, ref, names, power=[5, 6])
+
+
 def test_beckmann_glass_matches_cycles(addon):
     """Glass BSDFs of the Beckmann distribution (rough 0.3, tinted 0.5, IOR 1.2 at 0.15: Beckmann normals and
     Smith term, no energy compensation, as Cycles), per 4 x 4 image cell (4 bounces, the path tracer), the cells

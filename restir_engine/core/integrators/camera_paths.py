@@ -10,6 +10,7 @@ import numpy as np
 from ..geometry import camera as camera_mod
 from ..geometry.accel import Hits
 from ..lights.table import emitted_radiance
+from ..materials import volume
 from ..materials.surface import Surface
 from ..sampling import cols, finite
 from .pathtracer import _lamp_emission, lamp_hits, sample_rays
@@ -170,6 +171,9 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
         thr[:, idx] *= ray.f
         depth[idx] += 1
         hit = ctx.geom_accel.intersect(ray.o, ray.d)
+        absorbed = volume.transmittance(ctx, hit.prim, hit.t, ray.d)  # the segment inside an absorbing mesh
+        if absorbed is not None:
+            thr[:, idx] *= absorbed
         em, _a = _seen(ctx, ray.o, ray.d, None, hit, camera=False)
         pix = hits.rows[idx]
         hits.emitted[:, pix] += finite(cols(thr, idx) * em)

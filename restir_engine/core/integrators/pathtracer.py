@@ -28,6 +28,7 @@ from ..materials.bsdf import diffuse_f, eval_view, sample_bsdf
 from ..materials.glass import DELTA_PDF, sample_glass
 from ..materials.params import SurfaceParams
 from ..materials.surface import Surface
+from ..materials import volume
 from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
 from .trace_context import TraceContext
 
@@ -352,6 +353,11 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             hits = ctx.geom_accel.intersect(o, d)
         else:
             hits = hits.take(keep)
+        absorbed = volume.transmittance(ctx, hits.prim, hits.t, d)  # rays that crossed an absorbing mesh
+        if absorbed is not None:
+            throughput = throughput * absorbed
+            if dthr is not None:
+                dthr = dthr * absorbed
         # emission found by the BSDF ray: lamps in front of the hit, then the hit itself, else the world; when
         # the first surfaces' direct light is resampled, only what their delta (glass) rays find, which
         # resampling cannot reach
