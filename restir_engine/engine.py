@@ -9,6 +9,8 @@ import numpy as np
 
 from . import passes as pass_table
 from .core.pipeline import memory, methods
+from .core.pipeline.bands import bands_needed as band_count
+from .core.pipeline.bands import margin_rows
 from .core.renderer import Cancelled, RenderSettings, render_frame
 from .export import ExportError, export_scene, neighbour_frames
 from .properties import scene_settings_to_core
@@ -157,14 +159,20 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, msg)
         if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
             self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
-        estimate = memory.frame_estimate(core_scene, settings)
-        refusal, caution = memory.memory_problem(estimate, memory.available_memory(), settings)
+        free = memory.available_memory()
+        bands = band_count(core_scene, settings, free)
+        estimate = memory.banded_estimate(core_scene, settings, bands, margin_rows(settings, core_scene.camera),
+                                          keeps_history=self.is_animation)
+        refusal, caution = memory.memory_problem(estimate, free, settings)
         if refusal:  # refused before any work, rather than failing part-way or taking all of the machine's memory
             self.report({"ERROR"}, refusal)
             self.error_set(refusal)
             return
         if caution:
             self.report({"WARNING"}, caution)
+        if bands > 1:
+            self.report({"INFO"}, f"Rendering in {bands} bands of the image to stay within memory (about "
+                                  f"{memory.size_text(estimate.high)} at most)")
         if core_scene.camera.blind:  # a camera scaled to zero sees nothing: a black frame, no history
             self._write(_black_passes(scene, view_layer, core_scene.camera.window), core_scene.camera.window,
                         scene, view_layer)
@@ -181,7 +189,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
 
         try:
             result = render_frame(core_scene, settings, progress=progress, should_stop=self.test_break,
-                                  history=history)
+                                  history=history, bands=bands, keep_history=self.is_animation)
         except Cancelled:
             return
         except MemoryError:

@@ -426,7 +426,8 @@ def out_of_time(settings: RenderSettings, t0: float, done: int) -> bool:
 
 
 def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
-                 clock=None, processes: int | None = None) -> FrameResult:
+                 clock=None, processes: int | None = None, bands: int | None = None,
+                 keep_history: bool = True, history_slots: int = 1) -> FrameResult:
     """Render one frame with the chosen integrator, in ``processes`` worker processes (None: the count that
     parallel.processes.process_count chooses for the thread count; 1: in this process), at most one per chunk of
     pixels. The same seed gives the same image either way.
@@ -436,8 +437,25 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     progress(fraction, message) is called as chunks finish; should_stop() is polled while they run,
     and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none). ``history`` is the
     result's history of the previous frame (rendered the same way; another kind is not reused).
+
+    ``bands``: horizontal bands the window is rendered in (bands.py; None: as many as keep one band's working set
+    within memory.band_budget, 1 for most frames); a banded frame keeps its bands' histories only with
+    ``keep_history`` (an animation's next frame needs them, a still's does not); ``history_slots``: histories worker
+    processes keep (one per band of the banded frame this one belongs to).
     """
     from ..parallel import processes as procs
+    from . import bands as bands_mod
+    if bands is None:
+        from . import memory
+        bands = bands_mod.bands_needed(scene, settings, memory.available_memory())
+    if bands > 1:
+        def one(sc, st, report, stop, hist, clk):
+            result = render_frame(sc, st, report, stop, hist, clk, processes, bands=1,
+                                  history_slots=bands if keep_history else 1)
+            if not keep_history:
+                result.history = None
+            return result
+        return bands_mod.render_in_bands(one, scene, settings, bands, progress, should_stop, history, clock)
     _x0, _y0, w, h = scene.camera.window
     chunks = len(spans(w * h, settings.tile_pixels))
     n = procs.process_count(thread_count(), chunks) if processes is None else min(int(processes), chunks)
@@ -458,7 +476,7 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
             note = f"render worker processes could not start ({exc}): rendering in one process"
     if team is not None:
         from .shared_frame import render_frame_shared
-        result = render_frame_shared(scene, settings, team, progress, should_stop, history, clock)
+        result = render_frame_shared(scene, settings, team, progress, should_stop, history, clock, history_slots)
         if note:
             result.stats["processes_note"] = note
         return result

@@ -22,6 +22,11 @@ FIXED = 64 << 20  # bytes that do not grow with the image (tables, pools, the po
 BVH_PER_TRIANGLE = 160  # Embree's BVH (outside NumPy)
 WORKER_FIXED = 128 << 20  # a worker process's own: its interpreter, NumPy, Embree and the core's tables
 WORKER_PER_PIXEL = 48     # a worker's private whole-image arrays (G-buffer slots, its copy of the history's M, W)
+FRAME_WIDE = 260  # of BASE, what a banded frame keeps for its whole window: the film's sums and the passes
+HISTORY = 240     # a ReSTIR band's temporal history (G-buffer, DI reservoirs), kept for the whole window
+GI_HISTORY = 260  # ... and the GI reservoirs' and terms'
+BAND_BYTES = 1536 << 20  # one band's working set at most (pipeline/bands.py)
+MIN_BAND_ROWS = 32
 
 
 @dataclass(frozen=True)
@@ -63,6 +68,28 @@ def per_pixel_range(st) -> tuple[int, int]:
         elif methods.gi_auto(st):  # the probe's own cost is part of GI's; choosing path tracing costs nothing more
             high += GI
     return low, high
+
+
+def band_budget(free: int | None) -> int:
+    """Bytes one band's working set may take: BAND_BYTES, or half the free memory where that is less."""
+    return BAND_BYTES if free is None else max(64 << 20, min(BAND_BYTES, free // 2))
+
+
+def banded_estimate(scene, settings, bands: int, margin: int, keeps_history: bool) -> MemoryEstimate:
+    """The peak of ``scene`` rendered in ``bands`` bands of ``margin`` extra rows each side: the whole window's film
+    and passes (FRAME_WIDE) and histories (where ``keeps_history``), and one band's working set."""
+    if bands <= 1:
+        return frame_estimate(scene, settings)
+    _x0, _y0, w, h = scene.camera.window
+    pixels = int(w) * int(h)
+    band_pixels = int(w) * min(int(h), -(-int(h) // bands) + 2 * margin)
+    low, high = per_pixel_range(settings)
+    hist = 0
+    if keeps_history and settings.integrator == Integrator.RESTIR:
+        hist = HISTORY + (GI_HISTORY if methods.gi_possible(settings) else 0)
+    scene_bytes = scene_size(scene)
+    whole = FIXED + scene_bytes + (FRAME_WIDE + hist) * pixels
+    return MemoryEstimate(whole + low * band_pixels, whole + high * band_pixels, pixels, scene_bytes)
 
 
 def scene_size(scene) -> int:

@@ -55,9 +55,10 @@ def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = Fa
 
 
 def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
-                        history=None, clock=None) -> FrameResult:
+                        history=None, clock=None, keep_histories: int = 1) -> FrameResult:
     """:func:`frame.render_frame` on ``team``'s workers (same arguments and result; ``history`` a SharedHistory
-    of this team, anything else is not reused)."""
+    of this team, anything else is not reused); the workers keep the newest ``keep_histories`` histories (one per
+    band of a banded frame)."""
     validate(settings)
     t0 = time.perf_counter()
     with team.lock:
@@ -73,6 +74,7 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         try:
             team.run(("frame", {"scene": packed, "settings": wire.dumps(settings), "sender": wire.core_name(),
                                 "history": history.token if usable else None, "film": film_name, "slots": slots,
+                                "keep_histories": int(keep_histories),
                                 "costs": team.costs_seg.name, "clock": clock is not None}))
         finally:  # every worker attached (or the team is gone): the name is no longer needed
             wire.unlink_segments([seg])

@@ -23,6 +23,7 @@ from ..parallel.pool import set_thread_count
 from ..parallel.team import Arena, Team, film_zeros
 
 KEEP_SCENES = 3  # scene segments a worker keeps attached (a context may still refer to the last frames' arrays)
+KEEP_HISTORIES = 1  # temporal histories a worker keeps by default: the last frame's (a banded frame: one per band)
 
 
 class _Worker:
@@ -37,7 +38,8 @@ class _Worker:
         self.fr = None
         self.scene = None
         self.clock = None
-        self.history, self.history_token = None, None
+        self.histories: dict = {}  # token -> the temporal history of the frame (or band) it named
+        self.keep_histories = KEEP_HISTORIES
 
     # -- segments --------------------------------------------------------------------------------------------
     def _slots(self, names, costs: str) -> None:
@@ -48,7 +50,7 @@ class _Worker:
         self.slot_segs, self.slot_names = segs, (names, costs)
         self.team = Team(self.rank, self.size, self.barrier, [Arena(s.buf, s.name) for s in segs[:3]], self.stop,
                          np.frombuffer(segs[3].buf, np.float64))
-        self.history, self.history_token = None, None  # it lived in the old slots
+        self.histories = {}  # they lived in the old slots
 
     def _film(self, name: str):
         if self.film_seg is None or self.film_seg.name != name:
@@ -72,7 +74,8 @@ class _Worker:
             self._drop(self.scenes[:-KEEP_SCENES])
             del self.scenes[:-KEEP_SCENES]
         settings = wire.loads(frame["settings"], frame["sender"])
-        history = self.history if frame["history"] is not None and frame["history"] == self.history_token else None
+        history = self.histories.pop(frame["history"], None) if frame["history"] is not None else None
+        self.keep_histories = max(KEEP_HISTORIES, int(frame.get("keep_histories", KEEP_HISTORIES)))
         self.clock = StageClock() if frame["clock"] and self.team.leader else None
         self.scene = scene
         self.fr = FrameRenderer(scene, settings, history, self.clock, team=self.team, film_zeros=zeros)
@@ -100,7 +103,9 @@ class _Worker:
             out = {"stats": frame_stats(fr, self.scene, self.clock), "data": data,
                    "reservoirs": fr.candidates is not None, "history": fr.history is not None}
         if fr.history is not None:
-            self.history, self.history_token = fr.history, token
+            self.histories[token] = fr.history
+            for old in sorted(self.histories)[:-self.keep_histories]:
+                del self.histories[old]
         fr.release()
         self.fr = self.scene = None
         return out
@@ -109,7 +114,8 @@ class _Worker:
         try:
             self._serve()
         finally:  # quietly: arrays of the last frame may still view them
-            self.fr = self.scene = self.history = self.team = None
+            self.fr = self.scene = self.team = None
+            self.histories = {}
             self._drop(self.scenes + getattr(self, "slot_segs", []) + ([self.film_seg] if self.film_seg else []))
 
     def _serve(self) -> None:
