@@ -22,7 +22,6 @@ for p in (ROOT, os.path.join(ROOT, "scripts"), os.path.join(ROOT, "tests")):
     sys.path.insert(0, p)
 
 import bpy  # noqa: E402
-import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
 from bpy_scenes import configure_cycles, configure_restir  # noqa: E402

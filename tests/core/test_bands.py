@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from scenes_core import regression_room
 
-from restir_engine.core.geometry.camera import Camera  # noqa: F401  (the scenes' camera type)
 from restir_engine.core.pipeline import bands, memory
 from restir_engine.core.renderer import RenderSettings, render_frame
 
