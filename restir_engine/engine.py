@@ -9,8 +9,7 @@ import numpy as np
 
 from . import passes as pass_table
 from .core.pipeline import memory, methods
-from .core.pipeline.bands import bands_needed as band_count
-from .core.pipeline.bands import margin_rows
+from .core.pipeline.bands import plan as band_plan
 from .core.renderer import Cancelled, RenderSettings, render_frame
 from .export import ExportError, export_scene, neighbour_frames
 from .properties import scene_settings_to_core
@@ -160,9 +159,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
             self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
         free = memory.available_memory()
-        bands = band_count(core_scene, settings, free)
-        estimate = memory.banded_estimate(core_scene, settings, bands, margin_rows(settings, core_scene.camera),
-                                          keeps_history=self.is_animation)
+        bands, margin = band_plan(core_scene, settings, free)
+        estimate = memory.banded_estimate(core_scene, settings, bands, margin, keeps_history=self.is_animation)
         refusal, caution = memory.memory_problem(estimate, free, settings)
         if refusal:  # refused before any work, rather than failing part-way or taking all of the machine's memory
             self.report({"ERROR"}, refusal)

@@ -72,10 +72,15 @@ def test_band_count_follows_the_memory_budget():
     assert bands.bands_needed(scene, st, None) == 1  # a small frame: one band
     cam = scene.camera
     scene.camera = dataclasses.replace(cam, width=3840, height=2160, window=(0, 0, 3840, 2160))
-    n = bands.bands_needed(scene, st, None)
+    n, m = bands.plan(scene, st, None)
     _low, high = memory.per_pixel_range(st)
-    m = bands.margin_rows(st, scene.camera)
     assert n > 1 and high * 3840 * (-(-2160 // n) + 2 * m) <= memory.BAND_BYTES * 1.05
+    assert 0 < m <= bands.margin_rows(st, scene.camera)
+    scene.camera = dataclasses.replace(cam, width=7680, height=4320, window=(0, 0, 7680, 4320))
+    n8, m8 = bands.plan(scene, st, None)  # 8K: the 97-row radius would dwarf a band: cut to a quarter of it
+    assert m8 < bands.margin_rows(st, scene.camera) and 2 * m8 <= (-(-4320 // n8))
+    assert high * 7680 * (-(-4320 // n8) + 2 * m8) <= memory.BAND_BYTES * 1.05
+    scene.camera = dataclasses.replace(cam, width=3840, height=2160, window=(0, 0, 3840, 2160))
     whole = memory.frame_estimate(scene, st)
     banded = memory.banded_estimate(scene, st, n, m, keeps_history=False)
     assert banded.high < whole.high / 3  # 4K with every ReSTIR stage: about 16 GB whole, 3.8 GB banded

@@ -54,14 +54,15 @@ def layout(h: int, bands: int) -> tuple:
 
 
 def render_in_bands(render_one, scene, settings, bands: int, progress=None, should_stop=None, history=None,
-                    clock=None):
-    """:func:`frame.render_frame`'s result for ``scene`` rendered in ``bands`` bands, each by ``render_one(scene,
-    settings, progress, should_stop, history, clock)`` (one band's render_frame)."""
+                    clock=None, margin: int | None = None):
+    """:func:`frame.render_frame`'s result for ``scene`` rendered in ``bands`` bands of ``margin`` extra rows each
+    side (None: :func:`margin_rows`), each by ``render_one(scene, settings, progress, should_stop, history, clock)``
+    (one band's render_frame)."""
     from .frame import Cancelled, FrameResult
     cam = scene.camera
     x0, y0, w, h = cam.window
     rows = layout(h, bands)
-    m = margin_rows(settings, cam)
+    m = margin_rows(settings, cam) if margin is None else int(margin)
     hist = history.histories if isinstance(history, BandHistory) and history.layout == rows else (None,) * len(rows)
     t0 = time.perf_counter()
     passes: dict = {}
@@ -103,15 +104,23 @@ def render_in_bands(render_one, scene, settings, bands: int, progress=None, shou
     return FrameResult(passes, samples or 0, time.perf_counter() - t0, cancelled, stats, keep)
 
 
-def bands_needed(scene, settings, free: int | None) -> int:
-    """Bands a frame of ``scene`` is split into: 1 while one band's working set (memory.BAND_BYTES, or half the
-    free memory where that is less) holds the whole window, else enough bands, each at least MIN_BAND_ROWS tall."""
+def plan(scene, settings, free: int | None) -> tuple[int, int]:
+    """(bands, margin rows) of a frame of ``scene``: one band while one band's working set (memory.band_budget)
+    holds the whole window; else bands whose rows with both margins fit it, each at least MIN_BAND_ROWS tall, the
+    margin (the spatial radius) cut to a quarter of what fits where the radius is large against the band (a pixel
+    at a band's edge then reuses from fewer neighbours, as at the image's edge: still unbiased)."""
     _x0, _y0, w, h = scene.camera.window
     budget = memory.band_budget(free)
     _low, high = memory.per_pixel_range(settings)
-    need = high * w * h
-    if need <= budget:
-        return 1
     m = margin_rows(settings, scene.camera)
-    rows_fit = max(memory.MIN_BAND_ROWS, int(budget // max(high * w, 1)) - 2 * m)
-    return max(1, min(-(-h // rows_fit), max(1, h // memory.MIN_BAND_ROWS)))
+    if high * w * h <= budget:
+        return 1, m
+    fit = max(memory.MIN_BAND_ROWS, int(budget // max(high * w, 1)))  # rows of one band, margins included
+    m = min(m, fit // 4)
+    rows = max(memory.MIN_BAND_ROWS // 2, fit - 2 * m)
+    return max(1, min(-(-h // rows), max(1, h // (memory.MIN_BAND_ROWS // 2)))), m
+
+
+def bands_needed(scene, settings, free: int | None) -> int:
+    """Bands a frame of ``scene`` is split into (:func:`plan`)."""
+    return plan(scene, settings, free)[0]

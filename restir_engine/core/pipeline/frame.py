@@ -445,9 +445,10 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     """
     from ..parallel import processes as procs
     from . import bands as bands_mod
+    from . import memory
+    want, margin = bands_mod.plan(scene, settings, memory.available_memory())
     if bands is None:
-        from . import memory
-        bands = bands_mod.bands_needed(scene, settings, memory.available_memory())
+        bands = want
     if bands > 1:
         def one(sc, st, report, stop, hist, clk):
             result = render_frame(sc, st, report, stop, hist, clk, processes, bands=1,
@@ -455,7 +456,8 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
             if not keep_history:
                 result.history = None
             return result
-        return bands_mod.render_in_bands(one, scene, settings, bands, progress, should_stop, history, clock)
+        return bands_mod.render_in_bands(one, scene, settings, bands, progress, should_stop, history, clock,
+                                         margin if bands == want else None)
     _x0, _y0, w, h = scene.camera.window
     chunks = len(spans(w * h, settings.tile_pixels))
     n = procs.process_count(thread_count(), chunks) if processes is None else min(int(processes), chunks)
