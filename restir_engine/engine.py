@@ -187,7 +187,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
 
         try:
             result = render_frame(core_scene, settings, progress=progress, should_stop=self.test_break,
-                                  history=history, bands=bands, keep_history=self.is_animation)
+                                  history=history, bands=bands, band_margin=margin,
+                                  keep_history=self.is_animation)
         except Cancelled:
             return
         except MemoryError:

@@ -27,9 +27,6 @@ class BandHistory:
     layout: tuple
     histories: tuple
 
-    def fits(self, camera) -> bool:
-        return True  # each band's own history judges its view
-
 
 def band_seed(seed: int, band: int) -> int:
     """The seed of band ``band``: the frame's own for the first, mixed with the index for the others."""

@@ -427,7 +427,7 @@ def out_of_time(settings: RenderSettings, t0: float, done: int) -> bool:
 
 def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
                  clock=None, processes: int | None = None, bands: int | None = None,
-                 keep_history: bool = True, history_slots: int = 1) -> FrameResult:
+                 band_margin: int | None = None, keep_history: bool = True, history_slots: int = 1) -> FrameResult:
     """Render one frame with the chosen integrator, in ``processes`` worker processes (None: the count that
     parallel.processes.process_count chooses for the thread count; 1: in this process), at most one per chunk of
     pixels. The same seed gives the same image either way.
@@ -439,16 +439,16 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     result's history of the previous frame (rendered the same way; another kind is not reused).
 
     ``bands``: horizontal bands the window is rendered in (bands.py; None: as many as keep one band's working set
-    within memory.band_budget, 1 for most frames); a banded frame keeps its bands' histories only with
+    within memory.band_budget, 1 for most frames) with ``band_margin`` extra rows each side (None: bands.plan's, or
+    the spatial radius where ``bands`` is given); a banded frame keeps its bands' histories only with
     ``keep_history`` (an animation's next frame needs them, a still's does not); ``history_slots``: histories worker
     processes keep (one per band of the banded frame this one belongs to).
     """
     from ..parallel import processes as procs
     from . import bands as bands_mod
-    from . import memory
-    want, margin = bands_mod.plan(scene, settings, memory.available_memory())
     if bands is None:
-        bands = want
+        from . import memory
+        bands, band_margin = bands_mod.plan(scene, settings, memory.available_memory())
     if bands > 1:
         def one(sc, st, report, stop, hist, clk):
             result = render_frame(sc, st, report, stop, hist, clk, processes, bands=1,
@@ -457,7 +457,7 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
                 result.history = None
             return result
         return bands_mod.render_in_bands(one, scene, settings, bands, progress, should_stop, history, clock,
-                                         margin if bands == want else None)
+                                         band_margin)
     _x0, _y0, w, h = scene.camera.window
     chunks = len(spans(w * h, settings.tile_pixels))
     n = procs.process_count(thread_count(), chunks) if processes is None else min(int(processes), chunks)
