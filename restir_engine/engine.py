@@ -7,6 +7,7 @@ from dataclasses import replace
 import bpy
 import numpy as np
 
+from . import denoise
 from . import passes as pass_table
 from .core.pipeline import memory, methods
 from .core.pipeline.bands import plan as band_plan
@@ -36,13 +37,14 @@ def settings_from_scene(scene) -> RenderSettings:
                           **scene_settings_to_core(scene.restir))
 
 
-def with_data_passes(settings: RenderSettings, view_layer) -> RenderSettings:
-    """``settings`` computing Depth/Normal/Vector only when the view layer writes one of them."""
+def with_data_passes(settings: RenderSettings, view_layer, denoise_guides: bool = False) -> RenderSettings:
+    """``settings`` computing Depth/Normal/Vector only when the view layer writes one of them, and the Denoising
+    Albedo / Normal when it writes them or the denoiser reads them (``denoise_guides``)."""
     wanted = bool(view_layer.use_pass_z or view_layer.use_pass_normal or view_layer.use_pass_vector)
     reservoirs = bool(view_layer.restir.use_pass_reservoir_m or view_layer.restir.use_pass_reservoir_ucw)
     gi_reservoirs = bool(view_layer.restir.use_pass_gi_reservoir_m or view_layer.restir.use_pass_gi_reservoir_ucw)
     return replace(settings, data_passes=wanted, reservoir_passes=reservoirs, gi_reservoir_passes=gi_reservoirs,
-                   denoise_data=bool(view_layer.restir.use_pass_denoising_data))
+                   denoise_data=bool(view_layer.restir.use_pass_denoising_data) or denoise_guides)
 
 
 def _set_rect(render_pass, pixels: np.ndarray) -> None:
@@ -135,7 +137,9 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         view_layer = depsgraph.view_layer
         t0 = time.perf_counter()
         apply_threads(scene)
-        settings = with_data_passes(settings_from_scene(scene), view_layer)
+        denoising = denoise.wanted(scene)
+        settings = with_data_passes(settings_from_scene(scene), view_layer,
+                                    denoise_guides=denoising and scene.restir.denoising_input_passes != "RGB")
         # AUTO may resolve to ReSTIR (known once the scene is exported): keep and preroll its history too
         wants_temporal = methods.keeps_history(settings)
         key = (scene.name, view_layer.name)
@@ -216,6 +220,14 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             if aovs:
                 images = render_aovs(ctx, aovs, rays, settings.seed, settings.frame)
                 result.passes.update({f"AOV {name}": img for name, img in images.items()})
+        if denoising and not result.cancelled:
+            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Denoising")
+            t_den = time.perf_counter()
+            try:
+                result.passes["Noisy Image"] = denoise.denoise_combined(result.passes, denoise.settings_of(scene))
+                result.stats["denoise_seconds"] = time.perf_counter() - t_den
+            except denoise.DenoiserUnavailable as exc:
+                self.report({"WARNING"}, str(exc))
         self._write(result.passes, core_scene.camera.window, scene, view_layer, stamps)
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
                                                                   "world_method", "world_reason",
@@ -275,6 +287,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         session.budget = float(scene.restir.viewport_budget_ms) / 1000.0
         session.max_samples = int(scene.restir.viewport_samples)
         session.time_limit = float(scene.restir.time_limit)
+        session.denoise = self._viewport_denoiser(scene)
         if level == "NONE" and settings == self._viewport_settings_last:
             session.set_view(cam, key)
             return
@@ -299,7 +312,18 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         settings.reservoir_passes = _viewport_pass(context) in RESERVOIR_PASSES
         settings.gi_reservoir_passes = _viewport_pass(context) in GI_RESERVOIR_PASSES
         settings.tile_pixels = 16384  # small chunks: a stop request is seen within one chunk of one stage
+        settings.denoise_data = bool(scene.restir.use_preview_denoising)  # the albedo guiding the denoiser
         return settings
+
+    def _viewport_denoiser(self, scene):
+        """(Denoiser, its viewport settings) where Viewport Denoise is on and the library loads, else None."""
+        if not scene.restir.use_preview_denoising:
+            return None
+        try:
+            return denoise.denoiser(), denoise.VIEWPORT_SETTINGS
+        except denoise.DenoiserUnavailable as exc:
+            self.report({"WARNING"}, str(exc))
+            return None
 
     def _view(self, context):
         """(core camera of the 3D view at its full viewport resolution, key of the view)."""

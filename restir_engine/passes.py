@@ -32,6 +32,8 @@ PASSES = (
      "GI Reservoir UCW"),
     ("Denoising Albedo", "RGB", "COLOR", lambda sc, vl: vl.restir.use_pass_denoising_data, "Denoising Albedo"),
     ("Denoising Normal", "XYZ", "VECTOR", lambda sc, vl: vl.restir.use_pass_denoising_data, "Denoising Normal"),
+    ("Noisy Image", "RGBA", "COLOR", lambda sc, vl: vl.restir.use_pass_denoising_data and sc.restir.use_denoising,
+     "Noisy Image"),
     ("Sample Count", "X", "VALUE", lambda sc, vl: vl.restir.use_pass_sample_count and sc.restir.use_adaptive_sampling,
      "Sample Count"),
 )

@@ -21,11 +21,6 @@ def _update_passes(self, context):
         view_layer.update_render_passes()
 
 
-def _denoise_option(settings, context):
-    from .denoise import update_option
-    update_option(settings, context)
-
-
 @dataclass(frozen=True)
 class Field:
     """One ``scene.restir`` setting: its property name (kept as saved .blend files, presets and scripts use it), the
@@ -160,10 +155,30 @@ SCENE_FIELDS = (
         name="Threshold", description="A reservoir is emptied when its contribution exceeds this many times its "
         "block's mean (lower filters more)", default=BOILING_THRESHOLD, min=1.5, soft_max=100.0)),
     Field("use_denoising", BoolProperty, None, dict(
-        name="Denoise", description="Denoise F12 and animation frames in the compositor: "
-        "Blender's Denoise node (Open Image Denoise) on Combined with the Denoising Albedo "
-        "and Normal passes (turning this on sets the nodes and passes up)", default=False,
-        update=_denoise_option)),
+        name="Denoise", description="Denoise F12 and animation frames with Open Image Denoise (the library Blender "
+        "ships), guided by the first hit's albedo and normal, as Cycles does; the compositor is left as it is. "
+        "With the Denoising Data passes on, the image before denoising is kept as Noisy Image", default=True)),
+    Field("denoising_input_passes", EnumProperty, None, dict(
+        name="Passes", description="Passes that guide the denoiser",
+        items=[("RGB", "None", "The image alone", 1),
+               ("RGB_ALBEDO", "Albedo", "The image and the first hit's albedo", 2),
+               ("RGB_ALBEDO_NORMAL", "Albedo and Normal", "The image, the first hit's albedo and its normal", 3)],
+        default="RGB_ALBEDO_NORMAL")),
+    Field("denoising_prefilter", EnumProperty, None, dict(
+        name="Prefilter", description="How the guiding passes are treated",
+        items=[("NONE", "None", "Taken as noise-free (renders with many samples, no depth of field or motion)", 1),
+               ("FAST", "Fast", "Handed over as noisy: the denoiser allows for it at no extra cost", 2),
+               ("ACCURATE", "Accurate", "Denoised first, each on its own, then used as clean guides (slower, "
+                "sharper where the guides are noisy)", 3)],
+        default="ACCURATE")),
+    Field("denoising_quality", EnumProperty, None, dict(
+        name="Quality", description="The denoiser's quality (its network's size)",
+        items=[("HIGH", "High", "Best detail, slowest", 1), ("BALANCED", "Balanced", "Between the two", 2),
+               ("FAST", "Fast", "Quickest, for previews", 3)],
+        default="HIGH")),
+    Field("use_preview_denoising", BoolProperty, None, dict(
+        name="Viewport Denoise", description="Denoise the Rendered viewport's Combined image each time its samples "
+        "refine (off by default, as in Cycles)", default=False)),
     Field("processes", IntProperty, None, dict(
         name="Processes", description="Worker processes that render F12 and animation frames together, each "
         "with its share of the threads (Python runs one thread at a time per process, so processes use many "

@@ -227,6 +227,9 @@ class ViewportSession:
         self._image_pass = None
         self._thread: threading.Thread | None = None
         self.last_error: str | None = None
+        # (core.pipeline.denoiser.Denoiser, DenoiseSettings) denoising the Combined image shown, or None
+        self.denoise = None
+        self._denoised = None        # ((view key, divider), samples, image): the last denoised Combined
 
     # -- called from Blender's thread (never waits for a pass) -----------------------------------
     def set_scene(self, scene, settings: RenderSettings) -> None:
@@ -415,6 +418,8 @@ class ViewportSession:
         r = self.renderer
         image, info = pass_image(r, self.pass_name)
         if self.pass_name == "COMBINED":
+            if self.denoise is not None:
+                image = self._denoised_combined(r, image)
             image = np.minimum(image, HALF_FLOAT_MAX)
         _x0, _y0, w, h = r.ctx.scene.camera.window
         with self._cv:
@@ -427,6 +432,29 @@ class ViewportSession:
                                              mean_m=_mean_confidence(r, "res_m") if r.candidates is not None else None,
                                              gi_mean_m=_mean_confidence(r, "gi_m"))
         self.redraw()
+
+
+    def _finished(self, samples: int) -> bool:
+        """Whether the current view refines no further (its samples or its time limit reached)."""
+        return samples >= self.max_samples or (self.time_limit > 0 and self._refine_t0 is not None
+                                               and self.clock() - self._refine_t0 >= self.time_limit)
+
+    def _denoised_combined(self, r: FrameRenderer, image: np.ndarray) -> np.ndarray:
+        """The Combined image denoised: afresh for a new view or resolution, when the samples have doubled since the
+        last denoised image and when the view stops refining; in between, the last denoised image of this view (so a
+        denoiser slower than a sample pass does not hold refinement back)."""
+        tag, n = (self._key, self._divider), r.samples_done
+        last = self._denoised
+        if last is not None and last[0] == tag and (n < 2 * last[1] and not (self._finished(n) and n > last[1])
+                                                    or n == last[1]):
+            return last[2]
+        denoiser, settings = self.denoise
+        albedo = r.mean("albedo") if r.has_pass_data("albedo") else None
+        normal = r.mean("dnormal") if r.has_pass_data("dnormal") else None
+        out = np.array(image, np.float32, copy=True)
+        out[..., :3] = denoiser.denoise(image[..., :3], albedo, normal, settings)
+        self._denoised = (tag, n, out)
+        return out
 
 
 def _mean_confidence(renderer: FrameRenderer, key: str) -> float | None:

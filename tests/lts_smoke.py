@@ -1,5 +1,5 @@
 """Smoke test of the add-on on an older Blender LTS that the manifest names (run by scripts/test_lts.sh with that
-bpy's venv; not collected by pytest): the add-on registers, F12 of the demo scene writes finite passes, the CLI
+bpy's venv; not collected by pytest): the add-on registers, F12 of the demo scene writes finite passes (denoised, as by default), the CLI
 renders an animation of two frames and a single frame and exits promptly, and the built extension installs into a
 throw-away user folder and renders from there. Prints one line per check and exits 0 when all pass, 1 otherwise;
 exits without Blender's teardown (the bpy 4.5 module deadlocks in it, see restir_engine/cli.py)."""
@@ -54,6 +54,7 @@ def main() -> int:
     from restir_engine.engine import LAST_FRAME_STATS
     check("F12 passes", finite and passes["Combined"][..., :3].mean() > 0 and LAST_FRAME_STATS.get("samples") == 2
           and {"Combined", "Depth", "Normal", "Vector"} <= set(passes), ", ".join(sorted(passes)))
+    check("F12 denoised (Blender's own OIDN)", LAST_FRAME_STATS.get("denoise_seconds", 0) > 0, str(LAST_FRAME_STATS))
     with tempfile.TemporaryDirectory() as tmp:
         blend = os.path.join(tmp, "demo.blend")
         bpy.ops.wm.save_as_mainfile(filepath=blend, copy=True)

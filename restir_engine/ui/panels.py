@@ -233,10 +233,21 @@ class RESTIR_PT_sampling_denoising(RestirPanel, bpy.types.Panel):
         self.layout.prop(context.scene.restir, "use_denoising", text="")
 
     def draw(self, context):
+        from ..denoise import legacy_compositor_denoise
         layout = self.split_layout()
-        layout.label(text="Compositor: Denoise node on Combined with")
-        layout.label(text="Denoising Albedo and Normal")
-        layout.operator("restir.set_up_denoising")
+        s = context.scene.restir
+        col = layout.column()
+        col.active = s.use_denoising
+        col.prop(s, "denoising_input_passes")
+        sub = col.column()
+        sub.active = s.denoising_input_passes != "RGB"
+        sub.prop(s, "denoising_prefilter")
+        col.prop(s, "denoising_quality")
+        layout.prop(s, "use_preview_denoising")
+        if legacy_compositor_denoise(context.scene):
+            box = layout.box()
+            box.label(text="The compositor denoises (set up by an older version)", icon="INFO")
+            box.operator("restir.remove_compositor_denoising")
 
 
 class RESTIR_PT_light_paths(RestirPanel, bpy.types.Panel):

@@ -50,6 +50,7 @@ def configure_restir(scene, samples: int, bounces: int, seed: int = 0, **setting
     scene.restir.seed = seed
     scene.restir.pixel_filter = "BOX"  # the filter configure_cycles gives Cycles (a setting may change it)
     scene.restir.use_adaptive_sampling = False  # every pixel takes the samples asked for, as configure_cycles
+    scene.restir.use_denoising = False  # the raw estimate, as configure_cycles
     for k, v in settings.items():
         setattr(scene.restir, k, v)
     scene.view_settings.view_transform = "Standard"

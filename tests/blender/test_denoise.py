@@ -1,9 +1,11 @@
-"""Denoising: the Denoising Albedo / Normal passes and the compositor set-up (restir_engine/denoise.py).
+"""Denoising: the Denoising Albedo / Normal passes, Open Image Denoise in the engine (restir_engine/denoise.py,
+core/pipeline/denoiser.py) and files whose compositor an older version set up to denoise.
 
 The end-to-end test renders the built-in demo scene (scripts/make_demo_scene.py) at 4 samples with and without
-the "Denoise" option and compares both with a Cycles reference at 256 samples (its own noise caps the measurable ratio near 60): the issue's target is a denoised
-relMSE at least 5x below the raw one. One render each (a deterministic seed), so the ratio is a measurement of
-this image, not a statistical claim; the margin between the measured ratio and 5 is in the assertion message."""
+denoising and compares both with a Cycles reference at 256 samples (its own noise caps the measurable ratio near 60):
+the target is a denoised relMSE at least 5x below the raw one. One render each (a deterministic seed), so the ratio
+is a measurement of this image, not a statistical claim; the margin between the measured ratio and 5 is in the
+assertion message. The denoiser's own tests use synthetic images with a known clean image."""
 import os
 import sys
 
@@ -59,18 +61,121 @@ def test_denoising_passes_are_albedo_and_camera_space_normals(addon, tmp_path):
     assert np.median((world * normal).sum(axis=-1)) > 0.99
 
 
-def test_denoise_option_sets_up_the_compositor_and_cuts_the_error(addon, tmp_path):
+def test_a_new_scene_denoises_f12_without_touching_the_compositor(addon, tmp_path):
+    """Denoise is on in a new scene: Combined is denoised (relMSE against Cycles at least 5x below the raw
+    estimate's), Noisy Image is the raw estimate bit for bit (same seed), alpha is kept and no compositor is made."""
+    from harness.render import render_scene
+    assert bpy.data.scenes.new("fresh").restir.use_denoising  # Cycles' default too
     scene = demo_scene()
     configure_cycles(scene, 256, 4, 0)
-    ref = render_exr(scene, str(tmp_path / "ref.exr"))
-    configure_restir(scene, 4, 4, 0)
-    raw = render_exr(scene, str(tmp_path / "raw.exr"))
+    ref = render_scene(scene)[0]["Combined"][..., :3]
+    configure_restir(scene, 4, 4, 0)  # the raw estimate (denoising off)
+    raw = render_scene(scene)[0]["Combined"]
+    trees_before = len(bpy.data.node_groups)
     scene.restir.use_denoising = True
-    assert scene.view_layers[0].restir.use_pass_denoising_data
-    den = render_exr(scene, str(tmp_path / "den.exr"))
-    e_raw, e_den = rel_mse(raw, ref), rel_mse(den, ref)
+    scene.view_layers[0].restir.use_pass_denoising_data = True
+    passes = render_scene(scene)[0]
+    den = passes["Combined"]
+    np.testing.assert_array_equal(passes["Noisy Image"], raw)
+    np.testing.assert_array_equal(den[..., 3], raw[..., 3])
+    e_raw, e_den = rel_mse(raw[..., :3], ref), rel_mse(den[..., :3], ref)
     print(f"DENOISE raw {e_raw:.5f} denoised {e_den:.5f} ratio {e_raw / e_den:.2f}")
     assert e_raw > 5 * e_den, f"raw relMSE {e_raw:.4f}, denoised {e_den:.4f}: ratio {e_raw / e_den:.1f} (target 5)"
-    scene.restir.use_denoising = False  # the option also takes the Denoise node out again: the raw image returns
-    again = render_exr(scene, str(tmp_path / "again.exr"))
-    np.testing.assert_allclose(again, raw, rtol=1e-5, atol=1e-6)
+    from restir_engine.compat import compositor_tree
+    tree = compositor_tree(scene, create=False)
+    assert tree is None or not any(n.bl_idname == "CompositorNodeDenoise" for n in tree.nodes)
+    assert len(bpy.data.node_groups) == trees_before
+    # without the Denoising Data passes the denoiser still has its guides (the same image), and no Noisy Image
+    scene.view_layers[0].restir.use_pass_denoising_data = False
+    again = render_scene(scene)[0]
+    assert "Noisy Image" not in again and "Denoising Albedo" not in again
+    np.testing.assert_array_equal(again["Combined"], den)
+
+
+def test_an_older_compositor_denoise_is_not_doubled_and_can_be_removed(addon, tmp_path):
+    """A file whose compositor holds the Denoise node an older version wired in is not denoised again by the engine;
+    the panel's operator takes the node out, after which the engine denoises."""
+    from harness.render import render_scene
+    from restir_engine.compat import compositor_output, compositor_tree
+    from restir_engine.denoise import LEGACY_NODE, legacy_compositor_denoise
+    scene = demo_scene()
+    configure_restir(scene, 2, 2, 0)
+    raw = render_scene(scene)[0]["Combined"]
+    scene.render.use_compositing = True
+    tree = compositor_tree(scene)
+    layers = tree.nodes.new("CompositorNodeRLayers")
+    layers.name = f"{LEGACY_NODE} Layers"
+    layers.scene = scene
+    den = tree.nodes.new("CompositorNodeDenoise")
+    den.name = LEGACY_NODE
+    _out, socket = compositor_output(tree)
+    tree.links.new(layers.outputs["Image"], den.inputs["Image"])
+    tree.links.new(den.outputs["Image"], socket)
+    scene.restir.use_denoising = True
+    assert legacy_compositor_denoise(scene)
+    from restir_engine.engine import LAST_FRAME_STATS
+
+    def view_layer_combined():  # the EXR holds the composite ("Composite.Combined") before the view layer's
+        return render_scene(scene)[0]["Combined"][..., -4:]
+    np.testing.assert_array_equal(view_layer_combined(), raw)  # the engine's own output: not denoised
+    assert "denoise_seconds" not in LAST_FRAME_STATS
+    with bpy.context.temp_override(scene=scene):
+        assert bpy.ops.restir.remove_compositor_denoising() == {"FINISHED"}
+    assert not legacy_compositor_denoise(scene)
+    assert np.abs(view_layer_combined() - raw).max() > 1e-3
+    assert LAST_FRAME_STATS["denoise_seconds"] > 0
+
+
+def _noisy(shape, seed=0):
+    """A smooth HDR image and a noisy estimate of it (per-pixel exponential noise of mean 1, as a 1-sample
+    estimate of a diffuse surface under a small light)."""
+    h, w = shape
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    clean = np.stack([0.2 + 2.0 * xx / w, 0.2 + yy / h, 0.5 + 0.4 * np.sin(xx / 9.0)], -1).astype(np.float32)
+    rng = np.random.default_rng(seed)
+    return clean, (clean * rng.exponential(1.0, (h, w, 1))).astype(np.float32)
+
+
+def test_denoiser_cuts_noise_and_keeps_the_mean(addon):
+    from restir_engine.core.pipeline.denoiser import DenoiseSettings
+    from restir_engine.denoise import denoiser
+    clean, noisy = _noisy((96, 128))
+    for prefilter in ("NONE", "FAST", "ACCURATE"):
+        for quality in ("HIGH", "BALANCED", "FAST"):
+            out = denoiser().denoise(noisy, settings=DenoiseSettings("RGB", prefilter, quality))
+            mse_noisy, mse = float(((noisy - clean) ** 2).mean()), float(((out - clean) ** 2).mean())
+            assert out.shape == clean.shape and out.dtype == np.float32
+            assert mse < mse_noisy / 20, (prefilter, quality, mse_noisy, mse)
+            # the noisy mean's standard error is 1/sqrt(96·128) = 0.9 %: a denoiser that kept the energy is within
+            # 3 % (z = 3.3); one that lost a tenth of it fails
+            assert abs(out.mean() / clean.mean() - 1) < 0.03, (prefilter, quality, out.mean(), clean.mean())
+
+
+def test_the_albedo_guide_keeps_texture_edges(addon):
+    """A checkerboard albedo (4-pixel squares) under smooth light: without the guide the denoiser blurs the squares
+    into the noise; with it (and with albedo and normal, any prefilter) the error is at most half as large."""
+    from restir_engine.core.pipeline.denoiser import DenoiseSettings
+    from restir_engine.denoise import denoiser
+    light, _ = _noisy((96, 128))
+    yy, xx = np.mgrid[0:96, 0:128]
+    albedo = np.where(((yy // 4 + xx // 4) % 2 == 0)[..., None], 0.8, 0.1).astype(np.float32) * np.ones(3, np.float32)
+    clean = light * albedo
+    noisy = (clean * np.random.default_rng(1).exponential(1.0, (96, 128, 1))).astype(np.float32)
+    normal = np.zeros_like(clean)
+    normal[..., 2] = 1.0
+    alone = float(((denoiser().denoise(noisy, albedo, normal, DenoiseSettings("RGB")) - clean) ** 2).mean())
+    for passes in ("RGB_ALBEDO", "RGB_ALBEDO_NORMAL"):
+        for prefilter in ("NONE", "FAST", "ACCURATE"):
+            out = denoiser().denoise(noisy, albedo, normal, DenoiseSettings(passes, prefilter, "HIGH"))
+            guided = float(((out - clean) ** 2).mean())
+            assert guided < 0.5 * alone, (passes, prefilter, guided, alone)
+
+
+def test_non_finite_and_negative_input_is_read_as_black(addon):
+    from restir_engine.denoise import denoiser
+    clean, noisy = _noisy((32, 48))
+    noisy[3, 4] = np.nan
+    noisy[5, 6] = np.inf
+    noisy[7, 8] = -5.0
+    out = denoiser().denoise(noisy)
+    assert np.isfinite(out).all() and out.min() >= 0

@@ -100,7 +100,8 @@ def test_a_file_saved_before_the_table_keeps_every_value(addon):
     got = {name: getattr(s, name) for name in expected}
     for name, value in expected.items():
         assert got[name] == value if not isinstance(value, float) else abs(got[name] - value) < 1e-6, (name, got[name])
-    # every setting of the table when the file was saved but use_denoising (its update edits the compositor)
+    # every setting of the table when the file was saved but use_denoising (its update edited the compositor then)
     newer = {"processes", "pixel_filter", "filter_width", "time_limit", "use_adaptive_sampling", "adaptive_threshold",
-             "adaptive_min_samples"}  # settings added since
+             "adaptive_min_samples", "denoising_input_passes", "denoising_prefilter", "denoising_quality",
+             "use_preview_denoising"}  # settings added since
     assert set(expected) >= {f.name for f in _fields()} - {"use_denoising"} - newer

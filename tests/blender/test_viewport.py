@@ -301,3 +301,39 @@ def test_still_view_refines_in_sample_batches_as_f12(addon, monkeypatch):
     assert all(costs[k] == costs[k - 1] for k in range(2, len(costs)) if batches[k - 1] > 1), (batches, costs)
     ref = render_frame(dataclasses.replace(core, motion=None), dataclasses.replace(settings, samples=8, frame=1))
     assert np.allclose(got, ref.passes["Combined"], atol=1e-5)
+
+
+def test_viewport_denoise_refreshes_as_the_samples_double(addon, monkeypatch):
+    """Viewport Denoise: the image shown is the renderer's Combined through the denoiser (albedo-guided), denoised
+    again only when the samples have doubled and when the view stops refining; the last image is the denoised
+    final mean."""
+    from restir_engine.core.pipeline.denoiser import Denoiser
+    from restir_engine.denoise import VIEWPORT_SETTINGS, denoiser
+    core, cam, settings = demo((64, 36))
+    settings.denoise_data = True
+    counts, original = [], Denoiser.denoise
+
+    def counted(self, color, albedo=None, normal=None, settings=VIEWPORT_SETTINGS):
+        counts.append((session.renderer.samples_done, albedo is not None, settings))
+        return original(self, color, albedo, normal, settings)
+
+    monkeypatch.setattr(Denoiser, "denoise", counted)
+    session = ViewportSession(lambda: None, budget=0.0, max_samples=12)
+    session.denoise = (denoiser(), VIEWPORT_SETTINGS)
+    try:
+        session.set_scene(core, settings)
+        session.set_view(cam, "still")
+        wait_for(lambda: session.stats.samples >= 12)
+        wait_for(lambda: counts and counts[-1][0] == 12)
+        shown = session.latest()[0]
+        r = session.renderer
+        raw = pass_image(r, "COMBINED")[0]
+        expect = original(denoiser(), raw[..., :3], r.mean("albedo"), None, VIEWPORT_SETTINGS)
+    finally:
+        session.halt()
+    samples = [n for n, _a, _s in counts]
+    assert all(a and s == VIEWPORT_SETTINGS for _n, a, s in counts)
+    assert samples[0] == 1 and samples[-1] == 12
+    assert all(b >= 2 * a or b == 12 for a, b in zip(samples, samples[1:])), samples
+    np.testing.assert_allclose(shown[..., :3], np.minimum(expect, 65504.0), rtol=1e-6, atol=1e-7)
+    assert np.abs(shown[..., :3] - raw[..., :3]).max() > 1e-3
