@@ -15,11 +15,12 @@ import numpy as np
 
 from .compat import compositor_output, compositor_tree
 from .core.pipeline.denoiser import DenoiserUnavailable, DenoiseSettings, shared_denoiser
+from .core.pipeline.memory import DENOISER_SCRATCH
 
 LEGACY_NODE = "ReSTIR Denoise"   # the compositor node older versions wired in
 # OIDN's scratch memory for a frame, so that a 4K frame's denoising stays within its render's memory bound (OIDN's
 # own default grows with the image; beyond this it works in overlapping tiles, at some extra time)
-MAX_MEMORY_MB = 1024
+MAX_MEMORY_MB = DENOISER_SCRATCH >> 20
 # the Rendered viewport's denoising: Cycles' viewport defaults (albedo-guided, fast prefilter, balanced quality)
 VIEWPORT_SETTINGS = DenoiseSettings(input_passes="RGB_ALBEDO", prefilter="FAST", quality="BALANCED",
                                     max_memory_mb=MAX_MEMORY_MB)

@@ -165,6 +165,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         free = memory.available_memory()
         bands, margin = band_plan(core_scene, settings, free)
         estimate = memory.banded_estimate(core_scene, settings, bands, margin, keeps_history=self.is_animation)
+        if denoising:
+            estimate = memory.with_denoising(estimate, settings, keeps_history=self.is_animation)
         refusal, caution = memory.memory_problem(estimate, free, settings)
         if refusal:  # refused before any work, rather than failing part-way or taking all of the machine's memory
             self.report({"ERROR"}, refusal)

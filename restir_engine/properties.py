@@ -298,7 +298,8 @@ class RestirViewLayerSettings(bpy.types.PropertyGroup):
                                             default=False, update=_update_passes)
     use_pass_denoising_data: BoolProperty(name="Denoising Data", description="Denoising Albedo and Denoising Normal "
                                           "(first hit's albedo and camera-space normal, averaged over the samples), "
-                                          "for the compositor's Denoise node", default=False, update=_update_passes)
+                                          "for a compositor's Denoise node, and Noisy Image (Combined before "
+                                          "denoising) with Denoise on", default=False, update=_update_passes)
     use_pass_sample_count: BoolProperty(name="Sample Count", description="Samples each pixel took (with adaptive "
                                         "sampling, Render Properties > Sampling > Noise Threshold)", default=False,
                                         update=_update_passes)

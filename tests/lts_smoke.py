@@ -1,8 +1,8 @@
 """Smoke test of the add-on on an older Blender LTS that the manifest names (run by scripts/test_lts.sh with that
-bpy's venv; not collected by pytest): the add-on registers, F12 of the demo scene writes finite passes (denoised, as by default), the CLI
-renders an animation of two frames and a single frame and exits promptly, and the built extension installs into a
-throw-away user folder and renders from there. Prints one line per check and exits 0 when all pass, 1 otherwise;
-exits without Blender's teardown (the bpy 4.5 module deadlocks in it, see restir_engine/cli.py)."""
+bpy's venv; not collected by pytest): the add-on registers, F12 of the demo scene writes finite passes (denoised, as by
+default), the CLI renders an animation of two frames and a single frame and exits promptly, and the built
+extension installs into a throw-away user folder and renders from there. Prints one line per check and exits 0 when
+all pass, 1 otherwise; exits without Blender's teardown (the bpy 4.5 module deadlocks in it, see restir_engine/cli.py)."""
 from __future__ import annotations
 
 import glob

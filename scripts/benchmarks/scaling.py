@@ -93,7 +93,7 @@ def one(args) -> dict:
 
     import numpy as np
     from restir_core.parallel import pool, processes, wire
-    from restir_core.pipeline.frame import render_frame
+    from restir_core.pipeline.frame_render import render_frame
     from restir_core.profile import StageClock
 
     data = wire.loads(open(args.scene, "rb").read(), "restir_engine.core")

@@ -351,3 +351,23 @@ def test_fuzzed_bad_scenes_render_finite_or_fail_in_one_line(addon, seed):
             continue
         for name, img in passes.items():
             assert np.isfinite(img).all(), (picks, name)
+
+
+def test_the_memory_estimate_counts_the_denoiser(addon, monkeypatch):
+    """A denoised frame's peak includes the denoiser's images and OIDN's scratch: with the free memory between the
+    render's own peak and the denoised peak the engine refuses and says that turning Denoise off fits; with Denoise
+    off the same frame renders."""
+    from restir_engine.core.pipeline import memory
+    from restir_engine.engine import settings_from_scene, with_data_passes
+    cornell = cornell_box("EMISSIVE", (64, 48))
+    configure_restir(cornell, 1, 1, integrator="PATH")
+    st = with_data_passes(settings_from_scene(cornell), bpy.context.view_layer)
+    alone = memory.frame_estimate(export(), st)
+    denoised = memory.with_denoising(alone, st, keeps_history=False)
+    assert denoised.low > memory.DENOISER_SCRATCH > alone.high and denoised.render == alone.high
+    monkeypatch.setattr(memory, "available_memory", lambda: (alone.high + denoised.low) // 2)
+    cornell.restir.use_denoising = True
+    with pytest.raises(RuntimeError, match=r"turn Denoise off .*needs about"):
+        render_passes(cornell)
+    cornell.restir.use_denoising = False
+    assert np.isfinite(render_passes(cornell)["Combined"]).all()

@@ -52,7 +52,7 @@ def layout(h: int, bands: int) -> tuple:
 
 def render_in_bands(render_one, scene, settings, bands: int, progress=None, should_stop=None, history=None,
                     clock=None, margin: int | None = None):
-    """:func:`frame.render_frame`'s result for ``scene`` rendered in ``bands`` bands of ``margin`` extra rows each
+    """:func:`frame_render.render_frame`'s result for ``scene`` rendered in ``bands`` bands of ``margin`` extra rows each
     side (None: :func:`margin_rows`), each by ``render_one(scene, settings, progress, should_stop, history, clock)``
     (one band's render_frame)."""
     from .frame import Cancelled, FrameResult

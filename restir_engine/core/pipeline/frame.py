@@ -23,7 +23,7 @@ from ..integrators import pathtracer, trace_context
 from ..integrators.context_cache import context_for, fingerprint
 from ..integrators.method_choice import GI_MIN_SHARE
 from ..modes import DirectMethod, Integrator
-from ..parallel.pool import quiet_float_errors, thread_count
+from ..parallel.pool import quiet_float_errors
 from ..parallel.tasks import Progress, Stopped, chunk_size, spans
 from ..parallel.team import Solo
 from ..profile import NullClock
@@ -418,97 +418,6 @@ class FrameRenderer:
             lights.signature, st.frame, lights.light_uid, lights.uid_space,
             gi_res=None if gi_history is None else reuse.age_history(self.gi, gi_history),
             gi_terms=None if gb_gi is None else gb_gi.terms, gi_key=self.gi_light_key if gi_reused else None)
-
-
-def out_of_time(settings: RenderSettings, t0: float, done: int) -> bool:
-    """Whether a frame begun at perf_counter ``t0`` has used its Time Limit (after one pass at least)."""
-    return settings.time_limit > 0 and done > 0 and time.perf_counter() - t0 >= settings.time_limit
-
-
-def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
-                 clock=None, processes: int | None = None, bands: int | None = None,
-                 band_margin: int | None = None, keep_history: bool = True, history_slots: int = 1) -> FrameResult:
-    """Render one frame with the chosen integrator, in ``processes`` worker processes (None: the count that
-    parallel.processes.process_count chooses for the thread count; 1: in this process), at most one per chunk of
-    pixels. The same seed gives the same image either way.
-
-    A Time Limit (settings.time_limit) stops the frame after the pass that reaches it (fewer samples; which ones
-    is deterministic, how many depends on the machine).
-    progress(fraction, message) is called as chunks finish; should_stop() is polled while they run,
-    and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none). ``history`` is the
-    result's history of the previous frame (rendered the same way; another kind is not reused).
-
-    ``bands``: horizontal bands the window is rendered in (bands.py; None: as many as keep one band's working set
-    within memory.band_budget, 1 for most frames) with ``band_margin`` extra rows each side (None: bands.plan's, or
-    the spatial radius where ``bands`` is given); a banded frame keeps its bands' histories only with
-    ``keep_history`` (an animation's next frame needs them, a still's does not); ``history_slots``: histories worker
-    processes keep (one per band of the banded frame this one belongs to).
-    """
-    from ..parallel import processes as procs
-    from . import bands as bands_mod
-    if bands is None:
-        from . import memory
-        bands, band_margin = bands_mod.plan(scene, settings, memory.available_memory())
-    if bands > 1:
-        def one(sc, st, report, stop, hist, clk):
-            result = render_frame(sc, st, report, stop, hist, clk, processes, bands=1,
-                                  history_slots=bands if keep_history else 1)
-            if not keep_history:
-                result.history = None
-            return result
-        return bands_mod.render_in_bands(one, scene, settings, bands, progress, should_stop, history, clock,
-                                         band_margin)
-    _x0, _y0, w, h = scene.camera.window
-    chunks = len(spans(w * h, settings.tile_pixels))
-    n = procs.process_count(thread_count(), chunks) if processes is None else min(int(processes), chunks)
-    note = ""
-    if n > 1:
-        from . import memory
-        free = memory.available_memory()
-        fit = memory.processes_that_fit(n, memory.frame_estimate(scene, settings), len(scene.geometry), free)
-        if fit < n:
-            note = (f"{n} render processes would not fit in memory ({memory.size_text(free)} free, each needs its "
-                    f"own copy of the scene's BVH): rendering with {fit}")
-            n = fit
-    team = None
-    if n > 1:
-        try:
-            team = procs.team(n, max(1, thread_count() // n))
-        except procs.WorkerStartFailed as exc:
-            note = f"render worker processes could not start ({exc}): rendering in one process"
-    if team is not None:
-        from .shared_frame import render_frame_shared
-        result = render_frame_shared(scene, settings, team, progress, should_stop, history, clock, history_slots)
-        if note:
-            result.stats["processes_note"] = note
-        return result
-    if not isinstance(history, TemporalHistory):
-        history = None
-    t0 = time.perf_counter()
-    fr = FrameRenderer(scene, settings, history, clock)
-    cancelled = False
-    while fr.samples_done < settings.samples and not fr.converged and not out_of_time(settings, t0, fr.samples_done):
-        s = fr.samples_done
-        batch = 1 if settings.time_limit > 0 else fr.batch_size(settings.samples - s)  # a limit: checked per sample
-        report = None
-        if progress:
-            def report(f, s=s, b=batch):
-                label = f"Sample {s + 1}/{settings.samples}" if b == 1 else \
-                    f"Samples {s + 1}-{s + b}/{settings.samples}"
-                progress((s + f * b) / settings.samples, label)
-        if not fr.sample_pass(report, should_stop, batch):
-            cancelled = True
-            break
-    if fr.samples_done == 0:
-        raise Cancelled("render cancelled before the first sample pass finished")
-    with fr.clock.stage("passes"):
-        passes = fr.passes()
-    samples_done = fr.samples_done
-    fr.release()
-    stats = frame_stats(fr, scene, clock)
-    if note:
-        stats["processes_note"] = note
-    return FrameResult(passes, samples_done, time.perf_counter() - t0, cancelled, stats, fr.history)
 
 
 def frame_stats(fr: FrameRenderer, scene: Scene, clock) -> dict:

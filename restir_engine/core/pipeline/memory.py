@@ -25,6 +25,9 @@ WORKER_PER_PIXEL = 48     # a worker's private whole-image arrays (G-buffer slot
 FRAME_WIDE = 260  # of BASE, what a banded frame keeps for its whole window: the film's sums and the passes
 HISTORY = 240     # a ReSTIR band's temporal history (G-buffer, DI reservoirs), kept for the whole window
 GI_HISTORY = 260  # ... and the GI reservoirs' and terms'
+DENOISER = 112    # the denoiser's images after the frame: its cleaned inputs, guides, prefiltered guides, output
+DENOISED_PASSES = 128  # the frame's passes while it is denoised (float32: Combined, guides, Noisy Image, a few more)
+DENOISER_SCRATCH = 1024 << 20  # OIDN's scratch memory, capped by the caller (restir_engine/denoise.py)
 BAND_BYTES = 1536 << 20  # one band's working set at most (pipeline/bands.py)
 MIN_BAND_ROWS = 32
 
@@ -38,6 +41,7 @@ class MemoryEstimate:
     high: int
     pixels: int
     scene: int
+    render: int = 0   # where the frame is denoised afterwards: the render's own peak (its high), else 0
 
 
 def frame_estimate(scene, settings) -> MemoryEstimate:
@@ -84,12 +88,27 @@ def banded_estimate(scene, settings, bands: int, margin: int, keeps_history: boo
     pixels = int(w) * int(h)
     band_pixels = int(w) * min(int(h), -(-int(h) // bands) + 2 * margin)
     low, high = per_pixel_range(settings)
-    hist = 0
-    if keeps_history and settings.integrator == Integrator.RESTIR:
-        hist = HISTORY + (GI_HISTORY if methods.gi_possible(settings) else 0)
+    hist = history_per_pixel(settings, keeps_history)
     scene_bytes = scene_size(scene)
     whole = FIXED + scene_bytes + (FRAME_WIDE + hist) * pixels
     return MemoryEstimate(whole + low * band_pixels, whole + high * band_pixels, pixels, scene_bytes)
+
+
+def history_per_pixel(settings, keeps_history: bool) -> int:
+    """Bytes per pixel of the temporal history a frame hands to the next (0 where it keeps none)."""
+    if not keeps_history or settings.integrator != Integrator.RESTIR:
+        return 0
+    return HISTORY + (GI_HISTORY if methods.gi_possible(settings) else 0)
+
+
+def with_denoising(estimate: MemoryEstimate, settings, keeps_history: bool) -> MemoryEstimate:
+    """``estimate`` of a frame denoised afterwards: the peak is the larger of the render's and the denoiser's (the
+    frame's passes, as the film's sums are gone by then, the history it keeps, the denoiser's images and OIDN's
+    scratch)."""
+    per_pixel = DENOISED_PASSES + DENOISER + history_per_pixel(settings, keeps_history)
+    peak = FIXED + estimate.scene + per_pixel * estimate.pixels + DENOISER_SCRATCH
+    return MemoryEstimate(max(estimate.low, peak), max(estimate.high, peak), estimate.pixels, estimate.scene,
+                          render=estimate.high)
 
 
 def scene_size(scene) -> int:
@@ -144,7 +163,10 @@ def memory_problem(estimate: MemoryEstimate, free: int | None, settings=None) ->
         path_tracer = BASE + (DENOISE_DATA if settings is not None and settings.denoise_data else 0)
         cheaper = per_pixel > path_tracer
         advice = "lower the resolution (Output > Format) or render a border region"
-        if cheaper:
+        if estimate.render and estimate.render <= free:
+            advice += (f", or turn Denoise off (Render Properties > Sampling; the frame alone needs about "
+                       f"{size_text(estimate.render)})")
+        elif cheaper:
             advice += f", or use the Path Tracing integrator (about {BASE} bytes per pixel)"
         return (f"This frame needs about {size_text(estimate.low)} of memory ({estimate.pixels} pixels at "
                 f"{per_pixel} bytes each, scene {size_text(estimate.scene)}) but {size_text(free)} is free: "

@@ -1,5 +1,5 @@
 """A frame rendered by a team of worker processes (parallel/processes.py): the same passes, in the same order,
-from the same random streams as :func:`frame.render_frame` in one process, so the same seed gives the same image.
+from the same random streams as :func:`frame_render.render_frame` in one process, so the same seed gives the same image.
 
 This process sends the scene once (in shared memory), asks for one sample pass after another (polling the stop
 request and the workers while they render) and reads the passes from the shared film. The temporal history stays
@@ -15,7 +15,8 @@ from ..parallel.processes import WorkerTeam
 from ..sampling import finite
 from . import methods
 from .film import Film, film_keys
-from .frame import Cancelled, FrameResult, out_of_time
+from .frame import Cancelled, FrameResult
+from .frame_render import out_of_time
 from .settings import RenderSettings, validate
 
 SURFACE_BYTES = 300  # per surface and pass: the target terms (DI's and GI's), the G-buffer, tables
@@ -56,7 +57,7 @@ def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = Fa
 
 def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
                         history=None, clock=None, keep_histories: int = 1) -> FrameResult:
-    """:func:`frame.render_frame` on ``team``'s workers (same arguments and result; ``history`` a SharedHistory
+    """:func:`frame_render.render_frame` on ``team``'s workers (same arguments and result; ``history`` a SharedHistory
     of this team, anything else is not reused); the workers keep the newest ``keep_histories`` histories (one per
     band of a banded frame)."""
     validate(settings)
