@@ -3,7 +3,7 @@
 Each resolution renders in a fresh Python process (its peak RSS is the process's own: ru_maxrss), through
 bpy.ops.render.render as F12 does, 1 sample, Processes 1 (the worker processes' shared film would otherwise be
 counted in every process's RSS); the engine then renders in bands when the frame's working set exceeds
-memory.BAND_BYTES. Targets (issue 31): 4K within 4 GB, 8K within 12 GB.
+memory.BAND_BYTES, and denoises the frame (the default). Targets (issue 31): 4K within 4 GB, 8K within 12 GB.
 
     .venv313/bin/python scripts/bench.py memory_bands     # -> docs/results/memory_bands.json
 """
@@ -36,7 +36,8 @@ bpy.ops.render.render()
 from restir_engine.engine import LAST_FRAME_STATS
 print("RESULT", json.dumps({{"resolution": [{w}, {h}], "seconds": time.perf_counter() - t0,
       "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, "rss_before_render_mb": before,
-      "bands": LAST_FRAME_STATS.get("bands", 1), "direct_method": LAST_FRAME_STATS.get("direct_method"),
+      "bands": LAST_FRAME_STATS.get("bands", 1),
+      "denoise_seconds": LAST_FRAME_STATS.get("denoise_seconds"), "direct_method": LAST_FRAME_STATS.get("direct_method"),
       "indirect_method": LAST_FRAME_STATS.get("indirect_method")}}))
 """
 

@@ -1,0 +1,85 @@
+"""Blender images -> the material table's textures: read once into scene-linear float32 (sRGB bytes decoded, alpha or
+luminance replicated to three channels), kept across renders while unchanged (export/images.py), magenta where a
+file cannot be read. A mixin of MaterialRegistry (export/materials.py)."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.materials.textures import NearestImage
+from .images import TEXTURES, srgb_bytes_to_linear, unreadable_file
+
+MAGENTA = (1.0, 0.0, 1.0)
+
+
+class TextureReader:
+    """MaterialRegistry's image readers (``self.textures``, ``self.texture_index``, ``self._warn``)."""
+
+    def _factor_texture(self, material, socket) -> int:
+        """Texture index of an Image Texture driving a float socket (its Color as luminance, or its Alpha), or -1."""
+        if not socket.is_linked:
+            return -1
+        link = socket.links[0]
+        node = link.from_node
+        if node.type != "TEX_IMAGE" or node.image is None:
+            return -1
+        if node.inputs["Vector"].is_linked:
+            self._warn(material, f"'{node.name}' has a mapped vector input; the active UV map is used instead")
+        closest = node.interpolation == "Closest"
+        if link.from_socket.name == "Alpha":
+            return self._texture(material, node.image, alpha=True, closest=closest)
+        return self._texture(material, node.image, luminance=True, closest=closest)
+
+    def _texture(self, material, image, alpha: bool = False, luminance: bool = False, closest: bool = False) -> int:
+        """Index of an image in the texture list: its RGB (scene-linear), or its alpha / luminance replicated to
+        three channels; sampled bilinearly, or by the nearest texel with ``closest`` (other interpolations:
+        bilinear)."""
+        key = (image.name_full, "alpha" if alpha else "luminance" if luminance else "rgb", closest)
+        if key in self.texture_index:
+            return self.texture_index[key]
+        kept = TEXTURES.key(image, key)
+        data = TEXTURES.get(kept)
+        if data is None:
+            data = self._read_texture(material, image, alpha, luminance)
+            TEXTURES.put(kept, data)
+        self.texture_index[key] = len(self.textures)
+        self.textures.append(data.view(NearestImage) if closest else data)
+        return self.texture_index[key]
+
+    def _read_texture(self, material, image, alpha: bool, luminance: bool) -> np.ndarray:
+        """The image's pixels as (h, w, 3) float32, scene-linear (magenta where it cannot be read)."""
+        unreadable = unreadable_file(image)
+        if unreadable:  # asking Blender for its size would open it (a FIFO blocks the export for ever)
+            self._warn(material, f"image '{image.name}': {unreadable}; rendered magenta")
+            w = h = 0
+        else:
+            w, h = image.size[:]
+        data = None
+        if w > 0 and h > 0:
+            try:
+                buf = np.empty(w * h * image.channels, np.float32)
+                image.pixels.foreach_get(buf)
+                data = buf.reshape(h, w, image.channels)
+            except (RuntimeError, ValueError):
+                data = None
+        if unreadable:
+            data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+        elif data is None or data.size == 0:
+            self._warn(material, f"image '{image.name}' could not be loaded; rendered magenta")
+            data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+        elif alpha:
+            a = data[..., 3:4] if data.shape[2] == 4 else np.ones(data.shape[:2] + (1,), np.float32)
+            data = np.ascontiguousarray(np.repeat(a, 3, axis=2), dtype=np.float32)
+        else:
+            ch = data.shape[2]
+            rgb = data[..., :3] if ch >= 3 else np.repeat(data[..., :1], 3, axis=2)
+            space = image.colorspace_settings.name
+            if not image.is_float and space in {"sRGB", "sRGB EOTF"}:
+                rgb = srgb_bytes_to_linear(rgb)
+            elif space not in {"sRGB", "sRGB EOTF", "Linear Rec.709", "Linear", "Non-Color", "Raw", "Linear CIE-XYZ E"} \
+                    and not image.is_float:
+                self._warn(material, f"image '{image.name}' colour space '{space}' treated as sRGB")
+                rgb = srgb_bytes_to_linear(rgb)
+            if luminance:  # Blender's implicit colour -> float conversion
+                rgb = np.repeat((rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32))[..., None], 3, axis=2)
+            data = np.ascontiguousarray(rgb, dtype=np.float32)
+        return data
