@@ -2,7 +2,7 @@
 ``blender -b FILE.blend -E RESTIR [-o PATH] [-F FORMAT] [-s START] [-e END] (-a | -f N)``.
 
 Usage: python -m restir_engine FILE.blend [-E ENGINE] [--python-expr EXPR] [-o PATH] [-F FORMAT] [-s N] [-e N]
-       (-a | -f N) [--samples N] [--seed N] [--max-bounces N] [--percentage P] [-t N]
+       (-a | -f N) [--samples N] [--seed N] [--max-bounces N] [--percentage P] [--[no-]denoise] [-t N]
 Output path, format and frame range come from the file unless overridden. A bad argument gets one line
 ``error: ...`` and exit status 2; an unreadable file, an unknown engine or a failed render exit status 1.
 """
@@ -49,6 +49,8 @@ def parse(argv):
     p.add_argument("--seed", type=_at_least(0))
     p.add_argument("--max-bounces", type=_at_least(0))
     p.add_argument("--percentage", type=_at_least(1), help="resolution percentage")
+    p.add_argument("--denoise", action=argparse.BooleanOptionalAction, default=None,
+                   help="denoise the frames (Render Properties > Sampling > Denoise; default: the file's setting)")
     p.add_argument("-t", "--threads", type=_at_least(0),
                    help="threads to render with, 0 = every logical core (as blender -t; default: the file's)")
     p.add_argument("-E", "--engine", default="RESTIR", help="render engine id (CYCLES for a reference render)")
@@ -128,7 +130,8 @@ def main(argv=None) -> int:
         scene.render.threads_mode = "FIXED" if args.threads > 0 else "AUTO"
         if args.threads > 0:
             scene.render.threads = min(args.threads, 1024)
-    for opt, attr in ((args.samples, "samples"), (args.seed, "seed"), (args.max_bounces, "max_bounces")):
+    for opt, attr in ((args.samples, "samples"), (args.seed, "seed"), (args.max_bounces, "max_bounces"),
+                      (args.denoise, "use_denoising")):
         if opt is not None:
             setattr(scene.restir, attr, opt)
             if args.engine == "CYCLES" and hasattr(scene.cycles, attr):

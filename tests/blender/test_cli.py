@@ -43,6 +43,25 @@ def test_single_frame_with_overrides(blend, tmp_path):
     assert "Saved:" in r.stdout
 
 
+def test_denoise_option(blend, tmp_path):
+    """--no-denoise writes the raw estimate, --denoise the denoised one: with the Denoising Data passes on, the
+    denoised frame's Noisy Image is the --no-denoise frame's Combined bit for bit, and its Combined differs."""
+    import numpy as np
+    from harness.render import read_exr
+    data = ("--python-expr", "import bpy; bpy.context.scene.view_layers[0].restir.use_pass_denoising_data = True")
+
+    def render(flag):
+        out = tmp_path / flag / "x_####"
+        r = run_cli(str(blend), "-o", str(out), "-F", "OPEN_EXR_MULTILAYER", "-f", "1", flag, *data)
+        assert r.returncode == 0, r.stderr
+        return read_exr(str(tmp_path / flag / "x_0001.exr"))
+
+    raw, den = render("--no-denoise"), render("--denoise")
+    assert "Noisy Image" not in raw
+    np.testing.assert_array_equal(den["Noisy Image"], raw["Combined"])
+    assert np.abs(den["Combined"][..., :3] - raw["Combined"][..., :3]).max() > 1e-3
+
+
 def test_missing_file_and_missing_camera_fail_cleanly(addon, tmp_path):
     r = run_cli(str(tmp_path / "nope.blend"))
     assert r.returncode == 1 and "no such file" in r.stderr
