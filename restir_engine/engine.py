@@ -304,12 +304,13 @@ class RestirRenderEngine(bpy.types.RenderEngine):
 
     @staticmethod
     def _viewport_settings(scene, context) -> RenderSettings:
-        """The render settings, one sample per pass, data passes only on demand (the Depth/Normal/Motion viewport
+        """The render settings for the viewport's Samples, data passes only on demand (the Depth/Normal/Motion viewport
         passes compute them lazily); a reservoir pass on screen makes Auto resample, as in a final render."""
         from .viewport import GI_RESERVOIR_PASSES, RESERVOIR_PASSES
         settings = settings_from_scene(scene)
-        settings.samples = 1
-        settings.use_adaptive_sampling = False  # the viewport samples every pixel (its own refinement)
+        # a pass renders one sample (or a batch, viewport.py); Samples is the viewport's: adaptive sampling's schedule
+        # (Noise Threshold, as in a final render) reads it, and converged pixels stop refining
+        settings.samples = max(1, int(scene.restir.viewport_samples))
         settings.data_passes = False
         settings.reservoir_passes = _viewport_pass(context) in RESERVOIR_PASSES
         settings.gi_reservoir_passes = _viewport_pass(context) in GI_RESERVOIR_PASSES

@@ -306,7 +306,7 @@ class ViewportSession:
         elif self.time_limit > 0 and self._refine_t0 is not None and \
                 self.clock() - self._refine_t0 >= self.time_limit:
             return False
-        return self.renderer.samples_done < self.max_samples
+        return self.renderer.samples_done < self.max_samples and not self.renderer.converged
 
     def _run(self) -> None:
         try:
@@ -343,7 +343,7 @@ class ViewportSession:
             elif republish and self.renderer.samples_done > 0:
                 self._publish()
                 continue
-            if self.renderer.samples_done >= self.max_samples:
+            if self.renderer.samples_done >= self.max_samples or self.renderer.converged:
                 continue
             self._pass(navigation)
 
@@ -435,8 +435,8 @@ class ViewportSession:
 
 
     def _finished(self, samples: int) -> bool:
-        """Whether the current view refines no further (its samples or its time limit reached)."""
-        return samples >= self.max_samples or (self.time_limit > 0 and self._refine_t0 is not None
+        """Whether the current view refines no further (its samples, adaptive convergence or its time limit)."""
+        return samples >= self.max_samples or self.renderer.converged or (self.time_limit > 0 and self._refine_t0 is not None
                                                and self.clock() - self._refine_t0 >= self.time_limit)
 
     def _denoised_combined(self, r: FrameRenderer, image: np.ndarray) -> np.ndarray:

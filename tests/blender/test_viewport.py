@@ -337,3 +337,28 @@ def test_viewport_denoise_refreshes_as_the_samples_double(addon, monkeypatch):
     assert all(b >= 2 * a or b == 12 for a, b in zip(samples, samples[1:])), samples
     np.testing.assert_allclose(shown[..., :3], np.minimum(expect, 65504.0), rtol=1e-6, atol=1e-7)
     assert np.abs(shown[..., :3] - raw[..., :3]).max() > 1e-3
+
+
+def test_viewport_adaptive_sampling_stops_a_converged_view(addon):
+    """With Noise Threshold on, a still view whose pixels converge at the first check (a noiseless scene) stops
+    refining there, short of the viewport's Samples, and its image is the mean of the samples each pixel took; with
+    it off the same view refines to the viewport's Samples."""
+    from scenes_core import small_plane_under_world
+    core = small_plane_under_world(32)
+    base = RenderSettings(samples=400, integrator="PATH", max_bounces=1, use_adaptive_sampling=True,
+                          adaptive_threshold=0.01, adaptive_min_samples=16, data_passes=False, tile_pixels=4096)
+    for adaptive, expected in ((True, 32), (False, 48)):
+        session = ViewportSession(lambda: None, budget=0.0, max_samples=400 if adaptive else 48)
+        try:
+            session.set_scene(core, dataclasses.replace(base, use_adaptive_sampling=adaptive))
+            session.set_view(core.camera, "still")
+            wait_for(lambda: session.stats.samples >= expected)
+            time.sleep(0.3)  # a session that went on refining would pass its stop by now
+            assert session.stats.samples == expected, (adaptive, session.stats.samples)
+            assert session.renderer.converged == adaptive
+            shown = session.latest()[0]
+        finally:
+            session.halt()
+        ref = render_frame(dataclasses.replace(core, motion=None),
+                           dataclasses.replace(base, samples=expected, use_adaptive_sampling=False, frame=1))
+        np.testing.assert_allclose(shown[..., :3], ref.passes["Combined"][..., :3], rtol=1e-5, atol=1e-6)
