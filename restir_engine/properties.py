@@ -194,8 +194,8 @@ SCENE_FIELDS = (
         default=0.0, min=0.0, soft_max=3600.0, subtype="TIME_ABSOLUTE")),
     Field("use_adaptive_sampling", BoolProperty, bool, dict(
         name="Noise Threshold", description="Adaptive sampling, as Cycles': pixels whose noise estimate falls "
-        "under the threshold stop taking samples, and the frame's work goes to the noisy ones (F12 and animation; "
-        "the viewport samples every pixel)", default=True)),
+        "under the threshold stop taking samples, and the frame's work goes to the noisy ones (F12, animation and "
+        "the viewport, up to its Samples)", default=True)),
     Field("adaptive_threshold", FloatProperty, float, dict(
         name="Noise Threshold", description="The noise level at which a pixel stops: its relative difference "
         "between all its samples and half of them (lower: less noise, more samples; 0 = automatic, 1/Samples)",
