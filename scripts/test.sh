@@ -26,7 +26,7 @@ for i in "${!versions[@]}"; do
   ( echo "== Python ${versions[$i]}, bpy $("$venv/bin/python" -c 'import importlib.metadata as m; print(m.version("bpy"))')"
     start=$SECONDS
     rc=0
-    "$venv/bin/python" -m pytest -q -p no:cacheprovider tests "$@" || rc=$?
+    "$venv/bin/python" -m pytest -q -p no:cacheprovider --durations=15 tests "$@" || rc=$?
     echo "== Python ${versions[$i]}: exit $rc after $((SECONDS - start)) s"
     exit $rc ) > "$logs/$i.log" 2>&1 &
   pids+=($!)
