@@ -185,6 +185,16 @@ def _render_animation(bpy, scene) -> None:
     finally:
         bpy.app.handlers.render_write.remove(saved)
 
+def _end_workers() -> None:
+    """Close the render worker processes and their shared memory (``os._exit`` skips the atexit hook that would,
+    and Python's resource tracker would then report the segments as leaked)."""
+    from .core.parallel import processes
+    try:
+        processes.shutdown()
+    except Exception as exc:  # noqa: BLE001 - the frames are written; a failed close must not change the status
+        print(f"warning: render workers did not close cleanly: {exc}", file=sys.stderr)
+
+
 def run(argv=None) -> None:
     """``main`` as a process: exit with its status straight after the output is flushed, without Blender's
     teardown (it writes nothing a render needs, and the bpy 4.5 module deadlocks in it: its delayed-close thread
@@ -193,6 +203,7 @@ def run(argv=None) -> None:
         code = main(argv)
     except SystemExit as exc:  # argparse's errors
         code = exc.code if isinstance(exc.code, int) else 1
+    _end_workers()
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(code)
