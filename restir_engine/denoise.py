@@ -88,11 +88,8 @@ def wanted(scene) -> bool:
 def denoise_combined(passes: dict, settings: DenoiseSettings) -> np.ndarray:
     """Replace ``passes["Combined"]`` (h, w, 4) by its denoised image (alpha kept); returns the noisy Combined."""
     noisy = passes["Combined"]
-    rgb = denoiser().denoise(noisy[..., :3], passes.get("Denoising Albedo"), passes.get("Denoising Normal"),
-                             settings)
-    out = np.array(noisy, np.float32, copy=True)
-    out[..., :3] = rgb.reshape(out.shape[:-1] + (3,))
-    passes["Combined"] = out
+    passes["Combined"] = denoiser().denoise_rgba(noisy, passes.get("Denoising Albedo"), passes.get("Denoising Normal"),
+                                                 settings)
     return noisy
 
 

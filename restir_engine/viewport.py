@@ -303,8 +303,7 @@ class ViewportSession:
             return True
         if self.renderer.samples_done == 0:
             self._refine_t0 = None
-        elif self.time_limit > 0 and self._refine_t0 is not None and \
-                self.clock() - self._refine_t0 >= self.time_limit:
+        elif self._out_of_time():
             return False
         return self.renderer.samples_done < self.max_samples and not self.renderer.converged
 
@@ -433,11 +432,14 @@ class ViewportSession:
                                              gi_mean_m=_mean_confidence(r, "gi_m"))
         self.redraw()
 
+    def _out_of_time(self) -> bool:
+        """Whether the still view's refinement has used the Time Limit."""
+        return self.time_limit > 0 and self._refine_t0 is not None and \
+            self.clock() - self._refine_t0 >= self.time_limit
 
     def _finished(self, samples: int) -> bool:
         """Whether the current view refines no further (its samples, adaptive convergence or its time limit)."""
-        return samples >= self.max_samples or self.renderer.converged or (self.time_limit > 0 and self._refine_t0 is not None
-                                               and self.clock() - self._refine_t0 >= self.time_limit)
+        return samples >= self.max_samples or self.renderer.converged or self._out_of_time()
 
     def _denoised_combined(self, r: FrameRenderer, image: np.ndarray) -> np.ndarray:
         """The Combined image denoised: afresh for a new view or resolution, when the samples have doubled since the
@@ -451,8 +453,7 @@ class ViewportSession:
         denoiser, settings = self.denoise
         albedo = r.mean("albedo") if r.has_pass_data("albedo") else None
         normal = r.mean("dnormal") if r.has_pass_data("dnormal") else None
-        out = np.array(image, np.float32, copy=True)
-        out[..., :3] = denoiser.denoise(image[..., :3], albedo, normal, settings)
+        out = denoiser.denoise_rgba(image, albedo, normal, settings)
         self._denoised = (tag, n, out)
         return out
 

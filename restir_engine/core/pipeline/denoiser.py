@@ -156,6 +156,13 @@ class Denoiser:
             self._run(device, {"color": color, **guides, "output": out}, flags, quality, settings.max_memory_mb)
         return out
 
+    def denoise_rgba(self, image: np.ndarray, albedo: np.ndarray | None = None, normal: np.ndarray | None = None,
+                     settings: DenoiseSettings = DenoiseSettings()) -> np.ndarray:
+        """A float32 copy of the (h, w, 4) ``image`` with its colour denoised (:meth:`denoise`) and its alpha kept."""
+        out = np.array(image, np.float32, copy=True)
+        out[..., :3] = self.denoise(image[..., :3], albedo, normal, settings).reshape(out.shape[:-1] + (3,))
+        return out
+
     def close(self) -> None:
         with self._lock:
             if self._device is not None:
