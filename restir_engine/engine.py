@@ -12,7 +12,7 @@ from . import passes as pass_table
 from .core.pipeline import memory, methods
 from .core.pipeline.bands import plan as band_plan
 from .core.renderer import Cancelled, RenderSettings, render_frame
-from .export import ExportError, export_scene, neighbour_frames
+from .export import ExportError, export_scene, motion_blur, neighbour_frames
 from .properties import scene_settings_to_core
 
 MAX_REPORTED_WARNINGS = 12
@@ -181,10 +181,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self._write(_black_passes(scene, view_layer, core_scene.camera.window), core_scene.camera.window,
                         scene, view_layer)
             return
-        wants_vector = view_layer.use_pass_vector
-        if wants_vector or wants_temporal:
-            self.update_stats("ReSTIR", "Evaluating neighbouring frames for motion")
-            neighbour_frames(self, depsgraph, core_scene, self.camera_override, need_next=wants_vector)
+        self._motion(depsgraph, core_scene, view_layer.use_pass_vector, wants_temporal)
         t_export = time.perf_counter() - t0
 
         def progress(fraction, message):
@@ -243,6 +240,16 @@ class RestirRenderEngine(bpy.types.RenderEngine):
                                 frame=scene.frame_current, cancelled=result.cancelled, **result.stats)
         self.update_stats("ReSTIR", f"Frame {scene.frame_current} | {result.samples_done} samples | "
                                     f"export {t_export:.2f}s, render {result.seconds:.2f}s")
+
+    def _motion(self, depsgraph, core_scene, wants_vector: bool, wants_temporal: bool) -> None:
+        """The neighbouring frames' transforms (motion vectors, temporal reuse) and the shutter's (motion blur)."""
+        if wants_vector or wants_temporal:
+            self.update_stats("ReSTIR", "Evaluating neighbouring frames for motion")
+            neighbour_frames(self, depsgraph, core_scene, self.camera_override, need_next=wants_vector)
+        if motion_blur.wanted(depsgraph.scene):
+            self.update_stats("ReSTIR", "Evaluating the shutter for motion blur")
+            for msg in motion_blur.export_shutter(self, depsgraph, core_scene, self.camera_override):
+                self.report({"WARNING"}, msg)
 
     def _preroll(self, depsgraph, settings, count: int):
         """Render the first sample pass of frames F-count .. F-1 (not written): the history travels through

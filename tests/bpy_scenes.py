@@ -800,3 +800,61 @@ def panorama_scene(kind, size=(64, 32)):
     cam.clip_start = 0.01
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def motion_blur_scene(size=(96, 64), shutter=1.0, camera_pans=False, spin=True, deform=False):
+    """Frame 2 of an animation under an area light: a cube flies across a diffuse floor (1 m per frame, linear
+    keys), a glowing bar spins about its centre (90° per frame, linear), with ``camera_pans`` the camera turns 8°
+    per frame, with ``deform`` a glowing sheet's vertices slide 0.6 m per frame (a shape key); Render > Motion Blur
+    on with ``shutter`` (frames)."""
+    scene = reset()
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    scene.frame_start, scene.frame_end = 1, 3
+    plane("Floor", 8.0, (0, 0, 0), material=diffuse("Floor", (0.7, 0.7, 0.7)))
+    light("AREA", (0, 0, 3.0), energy=200.0, size=1.0)
+    bpy.ops.mesh.primitive_cube_add(size=0.6, location=(-1.5, -0.4, 0.5))
+    cube = bpy.context.active_object
+    cube.data.materials.append(diffuse("Cube", (0.8, 0.3, 0.2)))
+    cube.keyframe_insert("location", frame=1)
+    cube.location.x = 0.5
+    cube.keyframe_insert("location", frame=3)
+    keyed = [cube]
+    if spin:
+        bar = plane("Bar", 1.0, (1.2, 0.6, 0.8), material=emission("Bar", (0.3, 0.6, 1.0), 4.0), scale=(1.0, 0.15, 1))
+        bar.keyframe_insert("rotation_euler", frame=1)
+        bar.rotation_euler.z = math.pi
+        bar.keyframe_insert("rotation_euler", frame=3)
+        keyed.append(bar)
+    if deform:
+        bpy.ops.mesh.primitive_grid_add(x_subdivisions=8, y_subdivisions=2, size=1.2, location=(-0.6, 1.0, 0.05))
+        sheet = bpy.context.active_object
+        sheet.data.materials.append(emission("Sheet", (1.0, 0.8, 0.3), 3.0))
+        sheet.shape_key_add(name="Basis")
+        up = sheet.shape_key_add(name="Sweep")
+        for v in up.data:
+            v.co.x += 1.2  # the sheet's vertices slide 1.2 m along x (its object stays)
+        up.value = 0.0
+        up.keyframe_insert("value", frame=1)
+        up.value = 1.0
+        up.keyframe_insert("value", frame=3)
+        keyed.append(sheet.data.shape_keys)
+    cam = camera((0, -4.5, 3.5), (math.radians(52), 0, 0), lens=30.0)
+    if camera_pans:
+        cam.keyframe_insert("rotation_euler", frame=1)
+        cam.rotation_euler.z = math.radians(16)
+        cam.keyframe_insert("rotation_euler", frame=3)
+        keyed.append(cam)
+    for obj in keyed:
+        for fc in _anim_fcurves(obj):
+            for k in fc.keyframe_points:
+                k.interpolation = "LINEAR"
+    scene.frame_set(2)
+    scene.render.use_motion_blur = True
+    scene.render.motion_blur_shutter = shutter
+    return scene
+
+
+def _anim_fcurves(obj):
+    from harness.scenes import _fcurves
+    return _fcurves(obj)

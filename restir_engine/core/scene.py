@@ -350,3 +350,4 @@ class Scene:
     world_rotation: np.ndarray | None = None  # (3, 3) world -> environment texture frame (core/lights/world.py)
     world_camera_view: tuple | None = None    # (radiance (3,), image or None) camera rays see instead, or None
     motion: Motion | None = None
+    blur: object = None  # geometry.motion_blur.ShutterMotion: where things are during the shutter (None: no motion blur)

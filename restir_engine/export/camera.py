@@ -44,8 +44,6 @@ def export_camera(depsgraph, camera_override, warnings: list) -> Camera:
         warnings.append(f"Active camera '{cam_obj.name}' is a {cam_obj.type.lower()} object; "
                         "using its transform as a 50 mm camera")
     render = scene.render
-    if getattr(render, "use_motion_blur", False):
-        warnings.append("Motion blur is not rendered yet: each frame is rendered sharp at its own time")
     width, height = render_size(render)
     proj = cam_obj.calc_matrix_camera(depsgraph, x=width, y=height,
                                       scale_x=render.pixel_aspect_x, scale_y=render.pixel_aspect_y)

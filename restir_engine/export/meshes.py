@@ -73,6 +73,17 @@ def _read_mesh(mesh, want_uv: bool, want_tangents: bool = False, warnings: list 
             "tangents": tangents, "attributes": attrs, "texspace": _texspace(mesh, local)}
 
 
+def read_corners(mesh) -> np.ndarray:
+    """(t, 3, 3) float32 local-space corners of a mesh's loop triangles (as :func:`_read_mesh` orders them)."""
+    mesh.calc_loop_triangles()
+    tris = mesh.loop_triangles
+    co = np.empty(len(mesh.vertices) * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    vidx = np.empty(len(tris) * 3, np.int32)
+    tris.foreach_get("vertices", vidx)
+    return co.reshape(-1, 3)[vidx].reshape(len(tris), 3, 3)
+
+
 def _texspace(mesh, local: np.ndarray) -> tuple:
     """(lo, size) of a mesh's texture space: Generated = (local position - lo) / size (Blender's auto texture
     space is its box; a flat axis gets size 2 around its centre, a tiny one 2e-5)."""
@@ -315,7 +326,10 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
         normals[bad_n] = 0.0  # the shader falls back to the geometric normal
     stats = {"triangles": len(verts), "instances": len(blocks), "dropped": int((~keep).sum()),
              "instance_keys": [b[4] for b in blocks], "instance_matrices": np.array([b[1] for b in blocks]),
-             "meshes_read": reads, "slot_signature": tuple(slots_seen)}
+             "meshes_read": reads, "slot_signature": tuple(slots_seen),
+             # each instance's triangles before the unusable ones were dropped, and which were kept (motion blur's
+             # deformation steps read the same triangles again)
+             "block_starts": np.cumsum([0] + [len(b[0]["verts"]) for b in blocks]), "kept": keep}
     return TriangleSet(verts, normals, material, uvs, instance, tangents, objects=_object_table(blocks),
                        attributes=attributes or None, local_verts=local_verts), stats
 

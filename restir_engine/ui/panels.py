@@ -272,6 +272,31 @@ class RESTIR_PT_film(RestirPanel, bpy.types.Panel):
         row.prop(s, "filter_width")
 
 
+class RESTIR_PT_motion_blur(RestirPanel, bpy.types.Panel):
+    bl_label = "Motion Blur"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.render, "use_motion_blur", text="")
+
+    def draw(self, context):
+        layout = self.split_layout()
+        layout.active = context.scene.render.use_motion_blur
+        layout.prop(context.scene.render, "motion_blur_position", text="Position")
+        layout.prop(context.scene.render, "motion_blur_shutter")
+
+
+class RESTIR_PT_motion_blur_curve(RestirPanel, bpy.types.Panel):
+    bl_label = "Shutter Curve"
+    bl_parent_id = "RESTIR_PT_motion_blur"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.active = context.scene.render.use_motion_blur
+        layout.template_curve_mapping(context.scene.render, "motion_blur_shutter_curve")
+
+
 class RESTIR_PT_performance(RestirPanel, bpy.types.Panel):
     bl_label = "Performance"
     bl_options = {"DEFAULT_CLOSED"}
@@ -364,7 +389,8 @@ class RESTIR_PT_viewport_render_pass(bpy.types.Panel):
 
 
 PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_direct, RESTIR_PT_sampling_reuse, RESTIR_PT_sampling_indirect,
-          RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths, RESTIR_PT_film, RESTIR_PT_performance,
+          RESTIR_PT_sampling_denoising, RESTIR_PT_light_paths, RESTIR_PT_film, RESTIR_PT_motion_blur,
+          RESTIR_PT_motion_blur_curve, RESTIR_PT_performance,
           RESTIR_PT_passes)  # Render Properties
 VIEW_PANELS = (RESTIR_PT_viewport_render_pass,)  # the 3D view's header popovers
 

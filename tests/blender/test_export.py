@@ -233,8 +233,53 @@ def test_metaball_and_emission_texture(scene):
     assert np.isclose(table.power[:2].sum(), np.pi * 2 * 2.0 * lum * 4.0, rtol=1e-4)
 
 
-def test_unrendered_motion_blur_is_named(scene):
+class _Frames:
+    """The part of a RenderEngine export_shutter calls: frame_set on the scene."""
+
+    def __init__(self, scene):
+        self.scene = scene
+
+    def frame_set(self, frame, subframe=0.0):
+        self.scene.frame_set(frame, subframe=subframe)
+
+
+def _shutter(scene):
+    from restir_engine.export.motion_blur import export_shutter
+    dg = bpy.context.evaluated_depsgraph_get()
+    out = export_scene(dg)
+    warnings = export_shutter(_Frames(scene), dg, out)
+    return out, warnings
+
+
+def test_motion_blur_steps_follow_the_shutter(addon):
+    """Render > Motion Blur as Cycles evaluates it: 3 steps over the shutter around the frame (Center) or after it
+    (Start), the camera's steps where it moves, the deforming sheet's corners per step, nothing for an object whose
+    Object > Motion Blur is off; the frame is restored afterwards."""
+    from bpy_scenes import motion_blur_scene
+    scene = motion_blur_scene(shutter=1.0, camera_pans=True, deform=True)
+    out, warnings = _shutter(scene)
+    assert scene.frame_current == 2 and not warnings
+    blur = out.blur
+    keys = [k[0] for k in out.export_stats["instance_keys"]]
+    cube = keys.index("Cube")
+    # the cube moves 1 m per frame: x at frames 1.5, 2, 2.5
+    np.testing.assert_allclose(blur.instance_steps[:, cube, 0, 3], [-1.0, -0.5, 0.0], atol=1e-5)
+    assert blur.moving[cube] and not blur.moving[keys.index("Floor")]
+    assert blur.camera_steps is not None and len(blur.camera_steps) == 3
+    assert blur.deform_rows is not None and len(blur.deform_rows) == 2 * 8 * 2  # the 8 x 2 grid's triangles
+    np.testing.assert_allclose(blur.deform_steps[2, :, :, 0] - blur.deform_steps[0, :, :, 0], 0.6, atol=1e-5)
+    scene.render.motion_blur_position = "START"
+    np.testing.assert_allclose(_shutter(scene)[0].blur.instance_steps[:, cube, 0, 3], [-0.5, 0.0, 0.5],
+                               atol=1e-5)
+    scene.render.motion_blur_position = "CENTER"
+    bpy.data.objects["Cube"].cycles.use_motion_blur = False
+    assert not _shutter(scene)[0].blur.moving[cube]
+    scene.cycles.rolling_shutter_type = "TOP"
+    assert any("rolling shutter" in w for w in _shutter(scene)[1])
+
+
+def test_a_still_shutter_has_no_blur(scene):
     plane("Floor", 2.0, (0, 0, 0))
-    assert not any("Motion blur" in w for w in export().warnings)
     scene.render.use_motion_blur = True
-    assert sum("Motion blur" in w for w in export().warnings) == 1
+    out, warnings = _shutter(scene)
+    assert out.blur is None and not warnings

@@ -178,3 +178,38 @@ class Accel:
 
         run_chunks(work, self._chunks(n))
         return out
+
+
+class SplitAccel(Accel):
+    """The triangles of one scene in two Embree scenes: ``still`` (an Accel over the rows ``still_rows``, built once)
+    and the rows ``moving_rows`` whose corners change (``moving_triangles`` (m, 3, 3), rebuilt for each pose), so
+    that a moving object costs the build of its own triangles only. Primitive indices are the scene's rows."""
+
+    def __init__(self, still: Accel, still_rows: np.ndarray, moving_triangles: np.ndarray, moving_rows: np.ndarray,
+                 cutout=None, ng_rows: np.ndarray | None = None):
+        self.n_triangles = still.n_triangles + len(moving_rows)
+        self.cutout, self._ng_rows = cutout, ng_rows
+        self.still, self.still_rows = still, np.asarray(still_rows, np.int32)
+        self.moving, self.moving_rows = Accel(moving_triangles), np.asarray(moving_rows, np.int32)
+        self._scene = self.still._scene if self.still._scene is not None else self.moving._scene
+
+    def still_part(self) -> tuple:
+        """(the Accel of the unmoved rows, those rows): to share with the next pose's SplitAccel."""
+        return self.still, self.still_rows
+
+    def _intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
+        a = self.still._intersect(origins, directions, tmax)
+        b = self.moving._intersect(origins, directions, tmax)
+        hit_a = a.prim >= 0
+        a.prim[hit_a] = self.still_rows[a.prim[hit_a]]
+        nearer = (b.prim >= 0) & (b.t < a.t)
+        a.prim[nearer] = self.moving_rows[b.prim[nearer]]
+        a.t[nearer], a.u[nearer], a.v[nearer] = b.t[nearer], b.u[nearer], b.v[nearer]
+        return a
+
+    def _occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+        out = self.still._occluded(origins, directions, tmax)
+        rest = np.flatnonzero(~out)
+        if rest.size:
+            out[rest] = self.moving._occluded(cols(origins, rest), cols(directions, rest), tmax[rest])
+        return out

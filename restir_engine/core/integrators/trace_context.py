@@ -2,7 +2,9 @@
 the light table, per-material rows, per-triangle normals, the world), and the instances' screen boxes."""
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -142,3 +144,56 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         world=world,
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)
+
+
+def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tuple | None = None) -> TraceContext:
+    """``base``'s context for ``scene``, the same scene with the triangle rows ``rows`` moved (motion blur's
+    poses, geometry/motion_blur.py): the moved rows' derived arrays and their Embree scene rebuilt (the others'
+    Embree scene, built over the unmoved rows, is shared: ``still`` (Accel, rows) from an earlier call's
+    :meth:`SplitAccel.still_part` with the same ``rows``), the light table rebuilt where an emitter moved; the
+    materials, lamps and the world are base's."""
+    from ..geometry.accel import SplitAccel
+    geom = scene.geometry
+    bd = base.geom_derived
+    ng = bd.ng.copy()
+    if rows.size:
+        ng[rows], _ = triangle_geometry(geom.verts[rows])
+    normal_rows = bd.normal_rows.copy()
+    normal_rows[:, rows] = geom.normals[rows].reshape(len(rows), 9).T
+    bounds, boxes = _moved_bounds(bd, geom, rows)
+    derived = GeometryDerived(bounds, ng, np.ascontiguousarray(ng.T), bd.flat, normal_rows, boxes)
+    if still is None:
+        keep = np.ones(len(geom), bool)
+        keep[rows] = False
+        still_rows = np.flatnonzero(keep)
+        still = (Accel(base.scene.geometry.verts[still_rows]), still_rows)
+    cut = base.geom_accel.cutout
+    accel = SplitAccel(still[0], still[1], geom.verts[rows], rows, cut, derived.ng_rows if cut else None)
+    lights, emit_accel = base.lights, base.emit_accel
+    if rows.size and lights.n_geom and (lights.geom_to_light[rows] >= 0).any():
+        lights = LightTable(scene, base.lights.scene_radius)
+        if base.lights.env is not None:
+            lights.attach_world(base.lights.env)
+        emit_accel = Accel(lights.tri_verts[:lights.n_geom]) if lights.n_geom else None
+    return dataclasses.replace(base, scene=scene, geom_accel=accel, lights=lights, emit_accel=emit_accel,
+                               geom_ng=ng, geom_ng_rows=derived.ng_rows, geom_normal_rows=normal_rows,
+                               geom_derived=derived, measured=base.measured)
+
+
+def _moved_bounds(base: GeometryDerived, geom, rows: np.ndarray) -> tuple:
+    """(bounds, boxes) covering ``base``'s and the moved rows ``rows`` of ``geom``: the base boxes with the moved
+    rows' instance boxes added (a superset of where the geometry is at this pose: the camera masks built from it
+    only test more pixels), without a pass over the unmoved triangles."""
+    if not rows.size:
+        return base.bounds, base.boxes
+    moved = SimpleNamespace(verts=geom.verts[rows], instance=None if geom.instance is None else geom.instance[rows])
+    v = moved.verts.reshape(-1, 3)
+    fin = v[np.isfinite(v).all(axis=1)]
+    if not len(fin):
+        return base.bounds, base.boxes
+    lo, hi = fin.min(0), fin.max(0)
+    if base.bounds is not None:
+        lo, hi = np.minimum(lo, base.bounds[0]), np.maximum(hi, base.bounds[1])
+    add = instance_boxes(moved, (fin.min(0), fin.max(0)))
+    old = base.boxes if base.boxes is not None else (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.float32))
+    return (lo, hi), (np.concatenate([old[0], add[0]]), np.concatenate([old[1], add[1]]))

@@ -154,6 +154,7 @@ class LightSample:
 class LightTable:
     def __init__(self, scene: Scene, scene_radius: float):
         geom, lamps, mats = scene.geometry, scene.lamps, scene.materials
+        self.scene_radius = scene_radius
         # emissive scene triangles: non-zero emission (texture mean included)
         emit_lum = luminance(mats.emission)
         tex_mean = np.array([luminance(mean_color(t)[None])[0] for t in mats.textures], np.float32)

@@ -99,6 +99,14 @@ class FrameRenderer:
                                                 getattr(self.ctx.scene, "world_image", None))
         self._choose_direct()
         self.space = di.LightSpace(self.ctx.lights)
+        # motion blur (geometry/motion_blur.py): each pass renders the scene posed at its own shutter time
+        self.base_ctx, self.base_space = self.ctx, self.space
+        blur = getattr(scene, "blur", None)
+        self.blur = blur if blur is not None and blur.moves else None
+        self.shutter_time = None  # the last pass's shutter time τ (None without motion blur)
+        if self.blur is not None:
+            self._blur_rows = self.blur.moving_rows(scene.geometry.instance)
+            self._still = None  # (Accel, rows) of the triangles that do not move, built at the first pose
         self.build_seconds = time.perf_counter() - t0
         self.set_camera(scene.camera)
         if history is not None and history.fits(scene.camera):
@@ -169,11 +177,10 @@ class FrameRenderer:
 
     def set_camera(self, camera) -> None:
         """Use another camera (same scene) and restart accumulation."""
+        if getattr(self, "blur", None) is not None:  # back to the frame's own pose (the next pass poses again)
+            self.ctx, self.space = self.base_ctx, self.base_space
         self.ctx.scene.camera = camera
-        self.coverage, self.coverage_reason, self.coverage_mask = coverage_mod.coverage(
-            self.settings.coverage_samples, self.ctx.lights, self.ctx.scene.lamps, camera)
-        self.masks = primary.CameraMasks(self.coverage_mask, coverage_mod.geometry_mask(self.ctx, camera),
-                                         coverage_mod.lamp_mask(self.ctx, camera))
+        self._set_masks(camera)
         _x0, _y0, w, h = camera.window
         self.release()
         st = self.settings
@@ -189,6 +196,32 @@ class FrameRenderer:
         self._data = None
         self.prev_history = None
         self.history = None
+
+    def _set_masks(self, camera) -> None:
+        """The camera rays' masks (which pixels may see geometry, lamps, emitters) for ``camera`` in self.ctx."""
+        self.coverage, self.coverage_reason, self.coverage_mask = coverage_mod.coverage(
+            self.settings.coverage_samples, self.ctx.lights, self.ctx.scene.lamps, camera)
+        self.masks = primary.CameraMasks(self.coverage_mask, coverage_mod.geometry_mask(self.ctx, camera),
+                                         coverage_mod.lamp_mask(self.ctx, camera))
+
+    def _pose(self, sample: int) -> None:
+        """Motion blur: pose the scene at pass ``sample``'s shutter time (ShutterMotion.pass_time) for the pass;
+        only the triangles that move are rebuilt (trace_context.moved_context)."""
+        st, blur, base = self.settings, self.blur, self.base_ctx
+        tau = blur.pass_time(st.seed, st.frame, sample, st.samples)
+        scene = blur.scene_at(base.scene, tau)
+        if self._blur_rows.size:
+            ctx = trace_context.moved_context(base, scene, self._blur_rows, self._still)
+            self._still = ctx.geom_accel.still_part()
+        else:  # only the camera moves
+            ctx = dataclasses.replace(base, scene=scene)
+        self.ctx = ctx
+        self.space = self.base_space if ctx.lights is base.lights else di.LightSpace(ctx.lights)
+        if self.gi is not None:
+            unbiased = st.bias_correction == "UNBIASED"
+            self.gi_space = gi.GISpace(ctx.geom_accel if unbiased else None, st.gi_target)
+        self._set_masks(scene.camera)
+        self.shutter_time = tau
 
     @property
     def samples_done(self) -> int:
@@ -222,8 +255,8 @@ class FrameRenderer:
 
     def data_passes(self):
         """Depth (h, w, 1), Normal (h, w, 3) and Vector (h, w, 4) at pixel centres (data_passes.py)."""
-        if self._data is None:
-            self._data = render_data_passes(self.ctx, self.settings.tile_pixels)
+        if self._data is None:  # at the frame's own time (motion blur: not at the last pass's)
+            self._data = render_data_passes(self.base_ctx, self.settings.tile_pixels)
         return self._data
 
     def passes(self) -> dict:
@@ -267,8 +300,9 @@ class FrameRenderer:
 
     def _can_batch(self) -> bool:
         """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
-        ReSTIR GI) and measures nothing for Auto indirect (no probe; the first pass without a measurement probes)."""
-        if self.candidates is not None or self._gi_runs():
+        ReSTIR GI), measures nothing for Auto indirect (no probe; the first pass without a measurement probes) and
+        is not motion-blurred (each sample at its own shutter time)."""
+        if self.candidates is not None or self._gi_runs() or self.blur is not None:
             return False
         if self.gi is None or self.samples_done > 0:
             return True
@@ -318,6 +352,8 @@ class FrameRenderer:
 
     def _sample_pass(self, progress, should_stop, batch: int, cap) -> int:
         """One pass of ``plan.batch`` samples through the stages. Returns the samples rendered."""
+        if self.blur is not None:
+            self._pose(self.samples_done)
         st, ctx, clock, team = self.settings, self.ctx, self.clock, self.team
         plan = self._plan(batch, cap)
         _x0, _y0, w, h = ctx.scene.camera.window
