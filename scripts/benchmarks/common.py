@@ -15,3 +15,26 @@ def write_json(path: str, data, indent: int = 1) -> None:
     with open(path, "w") as f:
         json.dump(data, f, indent=indent)
         f.write("\n")
+
+
+def bar_chart(path: str, labels, values, ylabel: str, title: str, reference: tuple | None = None) -> None:
+    """A bar per label (``values`` in the labels' order) saved as a PNG at ``path``; ``reference`` (label, value)
+    draws a dashed horizontal line for comparison."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 3.6))
+    ax.bar(range(len(values)), values, color="#4c72b0")
+    ax.set_xticks(range(len(values)), labels)
+    for i, v in enumerate(values):
+        ax.text(i, v, f"{v:.2f}", ha="center", va="bottom")
+    if reference is not None:
+        ax.axhline(reference[1], ls="--", color="#c44e52", label=reference[0])
+        ax.legend()
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, axis="y", alpha=0.3)
+    fig.tight_layout()
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

@@ -119,36 +119,39 @@ class ShutterMotion:
         a, b = self.deform_steps[j], self.deform_steps[j + 1]
         return (a + np.float32(f) * (b - a)).astype(np.float32)
 
-    def scene_at(self, scene: Scene, tau: float) -> Scene:
+    def scene_at(self, scene: Scene, tau: float, into: Scene | None = None) -> Scene:
         """``scene`` as it stands at shutter time τ: moving instances' triangles (corners, shading normals, UV
         tangents) moved, deforming ones taken from the steps, the objects' matrices and the camera at τ. The
-        arrays of what does not move are shared with ``scene``."""
+        arrays of what does not move are shared with ``scene``. ``into``: an earlier result of this call for the
+        same ``scene``, whose geometry arrays are overwritten in the moving rows only (no copy of the others;
+        that earlier scene then stands at τ too)."""
         geom = scene.geometry
         rows = self.moving_rows(geom.instance)
         if rows.size:
-            geom = self._geometry_at(geom, rows, tau)
+            geom = self._geometry_at(geom, rows, tau, None if into is None else into.geometry)
         camera = scene.camera
         c2w = self.camera_matrix(tau)
         if c2w is not None:
             camera = dataclasses.replace(camera, cam_to_world=c2w)
         return dataclasses.replace(scene, geometry=geom, camera=camera)
 
-    def _geometry_at(self, geom, rows: np.ndarray, tau: float):
+    def _geometry_at(self, geom, rows: np.ndarray, tau: float, into=None):
         mats = self.instance_matrices(tau)
         rel = np.einsum("kij,kjl->kil", mats, self._inverse_current)  # M(τ) · M(frame)⁻¹ per instance
         inst = np.clip(geom.instance[rows], 0, len(rel) - 1) if geom.instance is not None else np.zeros(len(rows),
                                                                                                        np.intp)
         lin = rel[inst, :3, :3]
-        verts = geom.verts.copy()
+        verts = geom.verts.copy() if into is None else into.verts
         v = geom.verts[rows].astype(np.float64)
         verts[rows] = (np.einsum("nij,ncj->nci", lin, v) + rel[inst, None, :3, 3]).astype(np.float32)
         normal_lin = np.swapaxes(affine_inverse(rel)[:, :3, :3], 1, 2)[inst]  # inverse transpose
-        normals = geom.normals.copy()
+        normals = geom.normals.copy() if into is None else into.normals
         normals[rows] = _unit(np.einsum("nij,ncj->nci", normal_lin, geom.normals[rows].astype(np.float64)))
         tangents = geom.tangents
         if tangents is not None:
-            tangents = tangents.copy()
-            tangents[rows, :, :3] = _unit(np.einsum("nij,ncj->nci", lin, tangents[rows, :, :3].astype(np.float64)))
+            tangents = tangents.copy() if into is None else into.tangents
+            tangents[rows, :, :3] = _unit(np.einsum("nij,ncj->nci", lin, geom.tangents[rows, :, :3]
+                                                    .astype(np.float64)))
         deformed = self.deformed(tau)
         if deformed is not None:
             verts[self.deform_rows] = deformed

@@ -146,22 +146,27 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)
 
 
-def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tuple | None = None) -> TraceContext:
+def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tuple | None = None,
+                  into: TraceContext | None = None) -> TraceContext:
     """``base``'s context for ``scene``, the same scene with the triangle rows ``rows`` moved (motion blur's
     poses, geometry/motion_blur.py): the moved rows' derived arrays and their Embree scene rebuilt (the others'
     Embree scene, built over the unmoved rows, is shared: ``still`` (Accel, rows) from an earlier call's
     :meth:`SplitAccel.still_part` with the same ``rows``), the light table rebuilt where an emitter moved; the
-    materials, lamps and the world are base's."""
+    materials, lamps and the world are base's. ``into``: an earlier result of this call with the same ``base``
+    and ``rows``, whose per-triangle arrays are overwritten in those rows only (it is not to be used after)."""
     from ..geometry.accel import SplitAccel
     geom = scene.geometry
     bd = base.geom_derived
-    ng = bd.ng.copy()
+    if into is None:
+        ng, ng_rows, normal_rows = bd.ng.copy(), bd.ng_rows.copy(), bd.normal_rows.copy()
+    else:
+        ng, ng_rows, normal_rows = into.geom_ng, into.geom_ng_rows, into.geom_normal_rows
     if rows.size:
         ng[rows], _ = triangle_geometry(geom.verts[rows])
-    normal_rows = bd.normal_rows.copy()
+        ng_rows[:, rows] = ng[rows].T
     normal_rows[:, rows] = geom.normals[rows].reshape(len(rows), 9).T
     bounds, boxes = _moved_bounds(bd, geom, rows)
-    derived = GeometryDerived(bounds, ng, np.ascontiguousarray(ng.T), bd.flat, normal_rows, boxes)
+    derived = GeometryDerived(bounds, ng, ng_rows, bd.flat, normal_rows, boxes)
     if still is None:
         keep = np.ones(len(geom), bool)
         keep[rows] = False

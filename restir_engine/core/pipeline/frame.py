@@ -209,9 +209,10 @@ class FrameRenderer:
         only the triangles that move are rebuilt (trace_context.moved_context)."""
         st, blur, base = self.settings, self.blur, self.base_ctx
         tau = blur.pass_time(st.seed, st.frame, sample, st.samples)
-        scene = blur.scene_at(base.scene, tau)
+        posed = self.ctx if self.ctx is not base else None  # the last pass's pose: its arrays are overwritten
+        scene = blur.scene_at(base.scene, tau, None if posed is None else posed.scene)
         if self._blur_rows.size:
-            ctx = trace_context.moved_context(base, scene, self._blur_rows, self._still)
+            ctx = trace_context.moved_context(base, scene, self._blur_rows, self._still, posed)
             self._still = ctx.geom_accel.still_part()
         else:  # only the camera moves
             ctx = dataclasses.replace(base, scene=scene)
