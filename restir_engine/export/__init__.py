@@ -46,11 +46,13 @@ def neighbour_frames(engine, depsgraph, scene_out: Scene, camera_override=None, 
     scene_out.motion = Motion(current=current, prev=prev, next=nxt, camera_prev=cam_prev, camera_next=cam_next)
 
 
-def export_scene(depsgraph, camera_override=None, camera=None, mesh_cache: dict | None = None) -> Scene:
+def export_scene(depsgraph, camera_override=None, camera=None, mesh_cache: dict | None = None,
+                 last: Scene | None = None) -> Scene:
     """Export everything visible in ``depsgraph``; raises :class:`ExportError` on unusable input.
 
     camera: a ready core Camera (the viewport's view) instead of the scene's camera object.
     mesh_cache: meshes read by earlier exports (export.meshes.export_geometry), for the viewport.
+    last: an earlier export with the same mesh_cache, whose triangles are reused where objects only moved.
     ``export_stats["material_index"]`` maps each material's name to its table index (incremental.py).
     """
     t0 = time.perf_counter()
@@ -59,7 +61,8 @@ def export_scene(depsgraph, camera_override=None, camera=None, mesh_cache: dict 
         camera = export_camera(depsgraph, camera_override, warnings)
     registry = MaterialRegistry(warnings)
     registry.camera = camera  # what Texture Coordinate's Camera and Window outputs are relative to
-    geometry, stats = export_geometry(depsgraph, registry, warnings, mesh_cache)
+    geometry, stats = export_geometry(depsgraph, registry, warnings, mesh_cache,
+                                      None if last is None else (last.geometry, last.export_stats))
     geometry_warnings = list(warnings)
     out = export_shading(depsgraph, registry, geometry, camera, warnings)
     out.export_stats = dict(stats, seconds=time.perf_counter() - t0, material_index=dict(registry.index),

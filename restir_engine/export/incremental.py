@@ -7,7 +7,9 @@ Levels, from cheapest:
 - ``SHADING``: materials, lamps, the world: the material table, lamps and world are exported again around the
   previous triangles (no mesh is read, no triangle is transformed; the Embree scene is reused);
 - ``TRANSFORM``: objects moved (or their material slots changed): the triangles are transformed again from the
-  meshes read before (the mesh cache), nothing is read from Blender's meshes;
+  meshes read before (the mesh cache), nothing is read from Blender's meshes; where only objects' matrices
+  changed, only the moved objects' triangles are (the others are the last export's; the renderer then updates
+  its Embree scene for the moved rows only: core/integrators/context_update.py);
 - ``FULL``: geometry edited, objects added/removed/hidden, anything unknown: everything, meshes read again.
 """
 from __future__ import annotations
@@ -81,7 +83,9 @@ class SceneExporter:
         if out is None:
             if done == "FULL":
                 self.mesh_cache.clear()
-            out = export_scene(depsgraph, camera=camera, mesh_cache=self.mesh_cache)
+            # a transform edit re-places only the instances that moved (export.meshes._retransformed)
+            out = export_scene(depsgraph, camera=camera, mesh_cache=self.mesh_cache,
+                               last=self.last if done == "TRANSFORM" else None)
             out.export_stats["material_needs"] = _needs(out)
         self.counts[done] += 1
         self.last, self.last_level = out, done

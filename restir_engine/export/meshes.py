@@ -8,6 +8,8 @@ cached per evaluated datablock so instances of one mesh are read once; no Python
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from ..core.scene import ObjectTable, TriangleSet
@@ -198,11 +200,30 @@ def slot_signature(depsgraph) -> tuple:
                  for _inst, obj in geometry_instances(depsgraph))
 
 
-def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None = None):
+def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None = None, last=None):
     """Returns (TriangleSet, stats dict); the TriangleSet's ``instance`` holds each triangle's index into
     ``stats["instance_keys"]`` / ``stats["instance_matrices"]``. ``mesh_cache`` (optional, kept by the caller
     between exports whose meshes did not change: the viewport after a transform edit) holds the local arrays
-    read from each evaluated mesh; ``stats["meshes_read"]`` counts the meshes read from Blender."""
+    read from each evaluated mesh; ``stats["meshes_read"]`` counts the meshes read from Blender. ``last``: the
+    (TriangleSet, stats) of an earlier export with the same ``mesh_cache``; where only instances' matrices changed
+    since, only their triangles are transformed again (:func:`_retransformed`), the other arrays are last's."""
+    blocks, reads, slots_seen = _collect_blocks(depsgraph, registry, warnings, mesh_cache)
+    if not blocks:
+        return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0, "instance_keys": [],
+                                     "instance_matrices": np.zeros((0, 4, 4)), "meshes_read": reads,
+                                     "slot_signature": tuple(slots_seen)}
+    if last is not None:
+        out = _retransformed(blocks, last[0], last[1], registry)
+        if out is not None:
+            geometry, stats = out
+            warnings.extend(stats["assembly_warnings"])
+            return geometry, dict(stats, meshes_read=reads, slot_signature=tuple(slots_seen))
+    return _assemble(blocks, reads, slots_seen, registry, warnings)
+
+
+def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None) -> tuple:
+    """(blocks, meshes read, slot names seen): a block per exported instance, (local arrays, world matrix, material
+    index map, object name, instance key, (colour, random, name, asset, holdout, pass index))."""
     blocks: list[tuple] = []  # (local arrays, matrix, material index map)
     cache: dict = {}
     reads = 0
@@ -256,10 +277,79 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
                                                          bool(getattr(obj, "is_holdout", False)),
                                                          float(getattr(obj, "pass_index", 0)))))
 
-    if not blocks:
-        return TriangleSet.empty(), {"triangles": 0, "instances": 0, "dropped": 0, "instance_keys": [],
-                                     "instance_matrices": np.zeros((0, 4, 4)), "meshes_read": reads,
-                                     "slot_signature": tuple(slots_seen)}
+    return blocks, reads, slots_seen
+
+
+def _placed(arrays: dict, m: np.ndarray) -> tuple:
+    """(verts (n, 3, 3), normals (n, 3, 3), tangents (n, 3, 4) or None) of a mesh's local arrays placed by the world
+    matrix ``m`` (float32 results of float64 arithmetic; normals by the inverse transpose, unit length)."""
+    n = len(arrays["verts"])
+    lin = m[:3, :3]
+    verts = (arrays["verts"].reshape(-1, 3) @ lin.T + m[:3, 3]).reshape(n, 3, 3).astype(np.float32)
+    try:
+        nm = np.linalg.inv(lin).T
+    except np.linalg.LinAlgError:
+        nm = lin
+    nn = arrays["normals"].reshape(-1, 3) @ nm.T
+    nn /= np.maximum(np.linalg.norm(nn, axis=1), 1e-30)[:, None]
+    normals = nn.reshape(n, 3, 3).astype(np.float32)
+    tangents = None
+    if arrays["tangents"] is not None:
+        tangents = np.empty((n, 3, 4), np.float32)
+        tw = arrays["tangents"][..., :3].reshape(-1, 3) @ lin.T   # surface vectors move with the linear part
+        tw /= np.maximum(np.linalg.norm(tw, axis=1), 1e-30)[:, None]
+        tangents[:, :, :3] = tw.reshape(n, 3, 3)
+        # a mirroring transform flips the bitangent (the normal is transformed, the frame's handedness not)
+        tangents[:, :, 3] = arrays["tangents"][..., 3] * np.sign(np.linalg.det(lin) or 1.0)
+    return verts, normals, tangents
+
+
+def _usable(verts: np.ndarray) -> tuple:
+    """(finite (n,), keep (n,)) bool: corners finite and not huge; and that with a non-zero area as well."""
+    finite = np.isfinite(verts).all(axis=(1, 2)) & (np.abs(verts).max(axis=(1, 2)) < MAX_COORD)
+    with np.errstate(invalid="ignore", over="ignore"):
+        area2 = np.linalg.norm(np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0]), axis=1)
+    return finite, finite & (area2 > 0) & np.isfinite(area2)
+
+
+def _retransformed(blocks, last, stats: dict, registry):
+    """(TriangleSet, stats) from the last export's where only instances' world matrices changed (the same
+    instances in the same order, the same cached mesh arrays, material slots and indices) and every triangle
+    stays usable or unusable as before; None otherwise (the caller assembles everything)."""
+    keys, arrays_seen = stats.get("instance_keys"), stats.get("block_arrays")
+    if arrays_seen is None or len(blocks) != len(keys) or \
+            stats.get("geometry_material_index") != dict(registry.index):
+        return None
+    for b, key, arrays, slot_map in zip(blocks, keys, arrays_seen, stats["slot_maps"]):
+        if b[4] != key or b[0] is not arrays or not np.array_equal(b[2], slot_map):
+            return None
+    mats = np.array([b[1] for b in blocks], np.float64)
+    changed = np.flatnonzero((mats != stats["instance_matrices"]).any(axis=(1, 2)))
+    starts, kept = stats["block_starts"], stats["kept"]
+    post = np.cumsum(kept) - 1  # each triangle's row after the unusable ones were dropped
+    verts, normals = last.verts.copy(), last.normals.copy()
+    tangents = None if last.tangents is None else last.tangents.copy()
+    for k in changed:  # the moved instances, each vectorized over its triangles
+        s, e = int(starts[k]), int(starts[k + 1])
+        v, nrm, tan = _placed(blocks[k][0], blocks[k][1])
+        _finite, keep = _usable(v)
+        if not np.array_equal(keep, kept[s:e]):
+            return None
+        rows = post[s:e][keep]
+        verts[rows] = v[keep]
+        nrm = nrm[keep]
+        nrm[~np.isfinite(nrm).all(axis=2)] = 0.0
+        normals[rows] = nrm
+        if tangents is not None and tan is not None:
+            tangents[rows] = tan[keep]
+    geometry = dataclasses.replace(last, verts=verts, normals=normals, tangents=tangents,
+                                   objects=_object_table(blocks))
+    return geometry, dict(stats, instance_matrices=mats)
+
+
+def _assemble(blocks, reads: int, slots_seen: list, registry, warnings: list) -> tuple:
+    """(TriangleSet, stats) of the blocks: every instance placed, unusable triangles dropped (with warnings)."""
+    first_warning = len(warnings)
     total = sum(len(b[0]["verts"]) for b in blocks)
     verts = np.empty((total, 3, 3), np.float32)
     normals = np.empty((total, 3, 3), np.float32)
@@ -277,15 +367,9 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
     at = 0
     for k, (arrays, m, slot_map, _name, _key, _info) in enumerate(blocks):  # per instance, vectorized over triangles
         n = len(arrays["verts"])
-        lin = m[:3, :3]
-        verts[at:at + n] = (arrays["verts"].reshape(-1, 3) @ lin.T + m[:3, 3]).reshape(n, 3, 3)
-        try:
-            nm = np.linalg.inv(lin).T
-        except np.linalg.LinAlgError:
-            nm = lin
-        nn = arrays["normals"].reshape(-1, 3) @ nm.T
-        nn /= np.maximum(np.linalg.norm(nn, axis=1), 1e-30)[:, None]
-        normals[at:at + n] = nn.reshape(n, 3, 3)
+        v, nrm, tan = _placed(arrays, m)
+        verts[at:at + n] = v
+        normals[at:at + n] = nrm
         material[at:at + n] = slot_map[np.clip(arrays["slot"], 0, len(slot_map) - 1)]
         instance[at:at + n] = k
         if uvs is not None and arrays["uvs"] is not None:
@@ -294,22 +378,15 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
             attributes[a][at:at + n] = vals
         if local_verts is not None:
             local_verts[at:at + n] = arrays["verts"]
-        if tangents is not None and arrays["tangents"] is not None:
-            tw = arrays["tangents"][..., :3].reshape(-1, 3) @ lin.T   # surface vectors move with the linear part
-            tw /= np.maximum(np.linalg.norm(tw, axis=1), 1e-30)[:, None]
-            tangents[at:at + n, :, :3] = tw.reshape(n, 3, 3)
-            # a mirroring transform flips the bitangent (the normal is transformed, the frame's handedness not)
-            tangents[at:at + n, :, 3] = arrays["tangents"][..., 3] * np.sign(np.linalg.det(lin) or 1.0)
+        if tangents is not None and tan is not None:
+            tangents[at:at + n] = tan
         at += n
     # drop unusable triangles: non-finite or huge coordinates, zero area
-    finite = np.isfinite(verts).all(axis=(1, 2)) & (np.abs(verts).max(axis=(1, 2)) < MAX_COORD)
+    finite, keep = _usable(verts)
     if not finite.all():
         bad_names = sorted({b[3] for b, s, e in _spans(blocks) if not finite[s:e].all()})
         warnings.append(f"{int((~finite).sum())} triangles with NaN, infinite or huge (>{MAX_COORD:g}) coordinates "
                         f"were skipped (objects: {', '.join(bad_names[:5])})")
-    with np.errstate(invalid="ignore", over="ignore"):
-        area2 = np.linalg.norm(np.cross(verts[:, 1] - verts[:, 0], verts[:, 2] - verts[:, 0]), axis=1)
-    keep = finite & (area2 > 0) & np.isfinite(area2)
     # an object scaled to zero is how animators hide it: its triangles go without a word
     hidden = np.repeat([not np.any(b[1][:3, :3]) for b in blocks], [len(b[0]["verts"]) for b in blocks])
     n_degenerate = int((finite & ~keep & ~hidden).sum())
@@ -329,7 +406,10 @@ def export_geometry(depsgraph, registry, warnings: list, mesh_cache: dict | None
              "meshes_read": reads, "slot_signature": tuple(slots_seen),
              # each instance's triangles before the unusable ones were dropped, and which were kept (motion blur's
              # deformation steps read the same triangles again)
-             "block_starts": np.cumsum([0] + [len(b[0]["verts"]) for b in blocks]), "kept": keep}
+             "block_starts": np.cumsum([0] + [len(b[0]["verts"]) for b in blocks]), "kept": keep,
+             # what a later export with the same mesh cache compares with (_retransformed)
+             "block_arrays": [b[0] for b in blocks], "slot_maps": [b[2] for b in blocks],
+             "geometry_material_index": dict(registry.index), "assembly_warnings": warnings[first_warning:]}
     return TriangleSet(verts, normals, material, uvs, instance, tangents, objects=_object_table(blocks),
                        attributes=attributes or None, local_verts=local_verts), stats
 

@@ -255,6 +255,51 @@ def test_edits_export_only_what_changed(addon):
     assert exporter.counts["FULL"] == 2 and exporter.counts["SHADING"] == 2 and exporter.counts["TRANSFORM"] == 1
 
 
+def _same_triangles(a, b):
+    for name in ("verts", "normals", "material", "instance", "uvs", "tangents", "local_verts"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert (x is None) == (y is None) and (x is None or np.array_equal(x, y)), name
+    assert np.array_equal(a.objects.world_to_object, b.objects.world_to_object)
+
+
+def test_a_move_re_places_only_the_moved_object(addon):
+    """A transform edit re-places the moved object's triangles only (the others' arrays are the last export's) and
+    gives the triangles a full export gives; the renderer then updates its Embree scene for the moved rows (a
+    split scene whose still part is kept while the same object moves on). Scaling the object to 0 (its triangles
+    become unusable) falls back to a full assembly, again equal to a full export."""
+    from restir_engine.core.geometry.accel import SplitAccel
+    from restir_engine.core.integrators import context_cache
+    build_demo(8, (64, 36))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=150, y_subdivisions=150, size=0.5, location=(0, 3, 0.01))
+    dg = bpy.context.evaluated_depsgraph_get()  # with the grid's 44k triangles, the sphere is 3 % of the scene
+    exporter = SceneExporter()
+    cam = export_scene(dg).camera
+    settings = dataclasses.replace(RenderSettings(), samples=1, max_bounces=1, data_passes=False)
+    first = exporter.export(dg, cam, "FULL")
+    context_cache.clear()
+    FrameRenderer(first, settings)
+    sphere = bpy.data.objects["Sphere"]
+    stills = []
+    for k in range(2):
+        sphere.location.x += 0.2
+        dg = bpy.context.evaluated_depsgraph_get()
+        moved = exporter.export(dg, cam, "TRANSFORM")
+        assert moved.geometry.material is first.geometry.material  # re-placed, not assembled again
+        _same_triangles(moved.geometry, export_scene(dg, camera=cam).geometry)
+        accel = FrameRenderer(moved, settings).ctx.geom_accel
+        assert isinstance(accel, SplitAccel)
+        sphere_rows = np.flatnonzero(np.isin(moved.geometry.instance, [i for i, key in enumerate(
+            moved.export_stats["instance_keys"]) if key[0] == "Sphere"]))
+        assert np.array_equal(accel.moving_rows, sphere_rows)
+        stills.append(accel.still)
+    assert stills[0] is stills[1]
+    sphere.scale = (0.0, 0.0, 0.0)
+    dg = bpy.context.evaluated_depsgraph_get()
+    hidden = exporter.export(dg, cam, "TRANSFORM")
+    assert hidden.geometry.material is not first.geometry.material and len(hidden.geometry) < len(first.geometry)
+    _same_triangles(hidden.geometry, export_scene(dg, camera=cam).geometry)
+
+
 def test_stop_during_a_pass_returns_promptly(addon):
     """Leaving Rendered mode during a long pass (full resolution, about 2 s) stops within 1 s; no thread left."""
     core, cam, settings = demo((640, 360))

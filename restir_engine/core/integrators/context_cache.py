@@ -2,21 +2,25 @@
 
 Every frame of an animation exports a fresh core Scene; when its geometry, materials, lamps and world are
 bit-identical to the previous frame's (a static scene seen by a moving camera, or only objects that do not
-move), the Embree scenes and the light table built for that frame are reused instead of rebuilt. The
-fingerprint is a BLAKE2b digest of every array of those parts (about 0.1 s per 100 MB of scene data), so
-any change, however small, rebuilds. One entry is kept (the last frame's), shared by renders and the
-viewport.
+move), the Embree scenes and the light table built for that frame are reused instead of rebuilt. Materials,
+lamps and the world are compared by a BLAKE2b digest of their arrays (about 0.1 s per 100 MB); the triangles by
+comparing their arrays with the last frame's. Where only some rows' positions changed (objects moved), the last
+context is updated (context_update.py); any other change rebuilds (the geometry's digest then decides whether the
+Embree scenes can be handed over). One entry is kept (the last frame's), shared by renders and the viewport.
 """
 from __future__ import annotations
 
 import dataclasses
 import hashlib
 import threading
+from typing import NamedTuple
 
 import numpy as np
 
+from .context_update import changed_rows, same_layout, updated_context
+
 _LOCK = threading.Lock()
-_LAST: tuple | None = None  # (fingerprint, TraceContext, geometry's fingerprint, lamp triangles' fingerprint)
+_LAST = None  # _Last: the last frame's context
 
 
 def fingerprint(*parts) -> bytes:
@@ -48,41 +52,69 @@ def fingerprint(*parts) -> bytes:
     return h.digest()
 
 
-def scene_key(scene, geometry_key: bytes | None = None) -> bytes:
-    """What the acceleration structures and the light table depend on (not the camera or the motion)."""
-    return fingerprint(geometry_key if geometry_key is not None else fingerprint(scene.geometry), scene.materials,
-                       scene.lamps, scene.world_radiance, getattr(scene, "world_image", None),
+def rest_key(scene) -> bytes:
+    """What the context depends on besides the triangles: materials, lamps, the world."""
+    return fingerprint(scene.materials, scene.lamps, scene.world_radiance, getattr(scene, "world_image", None),
                        getattr(scene, "world_rotation", None))
 
 
 def context_for(scene, max_bounces: int, film_transparent: bool, build):
     """(TraceContext, reused) for ``scene``: the last one with ``scene`` swapped in when the scene's content
-    is unchanged, else ``build(scene, max_bounces, film_transparent, accels=...)`` (which then becomes the last
-    one); ``accels`` hands over the last context's Embree scenes whose triangles are unchanged (an edit of
-    materials, lamp power or the world rebuilds the tables, not the acceleration structures)."""
+    is unchanged; the last one updated where only objects moved (context_update.py); else
+    ``build(scene, max_bounces, film_transparent, accels=...)`` (which then becomes the last one); ``accels`` hands
+    over the last context's Embree scenes whose triangles are unchanged (an edit of materials, lamp power or the
+    world rebuilds the tables, not the acceleration structures)."""
     global _LAST
     with _LOCK:
         last = _LAST
+    others = rest_key(scene)
+    if last is not None and last.others == others:
+        ctx = _same_or_moved(last, scene, max_bounces, film_transparent)
+        if ctx is not None:
+            reused = ctx.geom_accel is last.ctx.geom_accel
+            if not reused:
+                with _LOCK:
+                    _LAST = _Last(ctx, None, last.lamp_key, others)
+            return ctx, reused
     # the same TriangleSet object as the last context's is the same triangles (an exported scene's arrays are
     # never modified; the viewport's edits of materials or lamps hand the previous geometry on): no hashing
-    same_geometry = last is not None and last[1].scene.geometry is scene.geometry
-    geom_key = last[2] if same_geometry else fingerprint(scene.geometry)
-    key = scene_key(scene, geom_key)
-    if last is not None and last[0] == key:
-        ctx = dataclasses.replace(last[1], scene=scene, max_bounces=int(max(0, max_bounces)),
-                                  film_transparent=film_transparent)
-        return ctx, True
+    same_geometry = last is not None and last.ctx.scene.geometry is scene.geometry
+    geom_key = last.geom_key if same_geometry and last.geom_key is not None else fingerprint(scene.geometry)
     lamp_key = fingerprint(scene.lamps.tris.verts)
     accels = {}
     if last is not None:
-        if last[2] == geom_key:
-            accels["geom"], accels["derived"] = last[1].geom_accel, last[1].geom_derived
-        if last[3] == lamp_key:
-            accels["lamp"] = last[1].lamp_accel
+        if same_geometry or last.geom_key == geom_key:
+            accels["geom"], accels["derived"] = last.ctx.geom_accel, last.ctx.geom_derived
+        if last.lamp_key == lamp_key:
+            accels["lamp"] = last.ctx.lamp_accel
     ctx = build(scene, max_bounces, film_transparent, accels=accels)
     with _LOCK:
-        _LAST = (key, ctx, geom_key, lamp_key)
+        _LAST = _Last(ctx, geom_key, lamp_key, others)
     return ctx, False
+
+
+def _same_or_moved(last: "_Last", scene, max_bounces: int, film_transparent: bool):
+    """The last context for ``scene`` (same materials, lamps and world as the last one): as it is where the
+    triangles are the same, updated where only positions changed in a few rows (context_update.py); None where
+    the triangles changed otherwise."""
+    old = last.ctx.scene.geometry
+    geom = scene.geometry
+    if old is not geom and not same_layout(old, geom):
+        return None
+    rows = None if old is geom else changed_rows(old, geom)
+    if rows is None or rows.size == 0:
+        return dataclasses.replace(last.ctx, scene=scene, max_bounces=int(max(0, max_bounces)),
+                                   film_transparent=film_transparent)
+    return updated_context(last.ctx, scene, rows, max_bounces, film_transparent)
+
+
+class _Last(NamedTuple):
+    """The kept context and the fingerprints it was built for (geom_key None: not computed, an updated one)."""
+
+    ctx: object
+    geom_key: bytes | None
+    lamp_key: bytes
+    others: bytes
 
 
 def clear() -> None:

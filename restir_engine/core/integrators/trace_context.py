@@ -64,39 +64,56 @@ class GeometryDerived:
     flat: np.ndarray       # (n,) bool: the three corner normals are equal
     normal_rows: np.ndarray  # (9, n) corner shading normals as rows
     boxes: tuple = None    # (lo (k, 3), hi (k, 3)): each instance's box (one box without instances; camera.box_pixels)
+    box_ids: np.ndarray | None = None  # (k,) the instance each box belongs to (None: one box for the whole scene)
 
     @staticmethod
     def of(geom) -> "GeometryDerived":
         verts = geom.verts.reshape(-1, 3)
         finite = verts[np.isfinite(verts).all(axis=1)]
         bounds = (finite.min(0), finite.max(0)) if len(finite) else None
-        boxes = instance_boxes(geom, bounds)
+        ids, lo, hi = instance_box_table(geom, bounds)
         ng, _ = triangle_geometry(geom.verts) if len(geom) else (np.zeros((0, 3), np.float32), None)
         nrm = geom.normals
         flat = (nrm[:, 0] == nrm[:, 1]).all(axis=1) & (nrm[:, 0] == nrm[:, 2]).all(axis=1)
         return GeometryDerived(bounds, ng, np.ascontiguousarray(ng.T), flat,
-                               np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32), boxes)
+                               np.ascontiguousarray(nrm.reshape(len(nrm), 9).T, dtype=np.float32), (lo, hi), ids)
 
 
 def instance_boxes(geom, bounds) -> tuple:
     """(lo (k, 3), hi (k, 3)) float32: the bounding box of each instance's finite vertices (geometry.instance),
     or the scene's ``bounds`` as one box when there are no instances; empty without geometry."""
+    _ids, lo, hi = instance_box_table(geom, bounds)
+    return lo, hi
+
+
+def instance_box_table(geom, bounds) -> tuple:
+    """(ids (k,) int32 or None, lo (k, 3), hi (k, 3)): :func:`instance_boxes` with the instance of each box, in
+    increasing instance order (ids None: one box, the scene's ``bounds``, for a scene without instances)."""
     empty = (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.float32))
     if bounds is None:
-        return empty
+        return (None,) + empty
     inst = geom.instance
     if inst is None or len(inst) == 0 or inst.min() == inst.max():
-        return np.asarray(bounds[0], np.float32)[None], np.asarray(bounds[1], np.float32)[None]
-    v = geom.verts
-    ok = np.isfinite(v).all(axis=2)[..., None]
-    tlo = np.where(ok, v, np.inf).min(axis=1)
-    thi = np.where(ok, v, -np.inf).max(axis=1)
+        return None, np.asarray(bounds[0], np.float32)[None], np.asarray(bounds[1], np.float32)[None]
+    return boxes_by_instance(geom.verts, inst)
+
+
+def boxes_by_instance(verts: np.ndarray, inst: np.ndarray) -> tuple:
+    """(ids (k,) int32, lo (k, 3), hi (k, 3)) float32: the box of the finite corners of each instance among the
+    triangles ``verts`` (n, 3, 3) with instances ``inst`` (n,), in increasing instance order (instances without a
+    finite corner left out)."""
+    if not len(inst):
+        return np.zeros(0, np.int32), np.zeros((0, 3), np.float32), np.zeros((0, 3), np.float32)
+    ok = np.isfinite(verts).all(axis=2)[..., None]
+    tlo = np.where(ok, verts, np.inf).min(axis=1)
+    thi = np.where(ok, verts, -np.inf).max(axis=1)
     order = np.argsort(inst, kind="stable")
     starts = np.flatnonzero(np.r_[True, np.diff(inst[order]) != 0])
     lo = np.minimum.reduceat(tlo[order], starts)
     hi = np.maximum.reduceat(thi[order], starts)
     keep = np.isfinite(lo).all(axis=1) & np.isfinite(hi).all(axis=1)
-    return lo[keep].astype(np.float32), hi[keep].astype(np.float32)
+    ids = inst[order][starts][keep].astype(np.int32)
+    return ids, lo[keep].astype(np.float32), hi[keep].astype(np.float32)
 
 
 def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False, accels: dict | None = None
@@ -108,13 +125,6 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     geom = scene.geometry
     lamps = scene.lamps
     derived = accels.get("derived") or GeometryDerived.of(geom)
-    lamp_verts = lamps.tris.verts.reshape(-1, 3)
-    lamp_verts = lamp_verts[np.isfinite(lamp_verts).all(axis=1)]
-    boxes = [b for b in (derived.bounds, (lamp_verts.min(0), lamp_verts.max(0)) if len(lamp_verts) else None)
-             if b is not None]
-    lo = np.min([b[0] for b in boxes], axis=0) if boxes else np.zeros(3)
-    hi = np.max([b[1] for b in boxes], axis=0) if boxes else np.zeros(3)
-    radius = float(np.linalg.norm(hi - lo) / 2) if boxes else 1.0
     geom_ng = derived.ng
     lamp_ng, _ = triangle_geometry(lamps.tris.verts) if len(lamps.tris) else (np.zeros((0, 3), np.float32), None)
     params = SurfaceParams.of_table(scene.materials)
@@ -124,9 +134,7 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
         Accel(geom.verts, cut, geom_ng_rows if cut else None)
     world = World(scene.world_radiance, getattr(scene, "world_image", None), getattr(scene, "world_rotation", None),
                   getattr(scene, "world_camera_view", None))
-    lights = LightTable(scene, max(radius, 1e-3))
-    if world.sampled:  # the world's points may enter ReSTIR DI reservoirs (di.CandidateSettings.world_candidates)
-        lights.attach_world(WorldSphere(world, (lo + hi) / 2, max(radius, 1e-3)))
+    lights = scene_lights(scene, derived.bounds, world)
     return TraceContext(scene=scene, geom_accel=geom_accel,
                         lamp_accel=accels["lamp"] if "lamp" in accels else Accel(lamps.tris.verts),
                         lights=lights, geom_ng=geom_ng, lamp_ng=lamp_ng,
@@ -144,6 +152,29 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         world=world,
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)
+
+
+def scene_bounds(scene: Scene, geometry_bounds) -> tuple:
+    """(lo (3,), hi (3,), radius): the box of the scene's finite triangle and lamp vertices (``geometry_bounds``:
+    GeometryDerived.bounds) and half its diagonal (1 for an empty scene)."""
+    lamp_verts = scene.lamps.tris.verts.reshape(-1, 3)
+    lamp_verts = lamp_verts[np.isfinite(lamp_verts).all(axis=1)]
+    boxes = [b for b in (geometry_bounds, (lamp_verts.min(0), lamp_verts.max(0)) if len(lamp_verts) else None)
+             if b is not None]
+    lo = np.min([b[0] for b in boxes], axis=0) if boxes else np.zeros(3)
+    hi = np.max([b[1] for b in boxes], axis=0) if boxes else np.zeros(3)
+    radius = float(np.linalg.norm(hi - lo) / 2) if boxes else 1.0
+    return lo, hi, radius
+
+
+def scene_lights(scene: Scene, geometry_bounds, world: World) -> LightTable:
+    """The light table of ``scene`` (its scene radius from :func:`scene_bounds`), the world attached where it is
+    sampled (its points may enter ReSTIR DI reservoirs: di.CandidateSettings.world_candidates)."""
+    lo, hi, radius = scene_bounds(scene, geometry_bounds)
+    lights = LightTable(scene, max(radius, 1e-3))
+    if world.sampled:
+        lights.attach_world(WorldSphere(world, (lo + hi) / 2, max(radius, 1e-3)))
+    return lights
 
 
 def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tuple | None = None,
@@ -166,7 +197,7 @@ def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tup
         ng_rows[:, rows] = ng[rows].T
     normal_rows[:, rows] = geom.normals[rows].reshape(len(rows), 9).T
     bounds, boxes = _moved_bounds(bd, geom, rows)
-    derived = GeometryDerived(bounds, ng, ng_rows, bd.flat, normal_rows, boxes)
+    derived = GeometryDerived(bounds, ng, ng_rows, bd.flat, normal_rows, boxes, None)
     if still is None:
         keep = np.ones(len(geom), bool)
         keep[rows] = False
