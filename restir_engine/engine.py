@@ -151,32 +151,13 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             history, cancelled = self._preroll(depsgraph, settings, int(scene.restir.preroll_frames))
             if cancelled:
                 return
-        self.update_stats("ReSTIR", "Exporting scene")
-        try:
-            core_scene = export_scene(depsgraph, self.camera_override)
-        except ExportError as exc:
-            self.report({"ERROR"}, str(exc))
-            self.error_set(str(exc))
+        core_scene = self._export(depsgraph)
+        if core_scene is None:
             return
-        for msg in core_scene.warnings[:MAX_REPORTED_WARNINGS]:
-            self.report({"WARNING"}, msg)
-        if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
-            self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
-        free = memory.available_memory()
-        bands, margin = band_plan(core_scene, settings, free)
-        estimate = memory.banded_estimate(core_scene, settings, bands, margin, keeps_history=self.is_animation)
-        if denoising:
-            estimate = memory.with_denoising(estimate, settings, keeps_history=self.is_animation)
-        refusal, caution = memory.memory_problem(estimate, free, settings)
-        if refusal:  # refused before any work, rather than failing part-way or taking all of the machine's memory
-            self.report({"ERROR"}, refusal)
-            self.error_set(refusal)
+        plan = self._memory_plan(core_scene, settings, denoising)
+        if plan is None:
             return
-        if caution:
-            self.report({"WARNING"}, caution)
-        if bands > 1:
-            self.report({"INFO"}, f"Rendering in {bands} bands of the image to stay within memory (about "
-                                  f"{memory.size_text(estimate.high)} at most)")
+        bands, margin, estimate = plan
         if core_scene.camera.blind:  # a camera scaled to zero sees nothing: a black frame, no history
             self._write(_black_passes(scene, view_layer, core_scene.camera.window), core_scene.camera.window,
                         scene, view_layer)
@@ -206,28 +187,80 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             _TEMPORAL_HISTORY[key] = (scene.frame_current, result.history)
         for msg in scene_problems(core_scene, result.stats["light_triangles"] + result.stats["suns"]):
             self.report({"WARNING"}, msg)
-        stamps = {}
-        kinds, aovs = pass_table.cryptomatte_kinds(view_layer), pass_table.shader_aovs(view_layer)
-        if (kinds or aovs) and not result.cancelled:
-            from .core.integrators.trace_context import build_context
-            from .core.pipeline.aovs import render_aovs
-            ctx = build_context(core_scene, 0)  # the first hits these passes trace (their own camera rays)
-            rays = min(max(int(settings.samples), 16), 64)  # rays per pixel
-            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Cryptomatte and Shader AOVs")
-            if kinds:
-                stamps = self._cryptomatte(ctx, depsgraph, settings, view_layer, kinds, rays, result.passes)
-            if aovs:
-                images = render_aovs(ctx, aovs, rays, settings.seed, settings.frame)
-                result.passes.update({f"AOV {name}": img for name, img in images.items()})
+        stamps = {} if result.cancelled else self._own_ray_passes(core_scene, depsgraph, settings, result)
         if denoising and not result.cancelled:
-            self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Denoising")
-            t_den = time.perf_counter()
-            try:
-                result.passes["Noisy Image"] = denoise.denoise_combined(result.passes, denoise.settings_of(scene))
-                result.stats["denoise_seconds"] = time.perf_counter() - t_den
-            except denoise.DenoiserUnavailable as exc:
-                self.report({"WARNING"}, str(exc))
+            self._denoise(scene, result)
         self._write(result.passes, core_scene.camera.window, scene, view_layer, stamps)
+        self._remember(scene, result, t_export)
+
+    def _export(self, depsgraph):
+        """The core Scene of the depsgraph, its warnings reported (at most MAX_REPORTED_WARNINGS of them); None
+        (reported as an error) where the file cannot be rendered."""
+        self.update_stats("ReSTIR", "Exporting scene")
+        try:
+            core_scene = export_scene(depsgraph, self.camera_override)
+        except ExportError as exc:
+            self.report({"ERROR"}, str(exc))
+            self.error_set(str(exc))
+            return None
+        for msg in core_scene.warnings[:MAX_REPORTED_WARNINGS]:
+            self.report({"WARNING"}, msg)
+        if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
+            self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
+        return core_scene
+
+    def _memory_plan(self, core_scene, settings: RenderSettings, denoising: bool):
+        """(bands, band margin, memory estimate) of the frame, or None where it cannot fit in the machine's free
+        memory (refused with the estimate before any work, rather than failing part-way)."""
+        free = memory.available_memory()
+        bands, margin = band_plan(core_scene, settings, free)
+        estimate = memory.banded_estimate(core_scene, settings, bands, margin, keeps_history=self.is_animation)
+        if denoising:
+            estimate = memory.with_denoising(estimate, settings, keeps_history=self.is_animation)
+        refusal, caution = memory.memory_problem(estimate, free, settings)
+        if refusal:
+            self.report({"ERROR"}, refusal)
+            self.error_set(refusal)
+            return None
+        if caution:
+            self.report({"WARNING"}, caution)
+        if bands > 1:
+            self.report({"INFO"}, f"Rendering in {bands} bands of the image to stay within memory (about "
+                                  f"{memory.size_text(estimate.high)} at most)")
+        return bands, margin, estimate
+
+    def _own_ray_passes(self, core_scene, depsgraph, settings: RenderSettings, result) -> dict:
+        """Cryptomatte and Shader AOV passes (their own camera rays) into ``result.passes``; returns the
+        Cryptomatte metadata stamps."""
+        scene, view_layer = depsgraph.scene, depsgraph.view_layer
+        kinds, aovs = pass_table.cryptomatte_kinds(view_layer), pass_table.shader_aovs(view_layer)
+        if not (kinds or aovs):
+            return {}
+        from .core.integrators.trace_context import build_context
+        from .core.pipeline.aovs import render_aovs
+        ctx = build_context(core_scene, 0)  # the first hits these passes trace
+        rays = min(max(int(settings.samples), 16), 64)  # rays per pixel
+        self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Cryptomatte and Shader AOVs")
+        stamps = {}
+        if kinds:
+            stamps = self._cryptomatte(ctx, depsgraph, settings, view_layer, kinds, rays, result.passes)
+        if aovs:
+            images = render_aovs(ctx, aovs, rays, settings.seed, settings.frame)
+            result.passes.update({f"AOV {name}": img for name, img in images.items()})
+        return stamps
+
+    def _denoise(self, scene, result) -> None:
+        """Combined denoised in place (the raw image kept as the Noisy Image pass)."""
+        self.update_stats("ReSTIR", f"Frame {scene.frame_current} | Denoising")
+        t_den = time.perf_counter()
+        try:
+            result.passes["Noisy Image"] = denoise.denoise_combined(result.passes, denoise.settings_of(scene))
+            result.stats["denoise_seconds"] = time.perf_counter() - t_den
+        except denoise.DenoiserUnavailable as exc:
+            self.report({"WARNING"}, str(exc))
+
+    def _remember(self, scene, result, t_export: float) -> None:
+        """The frame's choices and statistics for the panels (LAST_CHOICES, LAST_FRAME_STATS) and the status line."""
         LAST_CHOICES[scene.name] = {k: result.stats[k] for k in ("direct_method", "direct_reason",
                                                                   "world_method", "world_reason",
                                                                   "coverage_samples", "coverage_reason",

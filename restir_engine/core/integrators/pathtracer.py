@@ -275,6 +275,37 @@ def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) 
         add(hs, le)
 
 
+def _adder(target, idx, throughput, dthr, first):
+    """add(sel, le): radiance ``le`` (3, k) arriving along the rays ``sel`` into their paths' estimates ``target``
+    (rows ``idx``, weighted by ``throughput``), and through x2's diffuse lobe (``dthr``) into ``first.lo_d``."""
+    def add(sel, le):
+        target[:, idx[sel]] += finite(cols(throughput, sel) * le)
+        if dthr is not None:
+            first.lo_d[:, idx[sel]] += finite(cols(dthr, sel) * le)
+    return add
+
+
+def _emission_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, world_collect, add, world: bool, origin_n):
+    """The emission BSDF rays (o, d; traced ``hits``) find, into ``add``: lamps in front of the hits, then the
+    hit emitters, else the world where ``world``. ``collect`` (or None: all rays): the rays that collect lamps and
+    emitters; ``world_collect`` (or None: all) the escaping rays that collect the world. Returns (rows that hit
+    geometry, their primitives)."""
+    gather = collect is None or bool(collect.any())
+    if gather and len(ctx.scene.lamps.tris):
+        _lamps_on_rays(ctx, o, d, hits, prev_pdf, collect, add)
+    hit = hits.prim >= 0
+    esc = np.flatnonzero(~hit)
+    if world_collect is not None:
+        esc = esc[world_collect[esc]]
+    if esc.size and world:  # film transparency affects camera rays only
+        _world_on_rays(ctx, d, esc, prev_pdf, origin_n, add)
+    hsel = np.flatnonzero(hit)
+    hp = hits.prim[hsel]
+    if hsel.size and gather:
+        _emitters_hit(ctx, d, hits, hsel, hp, prev_pdf, collect, add)
+    return hsel, hp
+
+
 def _vertex_light(ctx: TraceContext, s: Surface, rng, target, idx, throughput, first, dthr, at_x2: bool) -> None:
     """Next-event estimation at a path vertex after the first, into ``target`` (and, past a first bounce, the
     diffuse part ``first.lo_d``): at x2 split by lobe (throughput is 1 there), after it weighted by the throughput
@@ -312,7 +343,6 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     indirect = np.zeros((3, n), np.float32)
     idx = np.arange(n)
     throughput = np.ones((3, n), np.float32)
-    lamps = ctx.scene.lamps
     world_on = ctx.world.sampled or bool((ctx.world.mean > 0).any())
     first = None
     dthr = None  # with first_bounce, after x2's BSDF sample: the throughput through x2's diffuse lobe alone
@@ -358,33 +388,18 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             throughput = throughput * absorbed
             if dthr is not None:
                 dthr = dthr * absorbed
-        # emission found by the BSDF ray: lamps in front of the hit, then the hit itself, else the world; when
-        # the first surfaces' direct light is resampled, only what their delta (glass) rays find, which
-        # resampling cannot reach
+        # emission found by the BSDF ray: when the first surfaces' direct light is resampled, only what their
+        # delta (glass) rays find, which resampling cannot reach
         collect = None if not (bounce == 0 and direct_resampled) else \
             (np.zeros(len(keep), bool) if ray.delta is None else ray.delta[keep])
-
-        def add(sel, le, target=target, idx=idx, throughput=throughput, dthr=dthr):
-            """Radiance ``le`` (3, k) arriving along the rays ``sel`` into their paths' estimates."""
-            target[:, idx[sel]] += finite(cols(throughput, sel) * le)
-            if dthr is not None:
-                first.lo_d[:, idx[sel]] += finite(cols(dthr, sel) * le)
-
-        if (collect is None or collect.any()) and len(lamps.tris):
-            _lamps_on_rays(ctx, o, d, hits, prev_pdf, collect, add)
-        hit = hits.prim >= 0
-        esc = np.flatnonzero(~hit)
-        if world_resampled and collect is not None:  # only delta rays, which resampling cannot reach
-            esc = esc[collect[esc]]
-        if esc.size and world_on:  # film transparency affects camera rays only
-            _world_on_rays(ctx, d, esc, prev_pdf, origin_n if ctx.world.sampled else None, add)
-        hsel = np.flatnonzero(hit)
+        add = _adder(target, idx, throughput, dthr, first)
+        # the world resampled at the first surfaces too: only their delta rays collect it
+        world_collect = collect if world_resampled else None
+        hsel, hp = _emission_on_rays(ctx, o, d, hits, prev_pdf, collect, world_collect, add, world_on,
+                                     origin_n if ctx.world.sampled else None)
         if hsel.size == 0:
             break
-        hp = hits.prim[hsel]
         last = None if budget is None else budget[idx[hsel]] <= bounce  # this path's bounces are spent
-        if collect is None or collect.any():
-            _emitters_hit(ctx, d, hits, hsel, hp, prev_pdf, collect, add)
         if bounce == ctx.max_bounces:
             break
         if last is not None and last.any():

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .table import sphere_coords, sphere_direction
+from .sphere import sphere_coords, sphere_direction
 from .world import World
 
 DISTANCE = 1e4    # R / r

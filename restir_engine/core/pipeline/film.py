@@ -14,7 +14,7 @@ import threading
 
 import numpy as np
 
-from ..materials.bsdf import denoising_albedo
+from ..materials.denoising_albedo import denoising_albedo
 from .adaptive import in_half
 from ..parallel.pool import in_worker, pool
 from ..parallel.tasks import map_tasks
