@@ -160,6 +160,8 @@ def _stop_on_interrupt() -> None:
     render callback, saves the unfinished frame and renders on, and the process exits 0.)"""
     def stop(_signum, _frame):
         os.write(2, b"error: interrupted (Ctrl+C): the frame being rendered was not saved\n")
+        from .core.parallel import processes
+        processes.abandon()  # no worker and no shared memory left behind
         os._exit(EXIT_INTERRUPTED)
     signal.signal(signal.SIGINT, stop)
 

@@ -145,6 +145,7 @@ def test_ctrl_c_stops_the_job_writes_nothing_and_exits_130(blend, tmp_path):
             first = proc.stdout.readline()
         assert first.startswith("Saved:") and first.strip().endswith("c_0001.png"), proc.stderr.read()
         time.sleep(0.5)  # frame 2 is rendering now
+        workers = _workers_of(proc.pid)
         proc.send_signal(signal.SIGINT)
         t0 = time.perf_counter()
         rest, err = proc.communicate(timeout=60)
@@ -153,6 +154,8 @@ def test_ctrl_c_stops_the_job_writes_nothing_and_exits_130(blend, tmp_path):
         proc.kill()
     assert proc.returncode == 130, (rest, err)
     assert "interrupted" in err and stopped < 5.0
+    assert "leaked" not in err, err  # the workers' shared memory was unlinked before the exit
+    assert not _running(workers), "render workers outlived the interrupted job"
     assert (tmp_path / "c_0001.png").exists()
     assert not (tmp_path / "c_0002.png").exists() and not (tmp_path / "c_0003.png").exists()
     assert "Saved:" not in rest
@@ -179,3 +182,33 @@ def test_a_texture_that_is_a_pipe_and_a_folder_given_as_the_file(blend, tmp_path
     assert (tmp_path / "pipe_0001.png").exists()
     r = run_cli(str(tmp_path), "-f", "1")
     assert r.returncode == 1 and r.stderr.strip() == f"error: {tmp_path} is a folder, not a .blend file"
+
+
+
+def _workers_of(pid: int) -> list[int]:
+    """The spawned render workers (multiprocessing's spawn_main) whose parent is ``pid``."""
+    out = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            stat = open(f"/proc/{entry}/stat").read()
+            cmd = open(f"/proc/{entry}/cmdline", "rb").read()
+        except OSError:
+            continue
+        if int(stat.rsplit(")", 1)[1].split()[1]) == pid and b"spawn_main" in cmd:
+            out.append(int(entry))
+    return out
+
+
+def _running(pids) -> list[int]:
+    """Those of ``pids`` still running (not gone, not zombies)."""
+    out = []
+    for p in pids:
+        try:
+            state = open(f"/proc/{p}/stat").read().rsplit(")", 1)[1].split()[0]
+        except OSError:
+            continue
+        if state != "Z":
+            out.append(p)
+    return out

@@ -281,3 +281,19 @@ def shutdown() -> None:
         if _TEAM is not None:
             _TEAM.close()
             _TEAM = None
+
+
+def abandon() -> None:
+    """Kill the team's workers at once and unlink its segments, without waiting for the team's lock (a render may
+    hold it): for a process about to end itself in a signal handler (the CLI's Ctrl+C), so that no worker and no
+    shared-memory segment outlives it."""
+    global _TEAM
+    team, _TEAM = _TEAM, None
+    if team is not None:
+        with contextlib.suppress(Exception):
+            team.close(kill=True)
+    # the team's semaphores (barrier, stop flag) are unlinked by multiprocessing's exit finalizers, which an
+    # os._exit skips: run them now
+    from multiprocessing import util
+    with contextlib.suppress(Exception):
+        util._run_finalizers(0)
