@@ -4,7 +4,7 @@ at several sample counts, on the harness scenes; relMSE against Cycles without d
 sampling at 1024 samples (Cycles' default bounces and film, Blackman-Harris 1.5 px as both engines' default) and
 the wall time of the whole render (export, render, denoising).
 
-    .venv313/bin/python scripts/bench.py defaults [--scenes cornell,interior_gi] [--size medium]
+    .venv313/bin/python scripts/bench.py defaults [--scenes cornell,interior_gi] [--size medium] [--chart]
         -> docs/results/defaults/defaults.{json,png}
 """
 from __future__ import annotations
@@ -80,6 +80,7 @@ def chart(results: dict, path: str) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
     names = list(results)
     fig, axes = plt.subplots(1, len(names), figsize=(3.2 * len(names), 3.2), squeeze=False)
     for ax, name in zip(axes[0], names):
@@ -87,6 +88,7 @@ def chart(results: dict, path: str) -> None:
             rows = results[name][label]
             ax.loglog([r["seconds"] for r in rows], [r["rel_mse"] for r in rows], style, label=label)
         ax.set_title(name, fontsize=9)
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_xlabel("seconds (wall)", fontsize=8)
         ax.grid(True, which="both", alpha=0.3)
     axes[0][0].set_ylabel(f"relMSE vs Cycles {REF_SPP} spp", fontsize=8)
@@ -101,7 +103,13 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--size", default="medium")
+    ap.add_argument("--chart", action="store_true", help="redraw the chart from the stored JSON")
     a = ap.parse_args()
+    if a.chart:
+        import json
+        with open(os.path.join(OUT, "defaults.json")) as fh:
+            chart(json.load(fh)["results"], os.path.join(OUT, "defaults.png"))
+        return
     import bpy
 
     import restir_engine
