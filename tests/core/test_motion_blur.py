@@ -141,3 +141,32 @@ def test_a_still_scene_with_blur_data_renders_as_without():
     a = render_frame(scene, st, processes=1).passes["Combined"]
     b = render_frame(still, st, processes=1).passes["Combined"]
     assert np.array_equal(a, b)
+
+
+def test_the_bands_of_a_blurred_frame_share_the_still_triangles_bvh(monkeypatch):
+    """A banded frame renders each band with its own renderer: the Embree scene of the triangles that do not move is
+    built once for all of them (and the banded image keeps the blur's light)."""
+    from restir_engine.core.geometry import accel
+    from restir_engine.core.integrators import context_cache
+    scene = _moving_emitter()
+    floor = tris(np.concatenate([quad((x, y, 0), (1, 0, 0), (0, 1, 0)) for x in (-1, 1) for y in (-1, 1)]), 0)
+    geom = scene.geometry
+    scene.geometry = dataclasses.replace(geom, verts=np.concatenate([geom.verts, floor.verts]),
+                                         normals=np.concatenate([geom.normals, floor.normals]),
+                                         material=np.concatenate([geom.material, floor.material]),
+                                         instance=np.concatenate([geom.instance, np.ones(8, np.int32)]))
+    scene.blur = ShutterMotion(np.concatenate([scene.blur.instance_steps, np.repeat(np.eye(4)[None, None], 3, 0)],
+                                              axis=1), np.repeat(np.eye(4)[None], 2, axis=0))
+    built = []
+    original = accel.Accel.__init__
+
+    def counting(self, triangles, *args, **kwargs):
+        built.append(len(triangles))
+        original(self, triangles, *args, **kwargs)
+
+    monkeypatch.setattr(accel.Accel, "__init__", counting)
+    context_cache.clear()
+    st = RenderSettings(samples=4, seed=2, max_bounces=0, integrator="PATH")
+    out = render_frame(scene, st, processes=1, bands=3)
+    assert built.count(8) == 1, built  # the still floor's 8 triangles: one Embree scene for the three bands
+    assert np.isfinite(out.passes["Combined"]).all() and out.passes["Combined"].max() > 0

@@ -199,10 +199,7 @@ def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tup
     bounds, boxes = _moved_bounds(bd, geom, rows)
     derived = GeometryDerived(bounds, ng, ng_rows, bd.flat, normal_rows, boxes, None)
     if still is None:
-        keep = np.ones(len(geom), bool)
-        keep[rows] = False
-        still_rows = np.flatnonzero(keep)
-        still = (Accel(base.scene.geometry.verts[still_rows]), still_rows)
+        still = _still_part(base, rows)
     cut = base.geom_accel.cutout
     accel = SplitAccel(still[0], still[1], geom.verts[rows], rows, cut, derived.ng_rows if cut else None)
     lights, emit_accel = base.lights, base.emit_accel
@@ -214,6 +211,24 @@ def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tup
     return dataclasses.replace(base, scene=scene, geom_accel=accel, lights=lights, emit_accel=emit_accel,
                                geom_ng=ng, geom_ng_rows=derived.ng_rows, geom_normal_rows=normal_rows,
                                geom_derived=derived, measured=base.measured)
+
+
+_STILL: tuple | None = None  # (Accel of a base context, moving rows, (Accel, rows) of the others): the last built
+
+
+def _still_part(base: TraceContext, rows: np.ndarray) -> tuple:
+    """(Accel, rows) of ``base``'s triangles outside ``rows``: the last one built for the same base context and
+    rows (the bands of a banded frame share it), else built now."""
+    global _STILL
+    kept = _STILL
+    if kept is not None and kept[0] is base.geom_accel and np.array_equal(kept[1], rows):
+        return kept[2]
+    keep = np.ones(len(base.scene.geometry), bool)
+    keep[rows] = False
+    still_rows = np.flatnonzero(keep)
+    still = (Accel(base.scene.geometry.verts[still_rows]), still_rows)
+    _STILL = (base.geom_accel, rows.copy(), still)
+    return still
 
 
 def _moved_bounds(base: GeometryDerived, geom, rows: np.ndarray) -> tuple:
