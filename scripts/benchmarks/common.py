@@ -17,6 +17,28 @@ def write_json(path: str, data, indent: int = 1) -> None:
         f.write("\n")
 
 
+def render_rgb(scene, path: str) -> tuple:
+    """(RGB (h, w, 3) float32 with row 0 at the top as Blender's image pixels are read, seconds): an F12 of ``scene``
+    through ``bpy.ops.render.render``, written to ``path`` as a 32-bit EXR and read back; the seconds are the
+    render's wall time (export, render, denoising)."""
+    import time
+
+    import bpy
+    import numpy as np
+
+    from restir_engine.compat import set_output_format
+    set_output_format(scene.render.image_settings, "OPEN_EXR")
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = path
+    t0 = time.perf_counter()
+    bpy.ops.render.render(write_still=True)
+    seconds = time.perf_counter() - t0
+    img = bpy.data.images.load(path, check_existing=False)
+    px = np.array(img.pixels[:], np.float32).reshape(img.size[1], img.size[0], -1)[..., :3]
+    bpy.data.images.remove(img)
+    return px, seconds
+
+
 def bar_chart(path: str, labels, values, ylabel: str, title: str, reference: tuple | None = None) -> None:
     """A bar per label (``values`` in the labels' order) saved as a PNG at ``path``; ``reference`` (label, value)
     draws a dashed horizontal line for comparison."""

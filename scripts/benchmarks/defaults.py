@@ -12,11 +12,9 @@ from __future__ import annotations
 import argparse
 import os
 import tempfile
-import time
 
-import numpy as np
 
-from benchmarks.common import RESULTS, write_json
+from benchmarks.common import RESULTS, render_rgb as render, write_json
 
 OUT = os.path.join(RESULTS, "defaults")
 SCENES = {"cornell": "default", "many_lights": "1k", "glossy": "0.2", "interior_gi": "default",
@@ -58,22 +56,6 @@ def ours_defaults(scene, samples: int, seed: int) -> None:
     for f in SCENE_FIELDS:
         scene.restir.property_unset(f.name)
     scene.restir.samples, scene.restir.seed = samples, seed
-
-
-def render(scene, path):
-    import bpy
-
-    from restir_engine.compat import set_output_format
-    set_output_format(scene.render.image_settings, "OPEN_EXR")
-    scene.render.image_settings.color_depth = "32"
-    scene.render.filepath = path
-    t0 = time.perf_counter()
-    bpy.ops.render.render(write_still=True)
-    seconds = time.perf_counter() - t0
-    img = bpy.data.images.load(path, check_existing=False)
-    px = np.array(img.pixels[:], np.float32).reshape(img.size[1], img.size[0], -1)[..., :3]
-    bpy.data.images.remove(img)
-    return px, seconds
 
 
 def chart(results: dict, path: str) -> None:

@@ -14,39 +14,23 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
-import time
 
-from benchmarks.common import ROOT, write_json  # noqa: E402, F401
+from benchmarks.common import ROOT, render_rgb as render, write_json  # noqa: E402, F401
 for p in (ROOT, os.path.join(ROOT, "scripts"), os.path.join(ROOT, "tests")):
     sys.path.insert(0, p)
 
 import bpy  # noqa: E402
-import numpy as np  # noqa: E402
 
 import restir_engine  # noqa: E402
 from bpy_scenes import configure_cycles, configure_restir  # noqa: E402
 from harness.metrics import rel_mse  # noqa: E402
 from make_demo_scene import build_demo  # noqa: E402
-from restir_engine.compat import set_output_format  # noqa: E402
 
 SIZE = (320, 180)
 SPP = (1, 2, 4, 8, 16, 32, 64, 128)
 ADAPTIVE_SPP = (128,)
 REF_SPP = 1024
 OUT = os.path.join(ROOT, "docs", "results", "denoise")
-
-
-def render(scene, path):
-    set_output_format(scene.render.image_settings, "OPEN_EXR")
-    scene.render.image_settings.color_depth = "32"
-    scene.render.filepath = path
-    t0 = time.perf_counter()
-    bpy.ops.render.render(write_still=True)
-    seconds = time.perf_counter() - t0
-    img = bpy.data.images.load(path, check_existing=False)
-    px = np.array(img.pixels[:], np.float32).reshape(img.size[1], img.size[0], -1)[..., :3]
-    bpy.data.images.remove(img)
-    return px, seconds
 
 
 def main():
