@@ -858,3 +858,55 @@ def motion_blur_scene(size=(96, 64), shutter=1.0, camera_pans=False, spin=True, 
 def _anim_fcurves(obj):
     from harness.scenes import _fcurves
     return _fcurves(obj)
+
+
+def translucent_material(name, color, mix_with=None, textured=False):
+    """A Translucent BSDF of ``color``; ``mix_with``: half of it a Diffuse BSDF of that colour (Mix Shader at 0.5);
+    ``textured``: its Color from the checker image through the plane's UVs."""
+    m = bpy.data.materials.new(name)
+    enable_nodes(m)
+    tree = m.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    node = tree.nodes.new("ShaderNodeBsdfTranslucent")
+    node.inputs["Color"].default_value = (*color, 1)
+    if textured:
+        tex = tree.nodes.new("ShaderNodeTexImage")
+        tex.image = bpy.data.images.get("Checker") or checker_image()
+        tex.interpolation = "Closest"
+        tree.links.new(tex.outputs["Color"], node.inputs["Color"])
+    out = node
+    if mix_with is not None:
+        dif = tree.nodes.new("ShaderNodeBsdfDiffuse")
+        dif.inputs["Color"].default_value = (*mix_with, 1)
+        out = tree.nodes.new("ShaderNodeMixShader")
+        out.inputs["Fac"].default_value = 0.5
+        tree.links.new(dif.outputs[0], out.inputs[1])
+        tree.links.new(node.outputs[0], out.inputs[2])
+    tree.links.new(out.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    return m
+
+
+def translucent_scene(size=(96, 64), back="AREA"):
+    """Four upright 1 x 1.4 panels in a row facing the camera, lit from behind (``back``: an area light the camera
+    does not see, or a sun) and weakly from the front, on a grey floor: a white Translucent BSDF, a green one, a Mix
+    of Diffuse and Translucent at 0.5, and a checker-textured Translucent. The panels' fronts show the light they
+    pass through; the floor in front of them is lit through them."""
+    scene = reset()
+    black_world(scene)
+    plane("Floor", 10, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
+    mats = [translucent_material("Translucent", (0.8, 0.8, 0.8)),
+            translucent_material("Green translucent", (0.3, 0.8, 0.2)),
+            translucent_material("Leaf", (0.6, 0.7, 0.3), mix_with=(0.5, 0.6, 0.2)),
+            translucent_material("Textured translucent", (1, 1, 1), textured=True)]
+    for k, mat in enumerate(mats):
+        _with_uvs(plane(f"Panel{k}", 1.0, (-1.65 + 1.1 * k, 0, 0.8), (math.pi / 2, 0, 0), material=mat,
+                        scale=(1, 1.4, 1)))
+    if back == "AREA":
+        lamp = light("AREA", (0, 2.0, 1.2), (math.radians(-90), 0, 0), energy=600.0, size=4.0)
+        lamp.visible_camera = False
+    else:
+        light("SUN", (0, 3, 3), (math.radians(-60), 0, 0), energy=4.0, angle=math.radians(3))
+    light("AREA", (0, -3.0, 2.5), (math.radians(50), 0, 0), energy=60.0, size=1.5)
+    camera((0, -4.5, 1.0), (math.radians(88), 0, 0), lens=35)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

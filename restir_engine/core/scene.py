@@ -109,6 +109,8 @@ class MaterialTable:
     absorption  (m, 3)  the material's Volume Absorption coefficient σa, per scene unit of length ((1 − Color) x Density,
                         as Cycles): a ray that travels inside the closed mesh and leaves it through its surface keeps
                         exp(−σa · distance) of its light (0: no volume)
+    translucent (m,) bool  a Translucent BSDF: Lambertian transmission, base_color/π toward the side away from the
+                        viewer and nothing back toward it (Surface turns such hits' frame away from the viewer)
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
@@ -158,6 +160,7 @@ class MaterialTable:
     mix_sign: np.ndarray = None
     absorption: np.ndarray = None
     holdout: np.ndarray = None  # (m,) bool: a Holdout shader (camera rays meeting it give alpha 0, black)
+    translucent: np.ndarray = None  # (m,) bool: a Translucent BSDF (Lambertian transmission of base_color)
     program: np.ndarray = None
     programs: list = field(default_factory=list)
     aov_program: np.ndarray = None  # (m,) index into aov_programs (the material's AOV Output nodes) or -1
@@ -187,6 +190,7 @@ class MaterialTable:
             glass_alpha=col("glass_alpha", 0.0), glass_multiscatter=col("glass_multiscatter", 1.0),
             glass_fresnel=col("glass_fresnel", 1.0), glass_beckmann=col("glass_beckmann", 0.0),
             diffuse_roughness=col("diffuse_roughness", 0.0), holdout=col("holdout", False, bool),
+            translucent=col("translucent", False, bool),
             absorption=col("absorption", (0.0, 0.0, 0.0)),
             **_mix_arrays(rows), **_programs(rows), **_programs(rows, "aov_program"),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

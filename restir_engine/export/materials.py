@@ -337,6 +337,14 @@ class MaterialRegistry(MixShaderReader, TextureReader):
                 self._warn(material, "Glossy BSDF anisotropy is not supported; rendered isotropic")
             self._normal(material, node, row, g, varying)
             return self._with_program(row, g, varying)
+        if t == "BSDF_TRANSLUCENT":
+            # Cycles: Lambertian transmission, Color/π on the side away from the viewer, none toward it
+            row = {"f0": 0.0, "metallic": 0.0, "translucent": True}
+            g, varying = self._compiler(material), {}
+            row["base_color"] = self._param(material, g, node.inputs["Color"], "color", "base_color", varying, row,
+                                            "base_tex")
+            self._normal(material, node, row, g, varying)
+            return self._with_program(row, g, varying)
         if t in {"MIX_SHADER", "ADD_SHADER"}:
             return self._mix(material, node, depth)
         self._warn(material, f"shader '{node.name}' ({t}) is not supported; approximated by the viewport colour")

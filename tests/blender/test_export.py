@@ -105,15 +105,33 @@ def test_principled_parameters_and_emission(scene):
 
 def test_unsupported_node_is_approximated_and_reported(scene):
     bpy.ops.mesh.primitive_plane_add()
+    m = bpy.data.materials.new("Cartoon")
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
+    nodes = m.node_tree.nodes
+    g = nodes.new("ShaderNodeBsdfToon")
+    m.node_tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
+    bpy.context.active_object.data.materials.append(m)
+    s = export()
+    assert any("Cartoon" in w and "BSDF_TOON" in w and "not supported" in w for w in s.warnings)
+
+
+def test_translucent_bsdf_is_exported_as_translucent(scene):
+    """A Translucent BSDF becomes a translucent row of its colour, without a warning (the lobe:
+    tests/materials/test_translucent.py)."""
+    bpy.ops.mesh.primitive_plane_add()
     m = bpy.data.materials.new("Leaf")
     if bpy.app.version < (5, 0, 0):
         m.use_nodes = True
     nodes = m.node_tree.nodes
     g = nodes.new("ShaderNodeBsdfTranslucent")
+    g.inputs["Color"].default_value = (0.2, 0.7, 0.1, 1)
     m.node_tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
     bpy.context.active_object.data.materials.append(m)
     s = export()
-    assert any("Leaf" in w and "BSDF_TRANSLUCENT" in w and "not supported" in w for w in s.warnings)
+    i = s.geometry.material[0]
+    assert s.materials.translucent[i] and np.allclose(s.materials.base_color[i], (0.2, 0.7, 0.1))
+    assert not s.warnings
 
 
 def textured_plane(img, socket: str, name="Tex"):

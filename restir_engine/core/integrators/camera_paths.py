@@ -216,7 +216,7 @@ def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     if hit.size:
         s = Surface(ctx, hits.prim[hit], hits.u[hit], hits.v[hit], cols(o, hit), cols(d, hit), hits.t[hit])
         depth[hit] = camera_mod.view_depth(cam, s.p)
-        normal[hit] = s.ns.T
+        normal[hit] = s.facing_normals()[1].T
         motion = ctx.scene.motion
         inst = ctx.scene.geometry.instance
         if motion is not None and inst is not None:

@@ -412,7 +412,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], cols(o, hsel), cols(d, hsel), hits.t[hsel])
         if bounce == 0 and first_bounce:
             # from here on the path estimates the radiance leaving x2: throughput 1, accumulated per first hit
-            first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.ng, s.params,
+            first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.facing_normals()[0], s.params,
                                 np.zeros((3, len(idx)), np.float32), np.zeros((3, len(idx)), np.float32))
             if budget is not None:
                 budget = budget[idx]

@@ -1,7 +1,8 @@
 """Shading data at ray hits, shared by the path tracer and the ReSTIR stages.
 
 Vectors are (3, n) float32 rows (x, y, z) in world space unless named ``*_l`` (local shading frame,
-z = shading normal). Normals face the incoming ray; ``wo`` points back along it (towards the viewer).
+z = shading normal). Normals face the incoming ray (away from it at Translucent BSDF hits, whose lobe lies on the
+far side); ``wo`` points back along it (towards the viewer).
 """
 from __future__ import annotations
 
@@ -39,8 +40,9 @@ def pixel_spread(camera) -> tuple:
 
 
 class Surface:
-    """Hits of rays o + t·d on scene triangles ``prim`` at barycentrics (u, v): p, ng, ns (facing the ray),
-    wo, the tangent frame (t, bt), wo_l, material index and BSDF params (textures applied)."""
+    """Hits of rays o + t·d on scene triangles ``prim`` at barycentrics (u, v): p, ng, ns (facing the ray; turned
+    away from it at Translucent BSDF hits, :meth:`facing_normals`), wo, the tangent frame (t, bt), wo_l, material
+    index and BSDF params (textures applied)."""
 
     def __init__(self, ctx, prim, u, v, o, d, t, camera: bool = False):
         geom = ctx.scene.geometry
@@ -65,8 +67,9 @@ class Surface:
         self.bsdf_mat = mat  # the material whose BSDF the hit uses
         self._material_params(ctx, mat, scale, tint)
         self._glass(ctx, mat, scale, tint, s_ng)
+        away = self._translucent(ctx, mat)
         self.t, self.bt = orthonormal_basis(self.ns)
-        self._bump_shadowing(mapped, smooth_n, s_ng)
+        self._bump_shadowing(mapped, smooth_n, s_ng if away is None else s_ng * away)
         self._view_frame()
         mu = self._specular_normal()
         # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal): looked
@@ -271,6 +274,31 @@ class Surface:
         self.params.assign(rows, SurfaceParams.from_material(np.zeros((k, 3), np.float32), np.zeros(k), np.ones(k),
                                                              np.zeros(k)))
 
+    def _translucent(self, ctx, mat):
+        """Translucent BSDF hits (scene.MaterialTable.translucent): their frame (ng, ns) is turned away from the
+        viewer, so that every stage (BSDF evaluation and sampling, next-event estimation, ReSTIR's targets) sees a
+        Lambertian lobe on the far side of the surface and nothing on the viewer's. Sets ``translucent`` ((n,) bool, or
+        None where no hit is translucent); returns the sign applied to each hit's normals ((n,) float32) or None."""
+        self.translucent = None
+        flags = ctx.scene.materials.translucent
+        if flags is None or not flags.any():
+            return None
+        tr = flags[mat]
+        if not tr.any():
+            return None
+        self.translucent = tr
+        away = np.where(tr, np.float32(-1.0), np.float32(1.0))
+        self.ng = self.ng * away
+        self.ns = self.ns * away
+        return away
+
+    def facing_normals(self):
+        """(ng, ns) (3, n) facing the incoming ray (the frame of translucent hits turned back toward the viewer)."""
+        if self.translucent is None:
+            return self.ng, self.ns
+        back = np.where(self.translucent, np.float32(-1.0), np.float32(1.0))
+        return self.ng * back, self.ns * back
+
     def _bump_shadowing(self, mapped, smooth_n, s_ng) -> None:
         """The unmapped (smooth) normal in the local frame and its shadowing term, for Cycles' bump shadowing."""
         self.bump_n = self.bump_a2 = None
@@ -367,7 +395,7 @@ class Surface:
         out._albedo = None if self._albedo is None else self._albedo[idx]
         out._layer = None if self._layer is None else self._layer[idx]
         for name in ("glass", "glass_front", "glass_ior", "glass_alpha", "glass_ms", "glass_fresnel",
-                     "glass_beckmann"):
+                     "glass_beckmann", "translucent"):
             a = getattr(self, name)
             setattr(out, name, None if a is None else a[idx])
         for name in ("p", "ng", "ns", "wo", "t", "bt", "wo_l", "bump_n", "spec_n", "glass_reflect", "glass_refract"):

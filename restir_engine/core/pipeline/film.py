@@ -123,7 +123,7 @@ class Film:
                 surf = c.hits.surf
                 albedo = denoising_albedo(surf)
                 flat["albedo"][pix] += np.ascontiguousarray((albedo if chain is None else albedo * chain).T)
-                flat["dnormal"][pix] += np.ascontiguousarray((world_to_cam @ surf.ns).T)
+                flat["dnormal"][pix] += np.ascontiguousarray((world_to_cam @ surf.facing_normals()[1]).T)
 
         def add_adaptive(pixels, rgb):
             """One more sample of ``pixels`` (unique) with RGB ``rgb`` (k, 3): the count, and twice the RGB
@@ -161,7 +161,7 @@ class Film:
                     add_adaptive(base, rgb[b])
             if "albedo" in flat and len(c.hits.rows):
                 add_rows("albedo", denoising_albedo(c.hits.surf))
-                add_rows("dnormal", world_to_cam @ c.hits.surf.ns)
+                add_rows("dnormal", world_to_cam @ c.hits.surf.facing_normals()[1])
 
         map_tasks(add, chunks, stop)
 
