@@ -16,12 +16,15 @@ __all__ = ["camera", "configure_cycles", "configure_restir", "cornell_box", "dif
 
 def cornell_box(light_kind="EMISSIVE", size=(48, 48)):
     """The harness's Cornell box (floor z=0, open towards -Y where the camera is), lit by its emissive quad
-    facing down, or instead by an area light, a point light, a spot or a sun."""
+    facing down, or instead by an area light, a point light, a spot, a sun, or (NEGATIVE) the area light and a
+    point lamp of negative power."""
     scene = build_cornell(size=size)
     if light_kind != "EMISSIVE":
         bpy.data.objects.remove(bpy.data.objects["Lamp"])
-    if light_kind == "AREA":
+    if light_kind in ("AREA", "NEGATIVE"):
         light("AREA", (0, 0, 1.98), energy=30.0, color=(1, 0.9, 0.8), size=0.6)
+    if light_kind == "NEGATIVE":  # a point lamp of negative power beside the area light: it subtracts light
+        light("POINT", (0.4, 0.0, 0.6), energy=-6.0, shadow_soft_size=0.1)
     elif light_kind == "POINT":
         light("POINT", (0, 0, 1.5), energy=40.0, color=(1, 0.9, 0.8), shadow_soft_size=0.1)
     elif light_kind == "SPOT":

@@ -131,11 +131,7 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
         if not np.isfinite(m).all() or not np.isfinite(power).all():
             warnings.append(f"Light '{obj.name}' has a non-finite transform or power and was skipped")
             continue
-        if power.min() < 0:
-            warnings.append(f"Light '{obj.name}' has negative power: subtracting light is not supported (Cycles "
-                            "subtracts it); its negative part was left out")
-            power = np.maximum(power, 0.0)
-        if power.max() <= 0:
+        if not power.any():  # negative power subtracts light, as in Cycles (sampled by its magnitude)
             continue
         visible = bool(getattr(obj, "visible_camera", True))
         if light.type == "SUN":

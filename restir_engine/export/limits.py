@@ -9,11 +9,11 @@ MAX_RADIANCE = 1e30
 
 
 def clamped_radiance(values, what: str, warnings: list):
-    """``values`` (array-like, any shape) with entries above MAX_RADIANCE clamped to it (a warning names ``what``),
-    negative and NaN entries left to the caller's own checks."""
+    """``values`` (array-like, any shape) with entries of magnitude above MAX_RADIANCE clamped to ±MAX_RADIANCE (a
+    warning names ``what``; negative entries are a light that subtracts), NaN entries left to the caller's checks."""
     arr = np.asarray(values, np.float64)
-    if np.nanmax(arr, initial=0.0) > MAX_RADIANCE * (1.0 + 1e-6):  # 1e30 itself rounds up in float32
+    if np.nanmax(np.abs(arr), initial=0.0) > MAX_RADIANCE * (1.0 + 1e-6):  # 1e30 itself rounds up in float32
         warnings.append(f"{what}: radiance above {MAX_RADIANCE:g} W/sr/m² cannot be held in float32 sums and was "
                         f"clamped to {MAX_RADIANCE:g}")
-        arr = np.minimum(arr, MAX_RADIANCE)
+        arr = np.clip(arr, -MAX_RADIANCE, MAX_RADIANCE)
     return arr

@@ -109,7 +109,7 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
     contrib *= np.abs(wi_l[2]) * w / np.maximum(ls.pdf, np.float32(1e-30))
     if throughput is not None:
         contrib *= throughput
-    live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (vmax(contrib) > 0))
+    live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (vmax(np.abs(contrib)) > 0))
     lv = live
     if live.size:
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), cols(ls.pos, live), cols(ls.wi, live),
@@ -143,7 +143,7 @@ def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, through
     if throughput is not None:
         contrib *= throughput
     out = np.zeros((3, n), np.float32)
-    live = np.flatnonzero((dot(wi, s.ng) > 0) & (pdf > 0) & (vmax(contrib) > 0))
+    live = np.flatnonzero((dot(wi, s.ng) > 0) & (pdf > 0) & (vmax(np.abs(contrib)) > 0))
     if live.size:
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), np.zeros((3, live.size), np.float32),
                                   cols(wi, live), np.full(live.size, np.inf, np.float32))

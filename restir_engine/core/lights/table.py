@@ -128,12 +128,12 @@ class LightTable:
         tex_mean = np.array([luminance(mean_color(t)[None])[0] for t in mats.textures], np.float32)
         emit_scale = np.where(mats.emit_tex >= 0, tex_mean[np.maximum(mats.emit_tex, 0)] if len(tex_mean) else 0.0, 1.0)
         sides = np.where(mats.two_sided_emission, 2.0, 1.0) * np.pi
-        mat_power_density = emit_lum * emit_scale * sides
+        mat_power_density = np.abs(emit_lum) * emit_scale * sides  # |power|: a negative light is sampled too
         geom_density = mat_power_density[geom.material] if len(geom) else np.zeros(0)
         prog_tri, prog_density = program_emission_density(geom, mats)
         if prog_tri.size:  # emission from node programs: per triangle
             geom_density = geom_density.copy()
-            geom_density[prog_tri] = prog_density * sides[geom.material[prog_tri]]
+            geom_density[prog_tri] = np.abs(prog_density) * sides[geom.material[prog_tri]]
         g_idx = np.flatnonzero(geom_density > 0) if len(geom) else np.zeros(0, np.int64)
         # lamp entries: area-light triangles, and the first proxy triangle of each point/spot sphere
         first_of_sphere = (lamps.sphere_first < 0) | (lamps.sphere_first == np.arange(len(lamps.sphere_first)))
@@ -173,7 +173,8 @@ class LightTable:
         tri_density = np.concatenate([geom_density[g_idx], mat_power_density[lamps.tris.material[l_idx]]]) \
             if len(tri_mat) else np.zeros(0)
         tri_power = tri_density * self.tri_area if len(tri_mat) else np.zeros(0, np.float32)
-        sun_power = luminance(lamps.sun_irradiance) * np.pi * scene_radius ** 2 if len(lamps.sun_dir) else np.zeros(0)
+        sun_power = np.abs(luminance(lamps.sun_irradiance)) * np.pi * scene_radius ** 2 if len(lamps.sun_dir) \
+            else np.zeros(0)
         self.n_tri = len(self.tri_verts)
         self.n_geom = len(g_idx)
         self.n_sun = len(lamps.sun_dir)
@@ -409,7 +410,7 @@ class LightTable:
             b1[sph], b2[sph] = self._cone_sample(light[sph], np.take(p, sph, axis=1), u2[sph], u3[sph])
         q, w, dl, cos_l, rad = self.point_towards(light, b1, b2, p)
         pdf = self.pdf_solid_angle(light, p, dl, cos_l)
-        ok = (vmax(rad) > 0) & np.isfinite(pdf)
+        ok = (vmax(np.abs(rad)) > 0) & np.isfinite(pdf)
         rad *= ok
         return q, w, dl, rad, pdf * ok
 

@@ -252,7 +252,7 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
         _p, f, g, _pb = shading_value(surf, wi, le, dist, cos_l)
         contrib = f * le
         contrib *= g * res.W * live
-        go = np.flatnonzero(vmax(contrib) > 0)
+        go = np.flatnonzero(vmax(np.abs(contrib)) > 0)
         if go.size:
             rays.append((go, cols(contrib, go), *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(q, go),
                                                              cols(wi, go), dist[go])))
@@ -263,7 +263,7 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
         ok = (dot(ls.wi, surf.ng) > 0) & (ls.pdf > 0)
         contrib = f * ls.le
         contrib *= np.abs(wi_l[2]) / np.maximum(ls.pdf, 1e-30) * ok
-        go = np.flatnonzero(vmax(contrib) > 0)
+        go = np.flatnonzero(vmax(np.abs(contrib)) > 0)
         if go.size:
             rays.append((go, cols(contrib, go), *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(ls.pos, go),
                                                              cols(ls.wi, go), ls.dist[go])))

@@ -105,7 +105,7 @@ def radiance_target(terms, pts: PackedPoints) -> np.ndarray:
     d2 = np.maximum(dot(d, d), np.float32(1e-30))
     cl = -dot(d, pts.normal)
     ok = (dot(d, terms.ns) > 0) & (dot(d, terms.ng) > 0) & (cl > 1e-8 * np.sqrt(d2))
-    lum = _LUM[0] * pts.le[0] + _LUM[1] * pts.le[1] + _LUM[2] * pts.le[2]
+    lum = np.abs(_LUM[0] * pts.le[0] + _LUM[1] * pts.le[1] + _LUM[2] * pts.le[2])  # negative lights: |Lo|
     return (lum * cl / (d2 * np.sqrt(d2)) * ok).astype(np.float32)
 
 
@@ -264,7 +264,7 @@ def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray, verified: bool = F
     ok = (cos2 > 0) & (dot(wi, sub.ng) > 0)
     contrib = f * lo
     contrib *= np.abs(wi_l[2]) * cos2 / np.maximum(dist * dist, np.float32(1e-30)) * res.W[live] * ok
-    go = np.flatnonzero(vmax(contrib) > 0)
+    go = np.flatnonzero(vmax(np.abs(contrib)) > 0)
     if go.size:
         if verified:
             out[:, live[go]] = cols(contrib, go)

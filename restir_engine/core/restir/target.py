@@ -2,14 +2,15 @@
 
 For a surface point x (shading normal n_s, geometric normal n_g, view direction ωo in world space) and a
 light point y (position, unit normal n_l, radiance Le), in area measure on the lights:
-  p̂(y) = luminance(f(ωo, ωi) · Le) · |cos θ_s| |cos θ_l| / d²      (0 below the geometric horizon,
+  p̂(y) = |luminance(f(ωo, ωi) · Le)| · |cos θ_s| |cos θ_l| / d²    (0 below the geometric horizon,
                                                                      at a back face of a one-sided light)
   p_b(y) = p_b,ω(ωi | ωo) · |cos θ_l| / d²                            (the BSDF sampling pdf, area measure)
 with f the Principled model of bsdf.py. Because luminance is linear, luminance(f · Le) splits into
   Le · k_d  +  S(ωi) · (Le · A + (1 - ωo·h)⁵ · Le · B + max(F(ωo·h) - f0, 0) · Le · C)
 where k_d, A, B and C are per-surface RGB vectors (luminance weights folded in), S is the scalar
 D·G/(4 cos θ_o cos θ_i) of the GGX lobes and F the exact dielectric Fresnel (η² - 1 and f0 per-surface rows); only S
-and the Fresnel terms depend on the candidate. A metal's Specular Tint (F82 term) is left out of p̂: p̂ then
+and the Fresnel terms depend on the candidate. The absolute value makes a light of negative power (Cycles subtracts
+its light) a candidate like any other; the estimate f · Le · W keeps its sign. A metal's Specular Tint (F82 term) is left out of p̂: p̂ then
 overestimates a tinted metal's grazing reflection a little, which costs variance, not bias. The half
 vector is never formed: with unit ωo, ωi, |ωo + ωi|² = 2 + 2 ωo·ωi, cos θ_h = (cos θ_o + cos θ_i)/|ωo + ωi|
 and ωo·h = (1 + ωo·ωi)/|ωo + ωi|. Agrees with bsdf.eval_bsdf to float32 rounding (tested).
@@ -190,6 +191,7 @@ class ShadingTerms:
                 pdf_s /= 4.0 * odh
         lum *= ci
         lum *= to_area
+        np.abs(lum, out=lum)                         # |f · Le|: a negative light's samples are drawn too
         p_hat = np.multiply(lum, ok, out=lum)  # zero where the point does not light the surface (x bool: 18x
         #                                        faster than np.where; the factors are finite by construction)
         if not want_pdf:
@@ -232,6 +234,7 @@ class ShadingTerms:
         p_hat = le[0] * kd[0]
         p_hat += le[1] * kd[1]
         p_hat += le[2] * kd[2]
+        np.abs(p_hat, out=p_hat)                     # |f · Le| (negative lights)
         p_hat *= geo
         if not want_pdf:
             return p_hat, None
