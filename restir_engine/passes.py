@@ -15,6 +15,11 @@ def has_gi_reservoirs(scene) -> bool:
     return methods.gi_possible(scene.restir)
 
 
+def light_group_names(view_layer) -> list:
+    """The view layer's light groups (View Layer Properties > Light Groups), in order."""
+    return [g.name for g in getattr(view_layer, "lightgroups", None) or ()]
+
+
 PASSES = (
     ("Combined", "RGBA", "COLOR", lambda sc, vl: True, "Combined"),
     ("Depth", "Z", "VALUE", lambda sc, vl: vl.use_pass_z, "Depth"),
@@ -62,10 +67,18 @@ def aov_rows(view_layer) -> list:
              f"AOV {name}") for name, kind in shader_aovs(view_layer)]
 
 
+def light_group_rows(view_layer) -> list:
+    """One "Combined_<group>" pass per light group (Cycles' names): the light of the group's lamps, emissive objects
+    and world, by every path."""
+    return [(f"Combined_{name}", "RGB", "COLOR", lambda sc, vl: True, f"Combined_{name}")
+            for name in light_group_names(view_layer)]
+
+
 def enabled_passes(scene, view_layer):
-    """Rows of :data:`PASSES` enabled for this scene and view layer, then its Cryptomatte and Shader AOV passes
-    (stateless: safe on throwaway engines)."""
-    return [row for row in PASSES if row[3](scene, view_layer)] + cryptomatte_rows(view_layer) + aov_rows(view_layer)
+    """Rows of :data:`PASSES` enabled for this scene and view layer, then its light group, Cryptomatte and Shader
+    AOV passes (stateless: safe on throwaway engines)."""
+    return [row for row in PASSES if row[3](scene, view_layer)] + light_group_rows(view_layer) + \
+        cryptomatte_rows(view_layer) + aov_rows(view_layer)
 
 
 def register_passes(engine, scene, view_layer):

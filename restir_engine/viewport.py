@@ -351,6 +351,7 @@ class ViewportSession:
         hist = old.latest_history() if old is not None else None
         cam = scene.camera if self._view is None else scaled_camera(self._view[0], self._divider)
         scene.camera = cam
+        scene.light_groups = None  # the viewport shows Combined alone: no estimate split by light group
         self.renderer = FrameRenderer(scene, dataclasses.replace(settings, frame=self._frame))
         if hist is not None and settings.temporal_reuse:
             self.renderer.adopt_history(hist)

@@ -249,6 +249,8 @@ class Lamps:
     sun_irradiance: np.ndarray
     sphere_radius: np.ndarray = None
     sphere_first: np.ndarray = None
+    group: np.ndarray = None      # (n,) int16 the lamp's light group (lights/groups.py; -1: none), None: no groups
+    sun_group: np.ndarray = None  # (s,) int16 each sun's
 
     def __post_init__(self):
         n = len(self.spot_cos)
@@ -355,3 +357,4 @@ class Scene:
     world_camera_view: tuple | None = None    # (radiance (3,), image or None) camera rays see instead, or None
     motion: Motion | None = None
     blur: object = None  # geometry.motion_blur.ShutterMotion: where things are during the shutter (None: no motion blur)
+    light_groups: object = None  # lights.groups.LightGroups: the view layer's light groups (None: none)

@@ -11,6 +11,7 @@ import numpy as np
 from ..core.scene import Motion, Scene
 from .camera import ExportError, export_camera
 from .limits import clamped_radiance
+from .light_groups import export_light_groups, group_index
 from .lights import export_lamps
 from .materials import MaterialRegistry
 from .meshes import export_geometry, instance_matrices
@@ -73,11 +74,12 @@ def export_scene(depsgraph, camera_override=None, camera=None, mesh_cache: dict 
 def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warnings: list) -> Scene:
     """The lamps, the world and the material table (after the geometry registered its materials in
     ``registry``) around ``geometry``."""
-    lamps = export_lamps(depsgraph, registry, warnings)
+    groups = group_index(depsgraph)
+    lamps = export_lamps(depsgraph, registry, warnings, groups)
     world, world_image, world_rotation, camera_view = export_world(depsgraph.scene, warnings)
     world = clamped_radiance(world, "World", warnings).astype(np.float32)
     if world_image is not None:
         world_image = clamped_radiance(world_image, "World texture", warnings).astype(np.float32)
     return Scene(geometry=geometry, materials=registry.table(), lamps=lamps, camera=camera,
                  world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings,
-                 world_camera_view=camera_view)
+                 world_camera_view=camera_view, light_groups=export_light_groups(depsgraph, geometry, groups))

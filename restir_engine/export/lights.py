@@ -118,8 +118,11 @@ def _area(tris: np.ndarray) -> float:
     return float(0.5 * np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1).sum())
 
 
-def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
-    parts = []  # (world tris, material index, spot center, spot axis, spot cos, spot smooth, camera visible)
+def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None) -> Lamps:
+    """The depsgraph's Light objects; ``groups`` ({light group name: index}, export/light_groups.py) gives each lamp
+    its group (Lamps.group per triangle, sun_group per sun; -1: none)."""
+    groups = groups or {}
+    parts = []  # (world tris, material index, spot, camera visible, sphere radius, light group)
     suns = []
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -137,7 +140,8 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
         if light.type == "SUN":
             axis = m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-30)
             suns.append((axis, np.cos(min(float(light.angle), np.pi) / 2),
-                         clamped_radiance(power, f"Sun '{obj.name}' irradiance", warnings)))
+                         clamped_radiance(power, f"Sun '{obj.name}' irradiance", warnings),
+                         groups.get(getattr(obj, "lightgroup", ""), -1)))
             continue
         if light.type == "AREA":
             local = _area_shape(light)
@@ -168,7 +172,8 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
             continue
         mat = registry.add_row({"name": f"(light {obj.name})", "base_color": (0, 0, 0), "f0": 0.0,
                                 "emission": tuple(radiance), "two_sided_emission": False})
-        parts.append((world.astype(np.float32), mat, spot, visible, sphere))
+        parts.append((world.astype(np.float32), mat, spot, visible, sphere, groups.get(getattr(obj, "lightgroup", ""),
+                                                                                      -1)))
 
     lamps = Lamps.empty()
     if parts:
@@ -186,10 +191,12 @@ def export_lamps(depsgraph, registry, warnings: list) -> Lamps:
         lamps.spot_smooth = rep([p[2][3] for p in parts], np.float32)
         lamps.camera_visible = rep([p[3] for p in parts], bool)
         lamps.sphere_radius = rep([p[4] for p in parts], np.float32)
+        lamps.group = rep([p[5] for p in parts], np.int16)
         first = np.repeat(np.cumsum([0] + counts[:-1]), counts)
         lamps.sphere_first = np.where(lamps.sphere_radius > 0, first, -1).astype(np.int32)
     if suns:
         lamps.sun_dir = np.array([s[0] for s in suns], np.float32)
         lamps.sun_cos = np.array([s[1] for s in suns], np.float32)
         lamps.sun_irradiance = np.array([s[2] for s in suns], np.float32)
+        lamps.sun_group = np.array([s[3] for s in suns], np.int16)
     return lamps

@@ -369,6 +369,50 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         ops.operator("scene.view_layer_remove_aov", icon="REMOVE", text="")
         if vl.active_aov is not None:
             layout.prop(vl.active_aov, "type")
+        layout.label(text="Light Groups")
+        row = layout.row()
+        row.template_list("UI_UL_list", "lightgroups", vl, "lightgroups", vl, "active_lightgroup_index", rows=3)
+        ops = row.column(align=True)
+        ops.operator("scene.view_layer_add_lightgroup", icon="ADD", text="")
+        ops.operator("scene.view_layer_remove_lightgroup", icon="REMOVE", text="")
+
+
+class RestirLightGroupPanel(RestirPanel):
+    """An object's or the world's Light Group (one "Combined_<group>" pass per group of the view layer)."""
+    bl_label = "Light Group"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_group(self, context, owner):
+        layout = self.split_layout()
+        row = layout.row(align=True)
+        row.prop_search(owner, "lightgroup", context.view_layer, "lightgroups", text="Light Group",
+                        results_are_suggestions=True)
+        name = owner.lightgroup
+        if name and name not in context.view_layer.lightgroups:  # the view layer lacks it: offer to add it
+            row.operator("scene.view_layer_add_lightgroup", icon="ADD", text="").name = name
+
+
+class RESTIR_PT_object_light_group(RestirLightGroupPanel, bpy.types.Panel):
+    bl_context = "object"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.object is not None and context.object.type in {
+            "MESH", "CURVE", "SURFACE", "FONT", "META", "LIGHT", "POINTCLOUD", "CURVES"}
+
+    def draw(self, context):
+        self.draw_group(context, context.object)
+
+
+class RESTIR_PT_world_light_group(RestirLightGroupPanel, bpy.types.Panel):
+    bl_context = "world"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.world is not None
+
+    def draw(self, context):
+        self.draw_group(context, context.world)
 
 
 class RESTIR_PT_viewport_render_pass(bpy.types.Panel):
@@ -393,6 +437,7 @@ PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_direct, RESTIR_PT_sampling_reus
           RESTIR_PT_motion_blur_curve, RESTIR_PT_performance,
           RESTIR_PT_passes)  # Render Properties
 VIEW_PANELS = (RESTIR_PT_viewport_render_pass,)  # the 3D view's header popovers
+DATA_PANELS = (RESTIR_PT_object_light_group, RESTIR_PT_world_light_group)  # Object and World Properties
 
 
 def _standard_panels():
@@ -403,7 +448,7 @@ def _standard_panels():
 
 
 def register():
-    for cls in PANELS + VIEW_PANELS:
+    for cls in PANELS + VIEW_PANELS + DATA_PANELS:
         bpy.utils.register_class(cls)
     for panel in _standard_panels():
         panel.COMPAT_ENGINES.add(ENGINE)
@@ -412,5 +457,5 @@ def register():
 def unregister():
     for panel in _standard_panels():
         panel.COMPAT_ENGINES.discard(ENGINE)
-    for cls in reversed(PANELS + VIEW_PANELS):
+    for cls in reversed(PANELS + VIEW_PANELS + DATA_PANELS):
         bpy.utils.unregister_class(cls)

@@ -307,3 +307,38 @@ def test_chunked_render_matches_sequential_with_gi(addon):
     assert seq["GI Reservoir M"].max() > 3.0  # temporal only: own sample + three frames of history
     assert np.array_equal(seq["Combined"], chunk["Combined"])
     assert np.array_equal(seq["GI Reservoir M"], chunk["GI Reservoir M"])
+
+
+def test_light_group_passes_split_combined(box):
+    """View Layer > Light Groups: one "Combined_<group>" pass per group, from lamps, emissive objects and the world
+    (a sun in "key", the ceiling quad in "key", a lamp in "fill", the world in "sky"; a lamp whose group the view
+    layer does not have is in none); the passes add up to Combined less the ungrouped lamp's light. Without light
+    groups there are no such passes."""
+    import math
+
+    from bpy_scenes import enable_nodes, light
+    configure_restir(box, 4, 2)
+    plain = render_passes(box)
+    assert not any(k.startswith("Combined_") for k in plain)
+    layer = box.view_layers[0]
+    for name in ("key", "fill", "sky"):
+        layer.lightgroups.add(name=name)
+    bpy.data.objects["Lamp"].lightgroup = "key"
+    light("POINT", (0.4, 0.0, 0.6), energy=20.0, shadow_soft_size=0.1).lightgroup = "fill"
+    light("SUN", (0, 0, 5), (math.radians(20), 0, 0), energy=2.0).lightgroup = "key"
+    stray = light("POINT", (-0.4, 0.0, 0.6), energy=20.0, shadow_soft_size=0.1)
+    stray.lightgroup = "nonexistent"
+    world = bpy.data.worlds.new("Sky")
+    enable_nodes(world)
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.2, 0.3, 0.5, 1)
+    world.lightgroup = "sky"
+    box.world = world
+    grouped = render_passes(box)
+    groups = {n: grouped[f"Combined_{n}"] for n in ("key", "fill", "sky")}
+    assert all(g.mean() > 1e-3 for g in groups.values())
+    total = sum(groups.values())
+    assert np.abs(total - grouped["Combined"][..., :3]).mean() > 1e-3  # the stray lamp's light is in no group
+    stray.lightgroup = "fill"
+    again = render_passes(box)
+    total = sum(again[f"Combined_{n}"] for n in ("key", "fill", "sky"))
+    assert np.abs(total - again["Combined"][..., :3]).max() <= 1e-4 * max(1.0, float(again["Combined"].max()))

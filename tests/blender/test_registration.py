@@ -151,3 +151,50 @@ def test_viewport_render_pass_selector(addon):
     Ctx.engine = "CYCLES"
     assert not panels.RESTIR_PT_viewport_render_pass.poll(Ctx)
     shading.type = "SOLID"
+
+
+def test_light_group_panels(addon):
+    """Light groups can be set up from the UI with this engine: the view layer's list with add/remove (Passes
+    panel), and an object's and the world's Light Group field (Object and World Properties), with the button that
+    adds a group the view layer lacks; the panels show for this engine only."""
+    from restir_engine.ui import panels
+    bpy.ops.mesh.primitive_cube_add()
+    obj = bpy.context.active_object
+    obj.lightgroup = "Key"
+    calls = []
+
+    class Layout:
+        use_property_split = use_property_decorate = False
+
+        def __getattr__(self, name):
+            def call(*args, **kwargs):
+                calls.append((name, args, kwargs))
+                return Layout()
+            return call
+
+    class Ctx:
+        engine = "RESTIR"
+        object = obj
+        world = bpy.context.scene.world
+        scene = bpy.context.scene
+        view_layer = bpy.context.view_layer
+    holder = type("Holder", (), {"layout": Layout(), "split_layout": panels.RestirPanel.split_layout,
+                                 "draw_group": panels.RestirLightGroupPanel.draw_group})()
+    for panel in panels.DATA_PANELS:
+        assert getattr(bpy.types, panel.__name__, None) is not None
+        assert panel.poll(Ctx)
+        calls.clear()
+        panel.draw(holder, Ctx)
+        search = [c for c in calls if c[0] == "prop_search"]
+        assert search and search[0][1][1:] == ("lightgroup", Ctx.view_layer, "lightgroups")
+        ops = [c[1][0] for c in calls if c[0] == "operator"]
+        assert ops == (["scene.view_layer_add_lightgroup"] if search[0][1][0].lightgroup else [])
+    Ctx.engine = "CYCLES"
+    assert not any(panel.poll(Ctx) for panel in panels.DATA_PANELS)
+    calls.clear()
+    Ctx.engine = "RESTIR"
+    panels.RESTIR_PT_passes.draw(holder, Ctx)
+    lists = [c for c in calls if c[0] == "template_list"]
+    assert any("lightgroups" in c[1] for c in lists)
+    assert {"scene.view_layer_add_lightgroup", "scene.view_layer_remove_lightgroup"} <= \
+        {c[1][0] for c in calls if c[0] == "operator"}

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..geometry import camera as camera_mod
 from ..geometry.accel import Hits
+from ..lights import groups as light_groups
 from ..lights.table import emitted_radiance
 from ..materials import volume
 from ..materials.surface import Surface
@@ -20,12 +21,14 @@ from .trace_context import TraceContext
 @dataclass
 class PrimaryHits:
     """Camera rays through n raster points: emission seen directly (3, n), alpha (n,), the rows that hit
-    geometry (k,) and their surfaces (surface.Surface, k)."""
+    geometry (k,) and their surfaces (surface.Surface, k); with light groups ``emitted_g`` (G, 3, n), the emission
+    by the group of what emits it (lights/groups.py)."""
 
     emitted: np.ndarray
     alpha: np.ndarray
     rows: np.ndarray
     surf: Surface
+    emitted_g: np.ndarray = None
 
 
 def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray | None = None,
@@ -48,7 +51,12 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
             emitted[:, idx] = sub.emitted
             alpha = np.full(len(x), 0.0 if transparent else 1.0, np.float32)
             alpha[idx] = sub.alpha
-            return PrimaryHits(emitted, alpha, idx[sub.rows], sub.surf)
+            emitted_g = light_groups.zeros(ctx.groups, len(x))
+            if emitted_g is not None:
+                if not transparent and ctx.groups.world >= 0:
+                    emitted_g[ctx.groups.world] = ctx.world.color[:, None]
+                emitted_g[:, :, idx] = sub.emitted_g
+            return PrimaryHits(emitted, alpha, idx[sub.rows], sub.surf, emitted_g)
     cam = ctx.scene.camera
     o, d, tmax = camera_mod.generate_rays(cam, x, y, lens_uv)
     if may_hit is None or may_hit.all():
@@ -59,7 +67,7 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
         if idx.size:
             sub = ctx.geom_accel.intersect(cols(o, idx), cols(d, idx), None if tmax is None else tmax[idx])
             hits.prim[idx], hits.t[idx], hits.u[idx], hits.v[idx] = sub.prim, sub.t, sub.u, sub.v
-    emitted, alpha = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
+    emitted, alpha, emitted_g = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
     rows = np.flatnonzero(hits.prim >= 0)
     surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows],
                    camera=True)
@@ -67,10 +75,12 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
     if held is not None:  # the pixel is transparent and black there
         alpha[rows[held]] = 0.0
         emitted[:, rows[held]] = 0.0
+        if emitted_g is not None:
+            emitted_g[:, :, rows[held]] = 0.0
         scale = np.ones(len(rows), np.float32)
         scale[held] = 0.0
         surf.params.scale(scale)
-    return PrimaryHits(emitted, alpha, rows, surf)
+    return PrimaryHits(emitted, alpha, rows, surf, emitted_g)
 
 
 def holdout_hits(ctx: TraceContext, surf) -> np.ndarray | None:
@@ -89,9 +99,9 @@ def holdout_hits(ctx: TraceContext, surf) -> np.ndarray | None:
 
 
 def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray, lens_uv: np.ndarray | None = None):
-    """What camera rays through raster points (x, y) (and aperture samples ``lens_uv``) see emitted (3, n) and
-    their alpha (n,): the part of :func:`primary` that needs no surface (extra rays per pixel for pixel
-    coverage)."""
+    """What camera rays through raster points (x, y) (and aperture samples ``lens_uv``) see emitted (3, n), their
+    alpha (n,) and the emission by light group (G, 3, n) or None: the part of :func:`primary` that needs no surface
+    (extra rays per pixel for pixel coverage)."""
     o, d, tmax = camera_mod.generate_rays(ctx.scene.camera, x, y, lens_uv)
     return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax))
 
@@ -100,9 +110,12 @@ def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: n
     """Emission (3, n) camera rays meet first: visible lamps in front of the hit, emissive surfaces, the world
     where nothing is hit (unless the film is transparent); alpha (n,) 0 where nothing is hit on a transparent
     film. ``camera`` False: rays continuing a camera ray through delta interfaces (every lamp is seen, the film's
-    transparency does not apply). ``lamp_mask`` (n,) bool: only these rays may see a lamp (None: all)."""
+    transparency does not apply). ``lamp_mask`` (n,) bool: only these rays may see a lamp (None: all). With light
+    groups also the emission by group (G, 3, n) (else None)."""
     n = len(hits.prim)
     emitted = np.zeros((3, n), np.float32)
+    groups = ctx.groups
+    emitted_g = light_groups.zeros(groups, n)
     alpha = np.ones(n, np.float32)
     rows = None if lamp_mask is None else np.flatnonzero(lamp_mask)
     if len(ctx.scene.lamps.tris) and (rows is None or rows.size):  # lamps seen (camera rays: those visible to them)
@@ -115,24 +128,35 @@ def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: n
         if sel.size:
             em = _lamp_emission(ctx, lh, oo, dd, sel)[0]
             emitted[:, sel if rows is None else rows[sel]] += em
+            if groups is not None:
+                light_groups.add(emitted_g, sel if rows is None else rows[sel],
+                                 groups.of_lights(ctx.lights.lamp_to_light[lh.prim[sel]]), em)
     miss = hits.prim < 0
     if ctx.film_transparent and camera:
         alpha[miss] = 0.0
     elif miss.any():
         m = np.flatnonzero(miss)
-        emitted[:, m] += ctx.world.radiance(cols(d, m), camera=camera)
+        em = ctx.world.radiance(cols(d, m), camera=camera)
+        emitted[:, m] += em
+        if groups is not None:
+            light_groups.add(emitted_g, m, groups.world, em)
     if ctx.lights.n_geom:  # emissive surfaces (mesh emission is two-sided by default)
         prim = np.maximum(hits.prim, 0)
         em = np.flatnonzero((hits.prim >= 0) & (ctx.lights.geom_to_light[prim] >= 0))
         if em.size:
-            emitted[:, em] += emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em],
-                                               hits.v[em], -cols(d, em) if ctx.has_programs else None, camera)
+            le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em], hits.v[em],
+                                  -cols(d, em) if ctx.has_programs else None, camera)
+            emitted[:, em] += le
+            if groups is not None:
+                light_groups.add(emitted_g, em, groups.of_lights(ctx.lights.geom_to_light[prim[em]]), le)
     if tmax is not None and camera:  # frame points off a panorama's image (beyond a fisheye's circle): black
         dead = tmax < 0
         if dead.any():
             emitted[:, dead] = 0.0
             alpha[dead] = 0.0
-    return finite(emitted), alpha
+            if emitted_g is not None:
+                emitted_g[:, :, dead] = 0.0
+    return finite(emitted), alpha, None if emitted_g is None else finite(emitted_g)
 
 
 @dataclass
@@ -174,9 +198,11 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
         absorbed = volume.transmittance(ctx, hit.prim, hit.t, ray.d)  # the segment inside an absorbing mesh
         if absorbed is not None:
             thr[:, idx] *= absorbed
-        em, _a = _seen(ctx, ray.o, ray.d, None, hit, camera=False)
+        em, _a, em_g = _seen(ctx, ray.o, ray.d, None, hit, camera=False)
         pix = hits.rows[idx]
         hits.emitted[:, pix] += finite(cols(thr, idx) * em)
+        if em_g is not None:
+            hits.emitted_g[:, :, pix] += finite(cols(thr, idx) * em_g)
         got = (hit.prim >= 0) & (depth[idx] <= ctx.max_bounces)
         alive[idx[~got]] = False
         sel = np.flatnonzero(got)

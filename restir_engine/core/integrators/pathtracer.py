@@ -23,6 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.accel import offset_origin, shadow_rays
+from ..lights import groups as light_groups
+from ..lights.groups import Tap, tap_add
 from ..lights.table import emitted_radiance, spot_factor
 from ..materials.bsdf import diffuse_f, eval_view, sample_bsdf
 from ..materials.glass import DELTA_PDF, sample_glass
@@ -87,13 +89,15 @@ def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
     return le, pdf.astype(np.float32)
 
 
-def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False):
+def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False,
+               taps=(), taps_d=()):
     """Next-event estimation at surfaces s (n): one light sample each, MIS-weighted against BSDF sampling
     (delta lights weight 1), one shadow ray. Radiance (3, n), times ``throughput`` (3, n) if given. With
-    ``diffuse`` also the part reflected by the diffuse lobe alone: (radiance, diffuse part)."""
+    ``diffuse`` also the part reflected by the diffuse lobe alone: (radiance, diffuse part). Light groups
+    (lights/groups.py): each row's radiance also goes into ``taps``, its diffuse part into ``taps_d``."""
     n = len(s)
     if ctx.world.sampled and n:
-        w_out = world_event(ctx, s, rng, throughput, diffuse)
+        w_out = world_event(ctx, s, rng, throughput, diffuse, taps, taps_d)
     else:
         w_out = None
     out = np.zeros((3, n), np.float32)
@@ -116,6 +120,9 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
                                   ls.dist[live])
         lv = live[~ctx.geom_accel.occluded(so, sd, far)]
         out[:, lv] = finite(cols(contrib, lv))
+    group = ctx.groups.of_lights(ls.light[lv]) if (taps or taps_d) and lv.size else None
+    if group is not None:
+        tap_add(taps, lv, group, cols(out, lv))
     if not diffuse:
         return out if w_out is None else out + w_out
     out_d = np.zeros((3, n), np.float32)
@@ -123,15 +130,19 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         kd = diffuse_f(s.view, cols(wi_l, lv), lv)
         out_d[:, lv] = finite(kd * cols(ls.le, lv) * (np.abs(wi_l[2, lv]) * w[lv] /
                                                        np.maximum(ls.pdf[lv], np.float32(1e-30))))
+        if group is not None:
+            tap_add(taps_d, lv, group, cols(out_d, lv))
     if w_out is not None:
         return out + w_out[0], out_d + w_out[1]
     return out, out_d
 
 
-def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False):
+def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False,
+                taps=(), taps_d=()):
     """Next-event estimation of the world at surfaces s (n): one direction sampled from the world's distribution,
     MIS-weighted against BSDF sampling, one shadow ray to infinity. Radiance (3, n) (times ``throughput``), and
-    with ``diffuse`` also the part the diffuse lobe alone reflects."""
+    with ``diffuse`` also the part the diffuse lobe alone reflects; both also into the light groups' ``taps`` and
+    ``taps_d`` (as :func:`next_event`)."""
     n = len(s)
     u = rng.random((2, n), dtype=np.float32)
     wi, pdf, le = ctx.world.sample(u[0], u[1], (s.ns, s.t, s.bt))
@@ -149,11 +160,16 @@ def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, through
                                   cols(wi, live), np.full(live.size, np.inf, np.float32))
         live = live[~ctx.geom_accel.occluded(so, sd, far)]
         out[:, live] = finite(cols(contrib, live))
+    grouped = bool(taps or taps_d) and live.size > 0
+    if grouped:
+        tap_add(taps, live, ctx.groups.world, cols(out, live))
     if not diffuse:
         return out
     out_d = np.zeros((3, n), np.float32)
     if live.size:
         out_d[:, live] = finite(diffuse_f(s.view, cols(wi_l, live), live) * cols(le, live) * scale[live])
+        if grouped:
+            tap_add(taps_d, live, ctx.groups.world, cols(out_d, live))
     return out, out_d
 
 
@@ -216,7 +232,8 @@ class FirstBounce:
     estimated by the rest of the path (next-event estimation at x2 and bounces 2..max_bounces; not x2's own
     emission, which is the primary surface's direct light), ``lo_d`` (3, k) the part of it x2's diffuse lobe
     reflects (the same light samples weighed by the diffuse lobe alone). The path tracer's indirect light is
-    throughput · lo."""
+    throughput · lo. With light groups, ``lo_g`` and ``lo_d_g`` (G, 3, k): lo and lo_d by the group of their lights
+    (lights/groups.py)."""
 
     rows: np.ndarray
     throughput: np.ndarray
@@ -226,17 +243,22 @@ class FirstBounce:
     params: SurfaceParams
     lo: np.ndarray
     lo_d: np.ndarray = None
+    lo_g: np.ndarray = None
+    lo_d_g: np.ndarray = None
 
 
 @dataclass
 class PathResult:
     """What :func:`continue_paths` found for primary surfaces (n): ``direct`` (3, n) the first BSDF ray's emitter
     hits (MIS-weighted) and the world it escapes to; ``indirect`` (3, n) bounces 1..max_bounces; ``first`` the
-    :class:`FirstBounce` when asked for (indirect is then its throughput · lo), else None. Radiance, scene-linear."""
+    :class:`FirstBounce` when asked for (indirect is then its throughput · lo), else None. Radiance, scene-linear.
+    With light groups ``direct_g`` and ``indirect_g`` (G, 3, n): the same by the group of their lights."""
 
     direct: np.ndarray
     indirect: np.ndarray
     first: FirstBounce | None = None
+    direct_g: np.ndarray | None = None
+    indirect_g: np.ndarray | None = None
 
 
 def _lamps_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, add) -> None:
@@ -247,7 +269,7 @@ def _lamps_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, add) -> Non
     if sel.size:
         le, pl = _lamp_emission(ctx, lh, o, d, sel)
         le *= power_heuristic(prev_pdf[sel], pl)
-        add(sel, le)
+        add(sel, le, None if ctx.groups is None else ctx.groups.of_lights(ctx.lights.lamp_to_light[lh.prim[sel]]))
 
 
 def _world_on_rays(ctx: TraceContext, d, esc, prev_pdf, origin_n, add) -> None:
@@ -257,7 +279,7 @@ def _world_on_rays(ctx: TraceContext, d, esc, prev_pdf, origin_n, add) -> None:
     le = ctx.world.radiance(de)
     if origin_n is not None:
         le *= power_heuristic(prev_pdf[esc], ctx.world.pdf(de, cols(origin_n, esc)))
-    add(esc, le)
+    add(esc, le, None if ctx.groups is None else ctx.groups.world)
 
 
 def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) -> None:
@@ -272,16 +294,23 @@ def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) 
         le *= (cos_l > 0) | ctx.lights.tri_two_sided[light[em]]
         pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
         le *= power_heuristic(prev_pdf[hs], pl)
-        add(hs, le)
+        add(hs, le, None if ctx.groups is None else ctx.groups.of_lights(light[em]))
 
 
-def _adder(target, idx, throughput, dthr, first):
-    """add(sel, le): radiance ``le`` (3, k) arriving along the rays ``sel`` into their paths' estimates ``target``
-    (rows ``idx``, weighted by ``throughput``), and through x2's diffuse lobe (``dthr``) into ``first.lo_d``."""
-    def add(sel, le):
-        target[:, idx[sel]] += finite(cols(throughput, sel) * le)
+def _adder(target, idx, throughput, dthr, first, target_g=None):
+    """add(sel, le, group): radiance ``le`` (3, k) arriving along the rays ``sel`` into their paths' estimates
+    ``target`` (rows ``idx``, weighted by ``throughput``), and through x2's diffuse lobe (``dthr``) into
+    ``first.lo_d``; with light groups also into ``target_g`` (and ``first.lo_d_g``) by the lights' ``group``."""
+    def add(sel, le, group=None):
+        v = finite(cols(throughput, sel) * le)
+        target[:, idx[sel]] += v
+        if target_g is not None and group is not None:
+            light_groups.add(target_g, idx[sel], group, v)
         if dthr is not None:
-            first.lo_d[:, idx[sel]] += finite(cols(dthr, sel) * le)
+            vd = finite(cols(dthr, sel) * le)
+            first.lo_d[:, idx[sel]] += vd
+            if target_g is not None and group is not None:
+                light_groups.add(first.lo_d_g, idx[sel], group, vd)
     return add
 
 
@@ -306,27 +335,33 @@ def _emission_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, world_co
     return hsel, hp
 
 
-def _vertex_light(ctx: TraceContext, s: Surface, rng, target, idx, throughput, first, dthr, at_x2: bool) -> None:
+def _vertex_light(ctx: TraceContext, s: Surface, rng, target, idx, throughput, first, dthr, at_x2: bool,
+                  target_g=None) -> None:
     """Next-event estimation at a path vertex after the first, into ``target`` (and, past a first bounce, the
     diffuse part ``first.lo_d``): at x2 split by lobe (throughput is 1 there), after it weighted by the throughput
-    and by the throughput through x2's diffuse lobe ``dthr``."""
+    and by the throughput through x2's diffuse lobe ``dthr``; with light groups also into ``target_g`` (and
+    ``first.lo_d_g``)."""
+    g = target_g is not None
     if at_x2:
-        ne, ne_d = next_event(ctx, s, rng, None, diffuse=True)
+        ne, ne_d = next_event(ctx, s, rng, None, diffuse=True, taps=(Tap(target_g, idx),) if g else (),
+                              taps_d=(Tap(first.lo_d_g, idx),) if g else ())
         target[:, idx] += ne
         first.lo_d[:, idx] += ne_d
     elif dthr is not None:
-        ne = next_event(ctx, s, rng, None)
+        ne = next_event(ctx, s, rng, None, taps=(Tap(target_g, idx, throughput), Tap(first.lo_d_g, idx, dthr))
+                        if g else ())
         target[:, idx] += ne * throughput
         first.lo_d[:, idx] += ne * dthr
     else:
-        target[:, idx] += next_event(ctx, s, rng, throughput)
+        target[:, idx] += next_event(ctx, s, rng, throughput, taps=(Tap(target_g, idx),) if g else ())
 
 
 def _no_first_bounce(ctx: TraceContext) -> FirstBounce:
     """A FirstBounce of no rays (no path reached a second vertex)."""
     z3 = np.zeros((3, 0), np.float32)
     return FirstBounce(np.zeros(0, np.int64), z3, np.zeros(0, np.float32), z3.copy(), z3.copy(),
-                       ctx.material_params.take(np.zeros(0, np.intp)), z3.copy(), z3.copy())
+                       ctx.material_params.take(np.zeros(0, np.intp)), z3.copy(), z3.copy(),
+                       light_groups.zeros(ctx.groups, 0), light_groups.zeros(ctx.groups, 0))
 
 
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
@@ -341,6 +376,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     n = len(s)
     direct = np.zeros((3, n), np.float32)
     indirect = np.zeros((3, n), np.float32)
+    direct_g, indirect_g = light_groups.zeros(ctx.groups, n), light_groups.zeros(ctx.groups, n)
     idx = np.arange(n)
     throughput = np.ones((3, n), np.float32)
     world_on = ctx.world.sampled or bool((ctx.world.mean > 0).any())
@@ -348,8 +384,10 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     dthr = None  # with first_bounce, after x2's BSDF sample: the throughput through x2's diffuse lobe alone
     for bounce in range(ctx.max_bounces + 1):
         target = direct if bounce == 0 else (indirect if first is None else first.lo)
+        target_g = direct_g if bounce == 0 else (indirect_g if first is None else first.lo_g)
         if bounce > 0:
-            _vertex_light(ctx, s, rng, target, idx, throughput, first, dthr, at_x2=bounce == 1 and first is not None)
+            _vertex_light(ctx, s, rng, target, idx, throughput, first, dthr, at_x2=bounce == 1 and first is not None,
+                          target_g=target_g)
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -------
         ray = first_ray if bounce == 0 and first_ray is not None else \
             sample_rays(s, rng.random((3, len(idx)), dtype=np.float32))
@@ -392,7 +430,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         # delta (glass) rays find, which resampling cannot reach
         collect = None if not (bounce == 0 and direct_resampled) else \
             (np.zeros(len(keep), bool) if ray.delta is None else ray.delta[keep])
-        add = _adder(target, idx, throughput, dthr, first)
+        add = _adder(target, idx, throughput, dthr, first, target_g)
         # the world resampled at the first surfaces too: only their delta rays collect it
         world_collect = collect if world_resampled else None
         hsel, hp = _emission_on_rays(ctx, o, d, hits, prev_pdf, collect, world_collect, add, world_on,
@@ -413,17 +451,20 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         if bounce == 0 and first_bounce:
             # from here on the path estimates the radiance leaving x2: throughput 1, accumulated per first hit
             first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.facing_normals()[0], s.params,
-                                np.zeros((3, len(idx)), np.float32), np.zeros((3, len(idx)), np.float32))
+                                np.zeros((3, len(idx)), np.float32), np.zeros((3, len(idx)), np.float32),
+                                light_groups.zeros(ctx.groups, len(idx)), light_groups.zeros(ctx.groups, len(idx)))
             if budget is not None:
                 budget = budget[idx]
             idx = np.arange(len(idx))
             throughput = np.ones((3, len(idx)), np.float32)
     if not first_bounce:
-        return PathResult(direct, indirect)
+        return PathResult(direct, indirect, None, direct_g, indirect_g)
     if first is None:
         first = _no_first_bounce(ctx)
     else:
         first.lo = finite(first.lo)
         first.lo_d = finite(first.lo_d)
         indirect[:, first.rows] = first.throughput * first.lo
-    return PathResult(direct, indirect, first)
+        if indirect_g is not None:
+            indirect_g[:, :, first.rows] = first.throughput * first.lo_g
+    return PathResult(direct, indirect, first, direct_g, indirect_g)

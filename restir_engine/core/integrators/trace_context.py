@@ -47,6 +47,7 @@ class TraceContext:
     lamp_ng_rows: np.ndarray = None     # (3, n_lamp) lamp_ng as rows
     geom_derived: "GeometryDerived" = None  # the geometry-only arrays above, kept for a rebuild over the same triangles
     emit_accel: Accel = None  # the emissive scene triangles alone (light index = primitive index), or None
+    groups: object = None  # lights.groups.GroupMap of this frame's light groups, or None (no groups)
     # what rendering this content measured (shared by the frames and views that reuse this context):
     # "auto_indirect" -> the last frame's AUTO indirect measurement and choice (renderer.FrameRenderer._remember)
     measured: dict = field(default_factory=dict)

@@ -104,7 +104,8 @@ def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray
 class LightSample:
     """Per shading point (n): unit direction wi (3, n), distance (n,) (inf for suns), radiance Le (3, n)
     arriving along -wi, pdf (n,) in solid angle (selection included; 0 = no light), delta (n,) bool,
-    pos (3, n) the sampled point on a triangle light (unused for suns)."""
+    pos (3, n) the sampled point on a triangle light (unused for suns), light (n,) the light's index (triangle
+    lights, then suns; -1: none)."""
 
     pos: np.ndarray
     wi: np.ndarray
@@ -112,11 +113,13 @@ class LightSample:
     le: np.ndarray
     pdf: np.ndarray
     delta: np.ndarray
+    light: np.ndarray = None
 
     @staticmethod
     def zeros(n: int) -> "LightSample":
         return LightSample(np.zeros((3, n), np.float32), np.zeros((3, n), np.float32), np.zeros(n, np.float32),
-                           np.zeros((3, n), np.float32), np.zeros(n, np.float32), np.zeros(n, bool))
+                           np.zeros((3, n), np.float32), np.zeros(n, np.float32), np.zeros(n, bool),
+                           np.full(n, -1, np.int64))
 
 
 class LightTable:
@@ -390,8 +393,9 @@ class LightTable:
         light = self.alias.sample(u[0], u[1])
         if self.n_sun == 0:  # surface lights only: no column selections
             pos, wi, dist, le, pdf = self._surface_sample(light, u[2], u[3], p)
-            return LightSample(pos, wi, dist, le, pdf, np.zeros(n, bool))
+            return LightSample(pos, wi, dist, le, pdf, np.zeros(n, bool), light)
         out = LightSample.zeros(n)
+        out.light = light
         tri = np.flatnonzero(light < self.n_tri)
         if tri.size:
             pos, wi, dist, le, pdf = self._surface_sample(light[tri], u[2, tri], u[3, tri], np.take(p, tri, axis=1))
@@ -454,6 +458,7 @@ class LightTable:
         if self.sun_alias is not None and n:
             s = self.sun_alias.sample(u[0], u[1])
             self._sun_sample(s, self.sun_alias.pdf[s], u, np.arange(n), out)
+            out.light = self.n_tri + s
         return out
 
     def _sun_sample(self, s, p_sel, u, cols_out, out: LightSample):

@@ -3,7 +3,8 @@
 Accumulators are float64 (h, w, c) or (h, w) arrays over the camera window, row 0 at the *bottom* (Blender's pass
 order), kept in a pool between frames: a fresh array's pages are faulted in on first write, a reused one is only
 zeroed. Keys: emit, direct, indirect (RGB radiance, W·sr⁻¹·m⁻², scene-linear), alpha; res_m, res_w (DI reservoirs'
-M and W); gi_m, gi_w (GI reservoirs'); albedo, dnormal (denoising data: first-hit albedo, camera-space normal);
+M and W); gi_m, gi_w (GI reservoirs'); lg0, lg1, ... (the light of each light group: emission, direct and indirect
+together, lights/groups.py); albedo, dnormal (denoising data: first-hit albedo, camera-space normal);
 with adaptive sampling (pipeline/adaptive.py) count (each pixel's samples) and aux (twice the RGB of the samples in
 its half set). Passes are their means over each pixel's samples (the frame's samples where no count is kept),
 float32 and finite.
@@ -47,11 +48,13 @@ class BufferPool:
 BUFFERS = BufferPool()
 
 
-def film_keys(gi: bool, denoise_data: bool, adaptive: bool = False) -> list[tuple[str, int]]:
-    """(accumulator key, channels) of a film, in allocation order (1: an (h, w) array)."""
+def film_keys(gi: bool, denoise_data: bool, adaptive: bool = False, groups: int = 0) -> list[tuple[str, int]]:
+    """(accumulator key, channels) of a film with ``groups`` light groups, in allocation order (1: an (h, w)
+    array)."""
     keys = [("emit", 3), ("direct", 3), ("indirect", 3), ("alpha", 1), ("res_m", 1), ("res_w", 1)]
     if gi:
         keys += [("gi_m", 1), ("gi_w", 1)]
+    keys += [(f"lg{k}", 3) for k in range(groups)]
     if denoise_data:
         keys += [("albedo", 3), ("dnormal", 3)]
     if adaptive:
@@ -71,10 +74,13 @@ class Film:
     accumulators (default: the buffer pool's; a team's film passes views of one zero-filled shared segment, and
     then nothing returns to the pool)."""
 
-    def __init__(self, w: int, h: int, gi: bool, denoise_data: bool, zeros=None, adaptive: bool = False):
+    def __init__(self, w: int, h: int, gi: bool, denoise_data: bool, zeros=None, adaptive: bool = False,
+                 group_names: tuple = ()):
         self.pooled = zeros is None
         z = zeros or BUFFERS.zeros
-        self.acc = {key: z((h, w, c) if c > 1 else (h, w)) for key, c in film_keys(gi, denoise_data, adaptive)}
+        self.group_names = tuple(group_names)
+        self.acc = {key: z((h, w, c) if c > 1 else (h, w))
+                    for key, c in film_keys(gi, denoise_data, adaptive, len(self.group_names))}
         self.samples = 0
 
     def has(self, key: str) -> bool:
@@ -113,6 +119,8 @@ class Film:
                         rgb[hit] += v
             if rgb is not None:
                 add_adaptive(c.pixels, rgb)
+            if self.group_names:
+                add_groups(c, span, pix, chain)
             if resampled:
                 flat["res_m"][pix] += c.res.M
                 flat["res_w"][pix] += c.res.W
@@ -124,6 +132,16 @@ class Film:
                 albedo = denoising_albedo(surf)
                 flat["albedo"][pix] += np.ascontiguousarray((albedo if chain is None else albedo * chain).T)
                 flat["dnormal"][pix] += np.ascontiguousarray((world_to_cam @ surf.facing_normals()[1]).T)
+
+        def add_groups(c, span, pix, chain):
+            """Each light group's emission seen, direct and indirect light of the chunk's sample."""
+            for k in range(len(self.group_names)):
+                acc = flat[f"lg{k}"]
+                if c.hits.emitted_g is not None:
+                    acc[span] += np.ascontiguousarray(c.hits.emitted_g[k].T)
+                for value in (c.direct_g, c.indirect_g):
+                    if value is not None:
+                        acc[pix] += np.ascontiguousarray((value[k] if chain is None else value[k] * chain).T)
 
         def add_adaptive(pixels, rgb):
             """One more sample of ``pixels`` (unique) with RGB ``rgb`` (k, 3): the count, and twice the RGB
@@ -156,6 +174,13 @@ class Film:
             for key, value in (("direct", c.direct), ("indirect", c.indirect)):
                 if value is not None:
                     add_rows(key, value, light=True)
+            for k in range(len(self.group_names)):
+                key = f"lg{k}"
+                if c.hits.emitted_g is not None:
+                    flat[key][span] += c.hits.emitted_g[k].reshape(3, c.batch, n).sum(axis=1).T
+                for value in (c.direct_g, c.indirect_g):
+                    if value is not None:
+                        add_rows(key, value[k])
             if rgb is not None:
                 for b in range(c.batch):  # the samples of the pass, in order
                     add_adaptive(base, rgb[b])
@@ -207,6 +232,8 @@ class Film:
         if "gi_m" in self.acc:
             jobs["GI Reservoir M"] = lambda: mean("gi_m")
             jobs["GI Reservoir UCW"] = lambda: mean("gi_w")
+        for k, name in enumerate(self.group_names):  # Cycles' names of the light groups' passes
+            jobs[f"Combined_{name}"] = lambda k=k: mean(f"lg{k}")
         if "count" in self.acc:
             jobs["Sample Count"] = self.sample_counts
         if "albedo" in self.acc:

@@ -22,6 +22,7 @@ import numpy as np
 from ..integrators import pathtracer, trace_context
 from ..integrators.context_cache import context_for, fingerprint
 from ..integrators.method_choice import GI_MIN_SHARE
+from ..lights.groups import GroupMap
 from ..modes import DirectMethod, Integrator
 from ..parallel.pool import quiet_float_errors
 from ..parallel.tasks import Progress, Stopped, chunk_size, spans
@@ -82,6 +83,11 @@ class FrameRenderer:
         bounces = methods.bounces(settings)
         self.ctx, self.context_reused = context_for(scene, bounces, settings.film_transparent,
                                                     trace_context.build_context)
+        groups = GroupMap.of(self.ctx.lights, scene)  # light groups: every estimate also split by group
+        if groups is not None:
+            self.ctx = dataclasses.replace(self.ctx, groups=groups)
+        # the light groups' names (one "Combined_<name>" pass each), () without
+        self.group_names = () if groups is None else tuple(scene.light_groups.names)
         self.indirect = IndirectChoice(settings, bounces, methods.gi_auto(settings), self.ctx)
         self.gi = None  # gi.GISettings when the indirect light is resampled
         if settings.integrator == Integrator.RESTIR:
@@ -90,7 +96,8 @@ class FrameRenderer:
             if methods.gi_possible(settings):
                 self.gi, self.gi_spatial = methods.gi_settings(settings, cam)
                 unbiased = settings.bias_correction == "UNBIASED"
-                self.gi_space = gi.GISpace(self.ctx.geom_accel if unbiased else None, settings.gi_target)
+                self.gi_space = gi.GISpace(self.ctx.geom_accel if unbiased else None, settings.gi_target,
+                                           len(self.group_names))
                 lights, lamps = self.ctx.lights, self.ctx.scene.lamps
                 # any change of what emits light (a lamp moved, switched, re-coloured) drops the GI history:
                 # its cached radiance would be stale
@@ -146,7 +153,8 @@ class FrameRenderer:
         when they cannot be) and its GI reservoirs dropped when anything that emits changed. Reprojection
         projects with the history's own camera, so its resolution may differ from this one's."""
         hist = history.remapped(self.ctx.lights)  # None: the lights cannot be mapped
-        if hist is not None and hist.gi_res is not None and (self.gi is None or hist.gi_key != self.gi_light_key):
+        if hist is not None and hist.gi_res is not None and (self.gi is None or hist.gi_key != self.gi_light_key or
+                                                             type(hist.gi_res) is not self.gi_space.kind):
             hist = dataclasses.replace(hist, gi_res=None, gi_terms=None)
         self.prev_history = hist
 
@@ -184,7 +192,8 @@ class FrameRenderer:
         _x0, _y0, w, h = camera.window
         self.release()
         st = self.settings
-        self.film = Film(w, h, self.gi is not None, st.denoise_data, self.film_zeros, st.use_adaptive_sampling)
+        self.film = Film(w, h, self.gi is not None, st.denoise_data, self.film_zeros, st.use_adaptive_sampling,
+                         self.group_names)
         # adaptive sampling: which pixels the next passes sample (pipeline/adaptive.py)
         self.adaptive = AdaptiveSampling(w, h, st.samples, st.adaptive_threshold, st.adaptive_min_samples) \
             if st.use_adaptive_sampling else None
@@ -220,7 +229,7 @@ class FrameRenderer:
         self.space = self.base_space if ctx.lights is base.lights else di.LightSpace(ctx.lights)
         if self.gi is not None:
             unbiased = st.bias_correction == "UNBIASED"
-            self.gi_space = gi.GISpace(ctx.geom_accel if unbiased else None, st.gi_target)
+            self.gi_space = gi.GISpace(ctx.geom_accel if unbiased else None, st.gi_target, len(self.group_names))
         self._set_masks(scene.camera)
         self.shutter_time = tau
 
@@ -406,7 +415,7 @@ class FrameRenderer:
         if gi_reused:
             with run.stage("gbuffer"):
                 gb_gi = gb.with_terms(ShadingTerms(gi_terms))
-                gi_res = frame_reservoirs(chunks, "gi_res", gi.GIReservoirs, len(gb), team)
+                gi_res = frame_reservoirs(chunks, "gi_res", self.gi_space.kind, len(gb), team)
             gi_res, gi_history = reuse.reuse_gi(run, st, ctx, self.gi, self.gi_space, self.gi_spatial, gb_gi, gi_res,
                                                 self.prev_history, self.reuse_stats)
             hand_back(mine, "gi_res", gi_res)
@@ -444,7 +453,7 @@ class FrameRenderer:
         if not gi_on:
             paths.keep_path_traced(own(chunks, team))
         for c in chunks:
-            c.path_indirect = None
+            c.path_indirect = c.path_indirect_g = None
         return gi_on
 
     def _keep_history(self, gb, res, gb_gi, gi_history, gi_reused: bool) -> None:

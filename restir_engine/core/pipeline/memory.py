@@ -49,6 +49,9 @@ def frame_estimate(scene, settings) -> MemoryEstimate:
     _x0, _y0, w, h = scene.camera.window
     pixels = int(w) * int(h)
     low, high = per_pixel_range(settings)
+    groups = getattr(scene, "light_groups", None)
+    if groups is not None:  # per light group: a float64 RGB film sum and float32 RGB estimates of the pass's stages
+        low, high = low + len(groups) * 36, high + len(groups) * 60
     scene_bytes = scene_size(scene)
     return MemoryEstimate(FIXED + scene_bytes + low * pixels, FIXED + scene_bytes + high * pixels, pixels,
                           scene_bytes)

@@ -19,13 +19,14 @@ from .work import Chunk
 
 def gi_initial(settings: gi.GISettings, space, surf, first, block: np.ndarray, filled: bool = False):
     """ReSTIR GI's initial reservoirs at surfaces ``surf`` from their first bounces (pathtracer.FirstBounce):
-    (glossy x1 (n,) bool, gi.GIReservoirs, the path-traced indirect light they do not carry (3, n)). ``block``
-    (WIDTH, n) receives the GI target terms (already holding the surfaces' target terms when ``filled``)."""
+    (glossy x1 (n,) bool, gi.GIReservoirs, the path-traced indirect light they do not carry (3, n), and that by
+    light group (G, 3, n) or None). ``block`` (WIDTH, n) receives the GI target terms (already holding the surfaces'
+    target terms when ``filled``)."""
     if not filled:
         ShadingTerms.of_surfaces(surf, block)
     glossy = gi.glossy_x1(surf.params, settings.roughness_threshold)
-    res, rest = gi.initial(first, gi.diffuse_only(ShadingTerms(block), glossy), len(surf), glossy, space)
-    return glossy, res, rest
+    res, rest, rest_g = gi.initial(first, gi.diffuse_only(ShadingTerms(block), glossy), len(surf), glossy, space)
+    return glossy, res, rest, rest_g
 
 
 def paths(ctx, plan: PassPlan, terms, gi_terms, make_gi, c: Chunk) -> None:
@@ -35,6 +36,7 @@ def paths(ctx, plan: PassPlan, terms, gi_terms, make_gi, c: Chunk) -> None:
     filled)`` is :func:`gi_initial` bound to the frame's GI settings."""
     if not plan.continuing:
         c.direct, c.indirect = None, None
+        c.direct_g = c.indirect_g = None
         return
     out = pathtracer.continue_paths(
         ctx, c.hits.surf, plan.rng(STREAM_PATH, c.index), direct_resampled=plan.resampled, first_ray=c.bsdf_ray,
@@ -42,12 +44,15 @@ def paths(ctx, plan: PassPlan, terms, gi_terms, make_gi, c: Chunk) -> None:
         budget=None if c.chain is None else ctx.max_bounces - c.chain.depth, world_resampled=plan.world_resampled)
     c.bsdf_ray = None
     c.direct, c.indirect = out.direct, out.indirect
+    c.direct_g, c.indirect_g = out.direct_g, out.indirect_g
     if out.first is not None:  # the first bounces: GI's initial samples (and the Auto measurement)
         block = gi_terms[:, c.surfaces]
         if plan.resampled:
             block[:] = terms[:, c.surfaces]
-        c.path_indirect = c.indirect
-        c.glossy, c.gi_res, c.indirect = make_gi(c.hits.surf, out.first, block, filled=plan.resampled)
+        c.path_indirect, c.path_indirect_g = c.indirect, c.indirect_g
+        c.glossy, c.gi_res, c.indirect, rest_g = make_gi(c.hits.surf, out.first, block, filled=plan.resampled)
+        if rest_g is not None:
+            c.indirect_g = rest_g
         c.gi_share = share_sums(c.path_indirect, c.indirect)
 
 
@@ -55,4 +60,4 @@ def keep_path_traced(chunks: list[Chunk]) -> None:
     """A pass that does not reuse GI: each chunk's indirect light is the path-traced one again, no GI reservoirs."""
     for c in chunks:
         if c.path_indirect is not None:
-            c.indirect, c.gi_res = c.path_indirect, None
+            c.indirect, c.indirect_g, c.gi_res = c.path_indirect, c.path_indirect_g, None

@@ -63,12 +63,15 @@ def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
     k0 = np.minimum((jx * g).astype(np.int64), g - 1) + g * np.minimum((jy * g).astype(np.int64), g - 1)
     k = (k0[None, :] + np.arange(1, strata)[:, None]) % strata  # (strata - 1, n)
     jj = r.random((2,) + k.shape, dtype=np.float32)
-    em, al = camera_paths.seen_emission(ctx, (sx + land(((k % g).astype(np.float32) + jj[0]) / g)).ravel(),
+    em, al, em_g = camera_paths.seen_emission(ctx, (sx + land(((k % g).astype(np.float32) + jj[0]) / g)).ravel(),
                                       (sy + land(((k // g).astype(np.float32) + jj[1]) / g)).ravel(),
                                       None if lens is None else lens.random((2, k.size), dtype=np.float32))
     inv = np.float32(1.0 / strata)
     c.hits.emitted[:, sel] = (c.hits.emitted[:, sel] + em.reshape(3, strata - 1, -1).sum(axis=1)) * inv
     c.hits.alpha[sel] = (c.hits.alpha[sel] + al.reshape(strata - 1, -1).sum(axis=0)) * inv
+    if em_g is not None:
+        gsum = em_g.reshape(len(em_g), 3, strata - 1, -1).sum(axis=2)
+        c.hits.emitted_g[:, :, sel] = (c.hits.emitted_g[:, :, sel] + gsum) * inv
 
 
 def pixel_shifts(plan: PassPlan, pixels: np.ndarray) -> np.ndarray:

@@ -4,6 +4,8 @@ reservoirs (one visibility ray each, skipped where the unbiased mode already ver
 from __future__ import annotations
 
 from ..integrators import pathtracer
+from ..lights import groups as light_groups
+from ..lights.groups import Tap
 from ..restir import di, gi
 from ..sampling import STREAM_SHADE
 from .plan import PassPlan
@@ -12,13 +14,18 @@ from .work import Chunk
 
 def shade(ctx, plan: PassPlan, gi_reused: bool, unbiased: bool, c: Chunk) -> None:
     r = plan.rng(STREAM_SHADE, c.index)
+    sums = light_groups.zeros(ctx.groups, len(c.hits.surf))  # this stage's light by light group, or None
+    taps = () if sums is None else (Tap(sums),)
     if plan.resampled:
-        direct = di.shade(ctx, c.hits.surf, c.res, r)
+        direct = di.shade(ctx, c.hits.surf, c.res, r, sums)
         if ctx.world.sampled and not plan.world_resampled:
-            direct = direct + pathtracer.world_event(ctx, c.hits.surf, r)
+            direct = direct + pathtracer.world_event(ctx, c.hits.surf, r, taps=taps)
     else:
-        direct = pathtracer.next_event(ctx, c.hits.surf, r)
+        direct = pathtracer.next_event(ctx, c.hits.surf, r, taps=taps)
     c.direct = direct if c.direct is None else c.direct + direct
+    if sums is not None:
+        c.direct_g = sums if c.direct_g is None else c.direct_g + sums
     if gi_reused:
         # the unbiased mode's reservoirs hold only samples their surface sees (gi.clear_occluded)
-        c.indirect = c.indirect + gi.shade(ctx.geom_accel, c.hits.surf, c.gi_res, c.glossy, verified=unbiased)
+        c.indirect = c.indirect + gi.shade(ctx.geom_accel, c.hits.surf, c.gi_res, c.glossy, verified=unbiased,
+                                           sums=c.indirect_g)

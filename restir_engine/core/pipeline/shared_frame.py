@@ -50,9 +50,10 @@ def slot_bytes(pixels: int, st: RenderSettings) -> int:
     return int((pixels * (per + PIXEL_BYTES)) * SLACK) + FIXED_BYTES
 
 
-def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = False) -> int:
+def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = False, groups: int = 0) -> int:
     from ..parallel.team import ALIGN
-    return sum(-(-(w * h * c * 8) // ALIGN) * ALIGN for _key, c in film_keys(gi, denoise_data, adaptive)) + ALIGN
+    return sum(-(-(w * h * c * 8) // ALIGN) * ALIGN
+               for _key, c in film_keys(gi, denoise_data, adaptive, groups)) + ALIGN
 
 
 def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
@@ -67,8 +68,10 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         _x0, _y0, w, h = cam.window
         gi = methods.gi_possible(settings)
         adaptive = settings.use_adaptive_sampling
-        film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data, adaptive))
-        film = Film(w, h, gi, settings.denoise_data, zeros, adaptive)
+        lg = getattr(scene, "light_groups", None)
+        group_names = () if lg is None else tuple(lg.names)
+        film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data, adaptive, len(group_names)))
+        film = Film(w, h, gi, settings.denoise_data, zeros, adaptive, group_names)
         slots = team.ensure_slots(slot_bytes(w * h, settings))
         usable = isinstance(history, SharedHistory) and history.team == team.id and history.fits(cam)
         seg, packed = wire.pack(scene)

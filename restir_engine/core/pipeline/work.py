@@ -33,6 +33,9 @@ class Chunk:
     path_indirect: np.ndarray = None  # the path tracer's indirect light (kept where a pass skips GI reuse) [paths]
     gi_share: tuple = (0.0, 0.0, 0.0, 0.0)  # indirect_choice.share_sums over its surfaces           [paths]
     glossy: np.ndarray = None  # (n,) bool: GI resamples only the diffuse lobe there (gi.glossy_x1)  [paths]
+    direct_g: np.ndarray = None    # (G, 3, n) direct light by light group (lights/groups.py)         [paths, shade]
+    indirect_g: np.ndarray = None  # (G, 3, n) indirect light by light group                          [paths, shade]
+    path_indirect_g: np.ndarray = None  # path_indirect by light group                                 [paths]
 
     @property
     def surfaces(self) -> slice:

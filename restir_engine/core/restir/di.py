@@ -32,6 +32,7 @@ import numpy as np
 
 from ..geometry.accel import shadow_rays
 from ..integrators.pathtracer import lamp_hits, sample_rays
+from ..lights import groups as light_groups
 from ..lights.tiles import PackedPoints, TileSettings, light_points, sample_points
 from ..materials.bsdf import eval_view, view_terms
 from ..materials.params import luminance_rows
@@ -239,10 +240,11 @@ def shading_value(surf, wi: np.ndarray, le: np.ndarray, dist: np.ndarray, cos_l:
     return p_hat, f, np.where(ok, g, 0.0).astype(np.float32), np.where(ok, pdf_b * to_area, 0.0).astype(np.float32)
 
 
-def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
+def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator, sums=None) -> np.ndarray:
     """Direct radiance (3, n) at the surfaces: each reservoir's sample with one shadow ray, plus one
-    light-sampled sun."""
+    light-sampled sun; with light groups also added to ``sums`` (G, 3, n) by the group of each sample's light."""
     n = len(surf)
+    groups = ctx.groups if sums is not None else None
     out = np.zeros((3, n), np.float32)
     lights = ctx.lights
     live = res.has_sample() & (res.W > 0)
@@ -254,8 +256,9 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
         contrib *= g * res.W * live
         go = np.flatnonzero(vmax(np.abs(contrib)) > 0)
         if go.size:
-            rays.append((go, cols(contrib, go), *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(q, go),
-                                                             cols(wi, go), dist[go])))
+            group = None if groups is None else groups.of_lights(res.light[go], reservoirs=True)
+            rays.append((go, cols(contrib, go), group, *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(q, go),
+                                                                    cols(wi, go), dist[go])))
     if lights.sun_alias is not None:
         ls = lights.sample_suns(n, rng.random((4, n), dtype=np.float32))
         wi_l = to_local(ls.wi, surf.ns, surf.t, surf.bt)
@@ -265,16 +268,19 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator) -> np.ndarray:
         contrib *= np.abs(wi_l[2]) / np.maximum(ls.pdf, 1e-30) * ok
         go = np.flatnonzero(vmax(np.abs(contrib)) > 0)
         if go.size:
-            rays.append((go, cols(contrib, go), *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(ls.pos, go),
-                                                             cols(ls.wi, go), ls.dist[go])))
+            group = None if groups is None else groups.of_lights(ls.light[go])
+            rays.append((go, cols(contrib, go), group, *shadow_rays(cols(surf.p, go), cols(surf.ng, go),
+                                                                    cols(ls.pos, go), cols(ls.wi, go), ls.dist[go])))
     if rays:
-        o = np.concatenate([r[2] for r in rays], axis=1)
-        d = np.concatenate([r[3] for r in rays], axis=1)
-        far = np.concatenate([r[4] for r in rays])
+        o = np.concatenate([r[3] for r in rays], axis=1)
+        d = np.concatenate([r[4] for r in rays], axis=1)
+        far = np.concatenate([r[5] for r in rays])
         visible = ~ctx.geom_accel.occluded(o, d, far)
         start = 0
-        for rows, contrib, *_ in rays:  # rows are unique within each kind
+        for rows, contrib, group, *_ in rays:  # rows are unique within each kind
             vis = visible[start:start + len(rows)]
             out[:, rows[vis]] += contrib[:, vis]
+            if group is not None:
+                light_groups.add(sums, rows[vis], group[vis], finite(contrib[:, vis]))
             start += len(rows)
     return finite(out)

@@ -50,10 +50,43 @@ JACOBIAN_LIMIT = 10.0  # biased mode: shifts whose |J| is outside [1/10, 10] are
 
 class GIReservoirs(Reservoirs):
     """age int16 (frames since the sample was made; -1 = empty), x2 (x, y, z), its normal (nx, ny, nz, float16),
-    Lo (lr, lg, lb); M, W (m²), p̂."""
+    Lo (lr, lg, lb); M, W (m²), p̂. With light groups (:func:`reservoir_kind`) a sample also carries its Lo by
+    group (g<k>r, g<k>g, g<k>b for group k: lights/groups.py), resampled and reused with it."""
 
     SAMPLE = {"age": np.int16, "x": np.float32, "y": np.float32, "z": np.float32, "nx": np.float16,
               "ny": np.float16, "nz": np.float16, "lr": np.float32, "lg": np.float32, "lb": np.float32}
+    groups = 0  # light groups whose Lo the samples carry
+
+    def group_lo(self, rows) -> np.ndarray:
+        """(G, 3, k) the Lo by light group of reservoirs ``rows``."""
+        return np.stack([np.stack([getattr(self, f"g{k}{c}")[rows] for c in "rgb"]) for k in range(self.groups)])
+
+    def set_group_lo(self, rows, lo_g: np.ndarray) -> None:
+        """Reservoirs ``rows`` get the Lo by light group ``lo_g`` (G, 3, k)."""
+        for k in range(self.groups):
+            for i, c in enumerate("rgb"):
+                getattr(self, f"g{k}{c}")[rows] = lo_g[k, i]
+
+
+_KINDS = {0: GIReservoirs}
+
+
+def reservoir_kind(groups: int) -> type:
+    """The GI reservoir class whose samples carry their Lo by ``groups`` light groups (GIReservoirs for none)."""
+    kind = _KINDS.get(groups)
+    if kind is None:
+        fields = {f"g{k}{c}": np.float32 for k in range(groups) for c in "rgb"}
+        kind = type(f"GIReservoirs{groups}", (GIReservoirs,), {"SAMPLE": {**GIReservoirs.SAMPLE, **fields},
+                                                                "groups": groups, "__module__": __name__})
+        _KINDS[groups] = kind
+    return kind
+
+
+def __getattr__(name: str):
+    """The grouped reservoir classes by name (GIReservoirs<G>), for pickles made in another process."""
+    if name.startswith("GIReservoirs") and name[len("GIReservoirs"):].isdigit():
+        return reservoir_kind(int(name[len("GIReservoirs"):]))
+    raise AttributeError(name)
 
 
 @dataclass
@@ -114,13 +147,17 @@ def initial(first, terms, n: int, glossy: np.ndarray, space=None):
     the path-traced indirect light (3, n) the reservoirs do not carry: the light x2's specular lobe sent, and the
     specular lobe at glossy x1 (``glossy`` (n,) bool). ``terms``: the GI target terms of the n surfaces (specular
     lobe off where glossy). A reservoir holds its one candidate, x2 with its diffuse light lo_d: M = 1,
-    W = 1 / p_area with p_area = p_ω · cos φ2 / d² the pdf of x2 in area measure."""
-    res = GIReservoirs.empty(n)
+    W = 1 / p_area with p_area = p_ω · cos φ2 / d² the pdf of x2 in area measure. With light groups (``first.lo_g``)
+    the reservoirs carry lo_d by group, and the rest comes by group too: (reservoirs, rest, rest by group (G, 3, n)
+    or None)."""
+    groups = 0 if first.lo_g is None else len(first.lo_g)
+    res = reservoir_kind(groups).empty(n)
     res.M[:] = 1.0
     rest = np.zeros((3, n), np.float32)
+    rest_g = np.zeros((groups, 3, n), np.float32) if groups else None
     rows = first.rows
     if rows.size == 0:
-        return res, rest
+        return res, rest, rest_g
     lo_d = first.lo_d
     here = terms.take(rows)
     pts = PackedPoints(first.p, first.n2, lo_d, np.zeros(len(rows), np.float32), np.zeros(len(rows), bool))
@@ -139,6 +176,9 @@ def initial(first, terms, n: int, glossy: np.ndarray, space=None):
             np.sqrt(np.maximum(d2[g], 1e-30))
         carried[:, g] = kd_t * (ci / np.maximum(first.pdf[g], 1e-30))
     rest[:, rows] = finite(first.throughput * (first.lo - lo_d) + (first.throughput - carried) * lo_d)
+    if groups:
+        rest_g[:, :, rows] = finite(first.throughput * (first.lo_g - first.lo_d_g) +
+                                    (first.throughput - carried) * first.lo_d_g)
     sel = np.flatnonzero(ok)
     r = rows[sel]
     res.age[r] = 0
@@ -147,7 +187,9 @@ def initial(first, terms, n: int, glossy: np.ndarray, space=None):
     res.lr[r], res.lg[r], res.lb[r] = lo_d[0, sel], lo_d[1, sel], lo_d[2, sel]
     res.p_hat[r] = p_hat[sel]
     res.W[r] = 1.0 / p_area[sel]
-    return res, rest
+    if groups:
+        res.set_group_lo(r, first.lo_d_g[:, :, sel])
+    return res, rest, rest_g
 
 
 
@@ -167,11 +209,12 @@ class GISpace:
 
     kind = GIReservoirs
 
-    def __init__(self, accel=None, target: str = "INTEGRAND"):
+    def __init__(self, accel=None, target: str = "INTEGRAND", groups: int = 0):
         if target not in GI_TARGETS:
             raise ValueError(f"unknown GI target {target!r}; available: {GI_TARGETS}")
         self.accel = accel
         self.target_kind = target
+        self.kind = reservoir_kind(groups)  # the reservoirs' class (their samples' Lo by ``groups`` light groups)
 
     @staticmethod
     def prepare(res: GIReservoirs, spans=None, team=None) -> np.ndarray:
@@ -238,10 +281,11 @@ def clear_occluded(accel, terms, res: GIReservoirs) -> GIReservoirs:
     return res
 
 
-def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray, verified: bool = False) -> np.ndarray:
+def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray, verified: bool = False, sums=None) -> np.ndarray:
     """Indirect radiance (3, n) at the primary surfaces ``surf`` from their GI reservoirs: f · Lo · |cos θ1| ·
     cos φ2 / d² · V · W with one shadow ray (f the diffuse lobe only where ``glossy``), none when the samples are
-    ``verified`` visible (:func:`clear_occluded`)."""
+    ``verified`` visible (:func:`clear_occluded`); with light groups also f · Lo_group · ... into ``sums``
+    (G, 3, n)."""
     n = len(surf)
     out = np.zeros((3, n), np.float32)
     live = np.flatnonzero(res.has_sample() & (res.W > 0))
@@ -262,15 +306,16 @@ def shade(accel, surf, res: GIReservoirs, glossy: np.ndarray, verified: bool = F
         gr = np.flatnonzero(g)
         f[:, gr] = diffuse_f(sub.view, cols(wi_l, gr), gr)
     ok = (cos2 > 0) & (dot(wi, sub.ng) > 0)
+    scale = np.abs(wi_l[2]) * cos2 / np.maximum(dist * dist, np.float32(1e-30)) * res.W[live] * ok
     contrib = f * lo
-    contrib *= np.abs(wi_l[2]) * cos2 / np.maximum(dist * dist, np.float32(1e-30)) * res.W[live] * ok
+    contrib *= scale
     go = np.flatnonzero(vmax(np.abs(contrib)) > 0)
     if go.size:
-        if verified:
-            out[:, live[go]] = cols(contrib, go)
-        else:
-            vis = visible(accel, cols(p, go), cols(sub.ng, go), cols(x2, go), cols(n2, go))
-            out[:, live[go[vis]]] = cols(contrib, go[vis])
+        if not verified:
+            go = go[visible(accel, cols(p, go), cols(sub.ng, go), cols(x2, go), cols(n2, go))]
+        out[:, live[go]] = cols(contrib, go)
+        if sums is not None and res.groups:
+            sums[:, :, live[go]] += finite(res.group_lo(live[go]) * cols(f, go) * scale[go])
     return finite(out)
 
 

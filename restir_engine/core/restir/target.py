@@ -10,8 +10,8 @@ with f the Principled model of bsdf.py. Because luminance is linear, luminance(f
 where k_d, A, B and C are per-surface RGB vectors (luminance weights folded in), S is the scalar
 D·G/(4 cos θ_o cos θ_i) of the GGX lobes and F the exact dielectric Fresnel (η² - 1 and f0 per-surface rows); only S
 and the Fresnel terms depend on the candidate. The absolute value makes a light of negative power (Cycles subtracts
-its light) a candidate like any other; the estimate f · Le · W keeps its sign. A metal's Specular Tint (F82 term) is left out of p̂: p̂ then
-overestimates a tinted metal's grazing reflection a little, which costs variance, not bias. The half
+its light) a candidate like any other; the estimate f · Le · W keeps its sign. A metal's Specular Tint (F82 term) is
+left out of p̂: p̂ then overestimates a tinted metal's grazing reflection a little, which costs variance, not bias. The half
 vector is never formed: with unit ωo, ωi, |ωo + ωi|² = 2 + 2 ωo·ωi, cos θ_h = (cos θ_o + cos θ_i)/|ωo + ωi|
 and ωo·h = (1 + ωo·ωi)/|ωo + ωi|. Agrees with bsdf.eval_bsdf to float32 rounding (tested).
 
