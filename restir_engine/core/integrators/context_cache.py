@@ -69,9 +69,8 @@ def context_for(scene, max_bounces: int, film_transparent: bool, build):
         last = _LAST
     others = rest_key(scene)
     if last is not None and last.others == others:
-        ctx = _same_or_moved(last, scene, max_bounces, film_transparent)
+        ctx, reused = _same_or_moved(last, scene, max_bounces, film_transparent)
         if ctx is not None:
-            reused = ctx.geom_accel is last.ctx.geom_accel
             if not reused:
                 with _LOCK:
                     _LAST = _Last(ctx, None, last.lamp_key, others)
@@ -94,18 +93,18 @@ def context_for(scene, max_bounces: int, film_transparent: bool, build):
 
 
 def _same_or_moved(last: "_Last", scene, max_bounces: int, film_transparent: bool):
-    """The last context for ``scene`` (same materials, lamps and world as the last one): as it is where the
-    triangles are the same, updated where only positions changed in a few rows (context_update.py); None where
-    the triangles changed otherwise."""
+    """(context, reused) for ``scene`` (same materials, lamps and world as the last one): the last context as it is
+    where the triangles are the same (reused), updated where only positions changed in a few rows
+    (context_update.py; not reused); (None, False) where the triangles changed otherwise."""
     old = last.ctx.scene.geometry
     geom = scene.geometry
     if old is not geom and not same_layout(old, geom):
-        return None
+        return None, False
     rows = None if old is geom else changed_rows(old, geom)
     if rows is None or rows.size == 0:
         return dataclasses.replace(last.ctx, scene=scene, max_bounces=int(max(0, max_bounces)),
-                                   film_transparent=film_transparent)
-    return updated_context(last.ctx, scene, rows, max_bounces, film_transparent)
+                                   film_transparent=film_transparent), True
+    return updated_context(last.ctx, scene, rows, max_bounces, film_transparent), False
 
 
 class _Last(NamedTuple):

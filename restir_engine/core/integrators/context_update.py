@@ -78,23 +78,36 @@ def updated_context(last: TraceContext, scene, rows: np.ndarray, max_bounces: in
     derived = updated_derived(last.geom_derived, geom, rows)
     cut = old.cutout
     accel = SplitAccel(still, still_rows, geom.verts[moving], moving, cut, derived.ng_rows if cut else None)
-    lights, emit_accel = last.lights, last.emit_accel
-    emitter_moved = bool(lights.n_geom) and bool((lights.geom_to_light[rows] >= 0).any())
-    new_box, old_box = scene_bounds(scene, derived.bounds), scene_bounds(last.scene, last.geom_derived.bounds)
-    if emitter_moved or not (np.array_equal(new_box[0], old_box[0]) and np.array_equal(new_box[1], old_box[1])):
-        lights = scene_lights(scene, derived.bounds, last.world)
-        emit_accel = Accel(lights.tri_verts[:lights.n_geom]) if lights.n_geom else None
+    lights, emit_accel = moved_lights(last, scene, rows, derived)
     return dataclasses.replace(last, scene=scene, geom_accel=accel, lights=lights, emit_accel=emit_accel,
                                geom_ng=derived.ng, geom_ng_rows=derived.ng_rows, geom_normal_rows=derived.normal_rows,
                                geom_flat=derived.flat, geom_derived=derived, max_bounces=int(max(0, max_bounces)),
                                film_transparent=film_transparent, measured={})
 
 
-def updated_derived(base: GeometryDerived, geom, rows: np.ndarray) -> GeometryDerived:
+def moved_lights(last: TraceContext, scene, rows: np.ndarray, derived: GeometryDerived) -> tuple:
+    """(light table, emissive triangles' Accel) of ``scene``, ``last``'s scene with the rows ``rows`` moved
+    (``derived``: its GeometryDerived): ``last``'s, unless an emissive triangle moved or the scene's bounds changed
+    (the light table's scene radius and the world's sphere follow them): then built again."""
+    lights, emit_accel = last.lights, last.emit_accel
+    emitter_moved = bool(lights.n_geom) and bool((lights.geom_to_light[rows] >= 0).any())
+    new_box, old_box = scene_bounds(scene, derived.bounds), scene_bounds(last.scene, last.geom_derived.bounds)
+    if emitter_moved or not (np.array_equal(new_box[0], old_box[0]) and np.array_equal(new_box[1], old_box[1])):
+        lights = scene_lights(scene, derived.bounds, last.world)
+        emit_accel = Accel(lights.tri_verts[:lights.n_geom]) if lights.n_geom else None
+    return lights, emit_accel
+
+
+def updated_derived(base: GeometryDerived, geom, rows: np.ndarray, into: GeometryDerived | None = None
+                    ) -> GeometryDerived:
     """``base`` (GeometryDerived.of an earlier geometry of the same layout) for ``geom``, where only the rows
-    ``rows`` changed: equal to ``GeometryDerived.of(geom)``."""
-    ng, ng_rows = base.ng.copy(), base.ng_rows.copy()
-    normal_rows, flat = base.normal_rows.copy(), base.flat.copy()
+    ``rows`` changed: equal to ``GeometryDerived.of(geom)``. ``into``: an earlier result of this call with the same
+    ``base`` and ``rows``, whose per-triangle arrays are overwritten in those rows (it is not to be used after)."""
+    if into is None:
+        ng, ng_rows = base.ng.copy(), base.ng_rows.copy()
+        normal_rows, flat = base.normal_rows.copy(), base.flat.copy()
+    else:
+        ng, ng_rows, normal_rows, flat = into.ng, into.ng_rows, into.normal_rows, into.flat
     if rows.size:
         ng[rows], _ = triangle_geometry(geom.verts[rows])
         ng_rows[:, rows] = ng[rows].T

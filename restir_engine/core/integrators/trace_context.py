@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from types import SimpleNamespace
 
 import numpy as np
 
@@ -187,31 +186,17 @@ def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tup
     materials, lamps and the world are base's. ``into``: an earlier result of this call with the same ``base``
     and ``rows``, whose per-triangle arrays are overwritten in those rows only (it is not to be used after)."""
     from ..geometry.accel import SplitAccel
+    from .context_update import moved_lights, updated_derived
     geom = scene.geometry
-    bd = base.geom_derived
-    if into is None:
-        ng, ng_rows, normal_rows = bd.ng.copy(), bd.ng_rows.copy(), bd.normal_rows.copy()
-    else:
-        ng, ng_rows, normal_rows = into.geom_ng, into.geom_ng_rows, into.geom_normal_rows
-    if rows.size:
-        ng[rows], _ = triangle_geometry(geom.verts[rows])
-        ng_rows[:, rows] = ng[rows].T
-    normal_rows[:, rows] = geom.normals[rows].reshape(len(rows), 9).T
-    bounds, boxes = _moved_bounds(bd, geom, rows)
-    derived = GeometryDerived(bounds, ng, ng_rows, bd.flat, normal_rows, boxes, None)
+    derived = updated_derived(base.geom_derived, geom, rows, None if into is None else into.geom_derived)
     if still is None:
         still = _still_part(base, rows)
     cut = base.geom_accel.cutout
     accel = SplitAccel(still[0], still[1], geom.verts[rows], rows, cut, derived.ng_rows if cut else None)
-    lights, emit_accel = base.lights, base.emit_accel
-    if rows.size and lights.n_geom and (lights.geom_to_light[rows] >= 0).any():
-        lights = LightTable(scene, base.lights.scene_radius)
-        if base.lights.env is not None:
-            lights.attach_world(base.lights.env)
-        emit_accel = Accel(lights.tri_verts[:lights.n_geom]) if lights.n_geom else None
+    lights, emit_accel = moved_lights(base, scene, rows, derived)
     return dataclasses.replace(base, scene=scene, geom_accel=accel, lights=lights, emit_accel=emit_accel,
-                               geom_ng=ng, geom_ng_rows=derived.ng_rows, geom_normal_rows=normal_rows,
-                               geom_derived=derived, measured=base.measured)
+                               geom_ng=derived.ng, geom_ng_rows=derived.ng_rows, geom_normal_rows=derived.normal_rows,
+                               geom_flat=derived.flat, geom_derived=derived, measured=base.measured)
 
 
 _STILL: tuple | None = None  # (Accel of a base context, moving rows, (Accel, rows) of the others): the last built
@@ -230,22 +215,3 @@ def _still_part(base: TraceContext, rows: np.ndarray) -> tuple:
     still = (Accel(base.scene.geometry.verts[still_rows]), still_rows)
     _STILL = (base.geom_accel, rows.copy(), still)
     return still
-
-
-def _moved_bounds(base: GeometryDerived, geom, rows: np.ndarray) -> tuple:
-    """(bounds, boxes) covering ``base``'s and the moved rows ``rows`` of ``geom``: the base boxes with the moved
-    rows' instance boxes added (a superset of where the geometry is at this pose: the camera masks built from it
-    only test more pixels), without a pass over the unmoved triangles."""
-    if not rows.size:
-        return base.bounds, base.boxes
-    moved = SimpleNamespace(verts=geom.verts[rows], instance=None if geom.instance is None else geom.instance[rows])
-    v = moved.verts.reshape(-1, 3)
-    fin = v[np.isfinite(v).all(axis=1)]
-    if not len(fin):
-        return base.bounds, base.boxes
-    lo, hi = fin.min(0), fin.max(0)
-    if base.bounds is not None:
-        lo, hi = np.minimum(lo, base.bounds[0]), np.maximum(hi, base.bounds[1])
-    add = instance_boxes(moved, (fin.min(0), fin.max(0)))
-    old = base.boxes if base.boxes is not None else (np.zeros((0, 3), np.float32), np.zeros((0, 3), np.float32))
-    return (lo, hi), (np.concatenate([old[0], add[0]]), np.concatenate([old[1], add[1]]))
