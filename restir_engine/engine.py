@@ -44,7 +44,8 @@ def with_data_passes(settings: RenderSettings, view_layer, denoise_guides: bool 
     reservoirs = bool(view_layer.restir.use_pass_reservoir_m or view_layer.restir.use_pass_reservoir_ucw)
     gi_reservoirs = bool(view_layer.restir.use_pass_gi_reservoir_m or view_layer.restir.use_pass_gi_reservoir_ucw)
     return replace(settings, data_passes=wanted, reservoir_passes=reservoirs, gi_reservoir_passes=gi_reservoirs,
-                   denoise_data=bool(view_layer.restir.use_pass_denoising_data) or denoise_guides)
+                   denoise_data=bool(view_layer.restir.use_pass_denoising_data) or denoise_guides,
+                   shadow_catcher_pass=bool(view_layer.restir.use_pass_shadow_catcher))
 
 
 def _set_rect(render_pass, pixels: np.ndarray) -> None:

@@ -39,6 +39,7 @@ PASSES = (
     ("Denoising Normal", "XYZ", "VECTOR", lambda sc, vl: vl.restir.use_pass_denoising_data, "Denoising Normal"),
     ("Noisy Image", "RGBA", "COLOR", lambda sc, vl: vl.restir.use_pass_denoising_data and sc.restir.use_denoising,
      "Noisy Image"),
+    ("Shadow Catcher", "RGB", "COLOR", lambda sc, vl: vl.restir.use_pass_shadow_catcher, "Shadow Catcher"),
     ("Sample Count", "X", "VALUE", lambda sc, vl: vl.restir.use_pass_sample_count and sc.restir.use_adaptive_sampling,
      "Sample Count"),
 )

@@ -303,6 +303,10 @@ class RestirViewLayerSettings(bpy.types.PropertyGroup):
     use_pass_sample_count: BoolProperty(name="Sample Count", description="Samples each pixel took (with adaptive "
                                         "sampling, Render Properties > Sampling > Noise Threshold)", default=False,
                                         update=_update_passes)
+    use_pass_shadow_catcher: BoolProperty(name="Shadow Catcher", description="The light shadow catcher objects "
+                                          "receive with the other objects over what they would receive without them "
+                                          "(multiply a background plate by it); Combined then leaves the catchers "
+                                          "transparent", default=False, update=_update_passes)
 
 
 class RestirViewShadingSettings(bpy.types.PropertyGroup):

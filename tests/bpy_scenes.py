@@ -913,3 +913,28 @@ def translucent_scene(size=(96, 64), back="AREA"):
     camera((0, -4.5, 1.0), (math.radians(88), 0, 0), lens=35)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def shadow_catcher_scene(size=(64, 48), transparent=False, catcher_pass=False):
+    """A red cube and a white sphere on a grey floor that is a shadow catcher (Object > Visibility > Mask > Shadow
+    Catcher), lit by an area light under a blue-grey world; ``transparent``: Film > Transparent (set again after
+    configure_cycles, which turns it off); ``catcher_pass``: the Shadow Catcher pass is written (Cycles' and ours)."""
+    scene = reset()
+    world = bpy.data.worlds.new("Sky")
+    enable_nodes(world)
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.2, 0.3, 0.5, 1)
+    scene.world = world
+    plane("Floor", 6, (0, 0, 0), material=diffuse("Floor", (0.8, 0.8, 0.8))).is_shadow_catcher = True
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(-0.6, 0, 0.5))
+    bpy.context.active_object.data.materials.append(diffuse("Red", (0.8, 0.1, 0.1)))
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.4, location=(0.7, -0.3, 0.4), segments=32, ring_count=16)
+    bpy.ops.object.shade_smooth()
+    bpy.context.active_object.data.materials.append(diffuse("White", (0.8, 0.8, 0.8)))
+    light("AREA", (1, -1, 3), energy=300.0, size=1.0)
+    camera((0, -5, 2.5), (math.radians(65), 0, 0), lens=35)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    scene.render.film_transparent = transparent
+    layer = scene.view_layers[0]
+    layer.cycles.use_pass_shadow_catcher = catcher_pass
+    layer.restir.use_pass_shadow_catcher = catcher_pass
+    return scene

@@ -25,6 +25,7 @@ STREAM_GI_SPATIAL = 48  # + spatial pass index
 # passes with camera rays of their own (pipeline/own_rays.py): (per-pixel shift, aperture) streams
 STREAM_CRYPTO_RAYS = (96, 97)
 STREAM_AOV_RAYS = (98, 99)
+STREAM_CATCHER = 100  # shadow catchers' light without the other objects (pipeline/shadow_catcher.py)
 
 
 def _sobol_2d(s: int) -> tuple[int, int]:

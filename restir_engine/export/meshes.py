@@ -275,7 +275,8 @@ def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None
         blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name,
                        instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, asset_name(obj),
                                                          bool(getattr(obj, "is_holdout", False)),
-                                                         float(getattr(obj, "pass_index", 0)))))
+                                                         float(getattr(obj, "pass_index", 0)),
+                                                         bool(getattr(obj, "is_shadow_catcher", False)))))
 
     return blocks, reads, slots_seen
 
@@ -427,7 +428,8 @@ def _object_table(blocks) -> ObjectTable:
                        random=np.array([b[5][1] for b in blocks], np.float32),
                        names=tuple(b[5][2] for b in blocks), assets=tuple(b[5][3] for b in blocks),
                        holdout=np.array([b[5][4] for b in blocks], bool),
-                       pass_index=np.array([b[5][5] for b in blocks], np.float32))
+                       pass_index=np.array([b[5][5] for b in blocks], np.float32),
+                       shadow_catcher=np.array([b[5][6] for b in blocks], bool))
 
 
 def asset_name(obj) -> str:

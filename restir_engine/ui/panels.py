@@ -353,6 +353,8 @@ class RESTIR_PT_passes(RestirPanel, bpy.types.Panel):
         col = layout.column(heading="Sampling", align=True)
         col.active = context.scene.restir.use_adaptive_sampling
         col.prop(vl.restir, "use_pass_sample_count")
+        col = layout.column(heading="Shadow Catcher", align=True)
+        col.prop(vl.restir, "use_pass_shadow_catcher", text="Shadow Catcher")
         col = layout.column(heading="Cryptomatte", align=True)
         col.prop(vl, "use_pass_cryptomatte_object", text="Object")
         col.prop(vl, "use_pass_cryptomatte_material", text="Material")
@@ -404,6 +406,23 @@ class RESTIR_PT_object_light_group(RestirLightGroupPanel, bpy.types.Panel):
         self.draw_group(context, context.object)
 
 
+class RESTIR_PT_object_mask(RestirPanel, bpy.types.Panel):
+    """Object Properties > Visibility > Shadow Catcher (pipeline/shadow_catcher.py; Holdout is in Visibility's own
+    Mask)."""
+    bl_label = "Shadow Catcher"
+    bl_context = "object"
+    bl_parent_id = "OBJECT_PT_visibility"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and context.object is not None and context.object.type in {
+            "MESH", "CURVE", "SURFACE", "FONT", "META", "POINTCLOUD", "CURVES"}
+
+    def draw(self, context):
+        layout = self.split_layout()
+        layout.prop(context.object, "is_shadow_catcher")
+
+
 class RESTIR_PT_world_light_group(RestirLightGroupPanel, bpy.types.Panel):
     bl_context = "world"
 
@@ -437,7 +456,8 @@ PANELS = (RESTIR_PT_sampling, RESTIR_PT_sampling_direct, RESTIR_PT_sampling_reus
           RESTIR_PT_motion_blur_curve, RESTIR_PT_performance,
           RESTIR_PT_passes)  # Render Properties
 VIEW_PANELS = (RESTIR_PT_viewport_render_pass,)  # the 3D view's header popovers
-DATA_PANELS = (RESTIR_PT_object_light_group, RESTIR_PT_world_light_group)  # Object and World Properties
+DATA_PANELS = (RESTIR_PT_object_light_group, RESTIR_PT_object_mask,
+               RESTIR_PT_world_light_group)  # Object and World Properties
 
 
 def _standard_panels():

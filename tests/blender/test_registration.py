@@ -153,14 +153,14 @@ def test_viewport_render_pass_selector(addon):
     shading.type = "SOLID"
 
 
-def test_light_group_panels(addon):
+def test_light_group_and_shadow_catcher_panels(addon):
     """Light groups can be set up from the UI with this engine: the view layer's list with add/remove (Passes
     panel), and an object's and the world's Light Group field (Object and World Properties), with the button that
     adds a group the view layer lacks; the panels show for this engine only."""
     from restir_engine.ui import panels
     bpy.ops.mesh.primitive_cube_add()
     obj = bpy.context.active_object
-    obj.lightgroup = "Key"
+    obj.lightgroup = "Key (not in the view layer)"
     calls = []
 
     class Layout:
@@ -180,7 +180,7 @@ def test_light_group_panels(addon):
         view_layer = bpy.context.view_layer
     holder = type("Holder", (), {"layout": Layout(), "split_layout": panels.RestirPanel.split_layout,
                                  "draw_group": panels.RestirLightGroupPanel.draw_group})()
-    for panel in panels.DATA_PANELS:
+    for panel in (panels.RESTIR_PT_object_light_group, panels.RESTIR_PT_world_light_group):
         assert getattr(bpy.types, panel.__name__, None) is not None
         assert panel.poll(Ctx)
         calls.clear()
@@ -188,13 +188,20 @@ def test_light_group_panels(addon):
         search = [c for c in calls if c[0] == "prop_search"]
         assert search and search[0][1][1:] == ("lightgroup", Ctx.view_layer, "lightgroups")
         ops = [c[1][0] for c in calls if c[0] == "operator"]
-        assert ops == (["scene.view_layer_add_lightgroup"] if search[0][1][0].lightgroup else [])
+        name = search[0][1][0].lightgroup
+        missing = bool(name) and name not in Ctx.view_layer.lightgroups
+        assert ops == (["scene.view_layer_add_lightgroup"] if missing else [])
     Ctx.engine = "CYCLES"
     assert not any(panel.poll(Ctx) for panel in panels.DATA_PANELS)
-    calls.clear()
     Ctx.engine = "RESTIR"
+    calls.clear()  # a shadow catcher is set in Object Properties > Visibility
+    assert panels.RESTIR_PT_object_mask.poll(Ctx)
+    panels.RESTIR_PT_object_mask.draw(holder, Ctx)
+    assert [c[1][1] for c in calls if c[0] == "prop"] == ["is_shadow_catcher"]
+    calls.clear()
     panels.RESTIR_PT_passes.draw(holder, Ctx)
     lists = [c for c in calls if c[0] == "template_list"]
     assert any("lightgroups" in c[1] for c in lists)
     assert {"scene.view_layer_add_lightgroup", "scene.view_layer_remove_lightgroup"} <= \
         {c[1][0] for c in calls if c[0] == "operator"}
+    assert ("use_pass_shadow_catcher" in [c[1][1] for c in calls if c[0] == "prop"])

@@ -14,7 +14,8 @@ NOT_SCENE = {"frame": "scene.frame_current", "film_transparent": "scene.render.f
              "data_passes": "the view layer's Depth/Normal/Vector passes (engine.with_data_passes)",
              "reservoir_passes": "the view layer's reservoir passes", "gi_reservoir_passes": "the GI reservoir passes",
              "denoise_data": "the view layer's Denoising Data pass", "tile_pixels": "core tuning (chunk size)",
-             "sample_batch": "core tuning (automatic)", "gi_target": "core measurements only"}
+             "sample_batch": "core tuning (automatic)", "gi_target": "core measurements only",
+             "shadow_catcher_pass": "the view layer's Shadow Catcher pass"}
 # the core's defaults are the reference path tracer's; a new Blender scene defaults to ReSTIR with Auto methods
 CORE_DEFAULT_DIFFERS = {"integrator", "direct_method", "indirect_method", "use_adaptive_sampling"}
 

@@ -48,13 +48,16 @@ class BufferPool:
 BUFFERS = BufferPool()
 
 
-def film_keys(gi: bool, denoise_data: bool, adaptive: bool = False, groups: int = 0) -> list[tuple[str, int]]:
-    """(accumulator key, channels) of a film with ``groups`` light groups, in allocation order (1: an (h, w)
-    array)."""
+def film_keys(gi: bool, denoise_data: bool, adaptive: bool = False, groups: int = 0,
+              catchers: bool = False) -> list[tuple[str, int]]:
+    """(accumulator key, channels) of a film with ``groups`` light groups (and shadow catchers), in allocation
+    order (1: an (h, w) array)."""
     keys = [("emit", 3), ("direct", 3), ("indirect", 3), ("alpha", 1), ("res_m", 1), ("res_w", 1)]
     if gi:
         keys += [("gi_m", 1), ("gi_w", 1)]
     keys += [(f"lg{k}", 3) for k in range(groups)]
+    if catchers:
+        keys += [("sc_with", 3), ("sc_without", 3), ("sc_behind", 3), ("sc_cov", 1)]
     if denoise_data:
         keys += [("albedo", 3), ("dnormal", 3)]
     if adaptive:
@@ -75,12 +78,14 @@ class Film:
     then nothing returns to the pool)."""
 
     def __init__(self, w: int, h: int, gi: bool, denoise_data: bool, zeros=None, adaptive: bool = False,
-                 group_names: tuple = ()):
+                 group_names: tuple = (), catcher_mode: str | None = None):
         self.pooled = zeros is None
         z = zeros or BUFFERS.zeros
         self.group_names = tuple(group_names)
+        self.catcher_mode = catcher_mode  # shadow_catcher.MODES, or None without shadow catchers
         self.acc = {key: z((h, w, c) if c > 1 else (h, w))
-                    for key, c in film_keys(gi, denoise_data, adaptive, len(self.group_names))}
+                    for key, c in film_keys(gi, denoise_data, adaptive, len(self.group_names),
+                                            catcher_mode is not None)}
         self.samples = 0
 
     def has(self, key: str) -> bool:
@@ -121,6 +126,11 @@ class Film:
                 add_adaptive(c.pixels, rgb)
             if self.group_names:
                 add_groups(c, span, pix, chain)
+            if c.catcher is not None and len(c.catcher):
+                pc = c.pixels[hit[c.catcher]]  # the catcher surfaces' pixels (unique)
+                for key, value in (("sc_with", c.sc_with), ("sc_without", c.sc_without), ("sc_behind", c.sc_behind)):
+                    flat[key][pc] += np.ascontiguousarray(value.T)
+                flat["sc_cov"][pc] += 1.0
             if resampled:
                 flat["res_m"][pix] += c.res.M
                 flat["res_w"][pix] += c.res.W
@@ -197,7 +207,8 @@ class Film:
         return np.float32(1.0 / max(1, self.samples))
 
     def combined(self) -> np.ndarray:
-        """The running mean of Combined (h, w, 4) float32: emission + direct + indirect, and alpha."""
+        """The running mean of Combined (h, w, 4) float32: emission + direct + indirect, and alpha; with shadow
+        catchers, their shadows as the mode says (shadow_catcher.py)."""
         inv = self._inverse_counts()
         h, w = self.acc["alpha"].shape
         out = np.empty((h, w, 4), np.float32)
@@ -205,7 +216,20 @@ class Film:
         out[..., :3] += self.acc["indirect"]
         out[..., :3] *= inv if np.ndim(inv) == 0 else inv[..., None]
         np.multiply(self.acc["alpha"], inv, out=out[..., 3], casting="unsafe")
+        if self.catcher_mode in ("TRANSPARENT", "OPAQUE"):
+            from .shadow_catcher import shadow
+            s = shadow(self.catcher_ratio(), self.acc["sc_cov"])
+            if self.catcher_mode == "TRANSPARENT":
+                out[..., 3] += (1.0 - out[..., 3]) * s
+            else:
+                out[..., :3] += self.mean("sc_behind") * (1.0 - s)[..., None]
+                out[..., 3] += self.mean("sc_cov")[..., 0]
         return finite(out)
+
+    def catcher_ratio(self) -> np.ndarray:
+        """The Shadow Catcher pass (h, w, 3): Σ L_with / Σ L_without per pixel (shadow_catcher.ratio)."""
+        from .shadow_catcher import ratio
+        return finite(ratio(self.acc["sc_with"], self.acc["sc_without"]))
 
     def mean(self, key: str) -> np.ndarray:
         """The running mean of accumulator ``key`` as (h, w, c) float32 (c = 1 for scalar ones), finite."""
@@ -234,6 +258,8 @@ class Film:
             jobs["GI Reservoir UCW"] = lambda: mean("gi_w")
         for k, name in enumerate(self.group_names):  # Cycles' names of the light groups' passes
             jobs[f"Combined_{name}"] = lambda k=k: mean(f"lg{k}")
+        if "sc_with" in self.acc:
+            jobs["Shadow Catcher"] = self.catcher_ratio
         if "count" in self.acc:
             jobs["Sample Count"] = self.sample_counts
         if "albedo" in self.acc:

@@ -42,6 +42,7 @@ from .indirect_choice import IndirectChoice, ratios
 from .plan import PassPlan
 from .runner import PassRunner
 from .settings import RenderSettings, validate
+from .shadow_catcher import Catchers, film_mode
 from .work import frame_reservoirs, hand_back, make_chunks, own, place
 
 MAX_BATCH = 8  # samples one pass renders at most (FrameRenderer.batch_size)
@@ -88,6 +89,7 @@ class FrameRenderer:
             self.ctx = dataclasses.replace(self.ctx, groups=groups)
         # the light groups' names (one "Combined_<name>" pass each), () without
         self.group_names = () if groups is None else tuple(scene.light_groups.names)
+        self.catchers = Catchers.of(self.ctx)  # shadow catchers (shadow_catcher.py), or None
         self.indirect = IndirectChoice(settings, bounces, methods.gi_auto(settings), self.ctx)
         self.gi = None  # gi.GISettings when the indirect light is resampled
         if settings.integrator == Integrator.RESTIR:
@@ -193,7 +195,7 @@ class FrameRenderer:
         self.release()
         st = self.settings
         self.film = Film(w, h, self.gi is not None, st.denoise_data, self.film_zeros, st.use_adaptive_sampling,
-                         self.group_names)
+                         self.group_names, film_mode(st, self.catchers is not None))
         # adaptive sampling: which pixels the next passes sample (pipeline/adaptive.py)
         self.adaptive = AdaptiveSampling(w, h, st.samples, st.adaptive_threshold, st.adaptive_min_samples) \
             if st.use_adaptive_sampling else None
@@ -312,7 +314,7 @@ class FrameRenderer:
         """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
         ReSTIR GI), measures nothing for Auto indirect (no probe; the first pass without a measurement probes) and
         is not motion-blurred (each sample at its own shutter time)."""
-        if self.candidates is not None or self._gi_runs() or self.blur is not None:
+        if self.candidates is not None or self._gi_runs() or self.blur is not None or self.catchers is not None:
             return False
         if self.gi is None or self.samples_done > 0:
             return True
@@ -344,7 +346,8 @@ class FrameRenderer:
             reusing=self.method == DirectMethod.RESTIR, temporal=first_with_history and hist.res is not None, gi=gi_on,
             gi_temporal=first_with_history and hist.gi_res is not None, probe=probe,
             glass_chains=st.integrator == Integrator.RESTIR and (resampled or gi_on), world_resampled=world_resampled,
-            continuing=pathtracer.needs_continuation(ctx, resampled, world_resampled), strata=self.coverage,
+            continuing=pathtracer.needs_continuation(ctx, resampled, world_resampled),
+            strata=self.coverage if self.catchers is None else 1,  # coverage rays do not see catchers as matte
             candidates=candidates, light_tiles=bool(resampled and ctx.lights.tri_alias is not None
                                                     and candidates.tile_settings.wanted(w * h,
                                                                                         candidates.light_candidates)))
@@ -379,7 +382,7 @@ class FrameRenderer:
                          team)
 
         with run.stage("primary"):
-            run.map_chunks(lambda c: primary.primary(ctx, plan, self.masks, c), chunks, 0)
+            run.map_chunks(lambda c: primary.primary(ctx, plan, self.masks, c, self.catchers), chunks, 0)
             n_surf = place(chunks, team)
             self._surfaces_per_chunk = n_surf / (len(chunks) * plan.batch)
         candidates = plan.candidates
@@ -423,7 +426,7 @@ class FrameRenderer:
             self._keep_history(gb, res, gb_gi, gi_history, gi_reused)
         unbiased = st.bias_correction == "UNBIASED"
         with run.stage("shade"):
-            run.map_chunks(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c), chunks, 2)
+            run.map_chunks(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c, self.catchers), chunks, 2)
         team.publish_costs()
         team.barrier()  # every process shaded its chunks: from here on the pass is not stopped (the film takes
         run.stop.should_stop = None  # all of it or, stopped before, none)

@@ -52,6 +52,9 @@ def frame_estimate(scene, settings) -> MemoryEstimate:
     groups = getattr(scene, "light_groups", None)
     if groups is not None:  # per light group: a float64 RGB film sum and float32 RGB estimates of the pass's stages
         low, high = low + len(groups) * 36, high + len(groups) * 60
+    catchers = getattr(getattr(scene.geometry, "objects", None), "shadow_catcher", None)
+    if getattr(settings, "shadow_catcher_pass", False) or (catchers is not None and catchers.any()):
+        low, high = low + 80, high + 116  # shadow catchers: 10 float64 film sums, 3 float32 RGB estimates
     scene_bytes = scene_size(scene)
     return MemoryEstimate(FIXED + scene_bytes + low * pixels, FIXED + scene_bytes + high * pixels, pixels,
                           scene_bytes)

@@ -14,7 +14,7 @@ from ..geometry import camera as camera_mod
 from ..integrators import camera_paths
 from ..restir.gbuffer import GBuffer
 from ..restir.target import ShadingTerms
-from ..sampling import STREAM_CAMERA, STREAM_CHAIN, STREAM_LENS, STREAM_PIXEL_OFFSET, pass_jitter
+from ..sampling import STREAM_CAMERA, STREAM_CHAIN, STREAM_LENS, STREAM_PIXEL_OFFSET, cols, pass_jitter
 from .plan import PassPlan
 from .work import Chunk, own
 
@@ -27,13 +27,23 @@ class CameraMasks:
         self.coverage, self.may_hit, self.lamps = coverage_mask, may_hit, lamps
 
 
-def primary(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:
-    """Fill ``c.hits`` (and ``c.chain`` where camera rays continue through glass)."""
+def primary(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk, catchers=None) -> None:
+    """Fill ``c.hits`` (and ``c.chain`` where camera rays continue through glass; ``c.catcher`` and what the
+    catchers hide where camera rays meet shadow catchers: shadow_catcher.Catchers)."""
     camera_rays(ctx, plan, masks, c)
     if plan.glass_chains and ctx.has_glass:
         # camera rays that met glass continue to the surface behind it, where resampling runs (without
         # resampling, the path continuation handles glass as the path tracer does, at less cost)
         c.chain = camera_paths.follow_specular(ctx, c.hits, plan.rng(STREAM_CHAIN, c.index))
+    if catchers is not None:
+        hits = c.hits
+        c.catcher = catchers.hits(hits.surf, c.chain)
+        pix = hits.rows[c.catcher]  # the matte: black and transparent there (shadow_catcher.py)
+        hits.emitted[:, pix] = 0.0
+        hits.alpha[pix] = 0.0
+        if hits.emitted_g is not None:
+            hits.emitted_g[:, :, pix] = 0.0
+        c.sc_behind = ctx.world.radiance(-cols(hits.surf.wo, c.catcher), camera=True)
 
 
 def camera_rays(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk) -> None:

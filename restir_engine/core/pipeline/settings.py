@@ -55,6 +55,7 @@ class RenderSettings:
     film_transparent: bool = False
     data_passes: bool = True  # Depth, Normal and Vector (one more ray per pixel and frame); off when not written
     denoise_data: bool = False  # Denoising Albedo / Normal: first-hit albedo and camera-space normal, per sample
+    shadow_catcher_pass: bool = False  # a Shadow Catcher pass is written (Combined then leaves catchers transparent)
     tile_pixels: int = CHUNK_PIXELS  # pixels per chunk of work (smaller: finer progress and cancellation)
     sample_batch: int = 0  # samples a pass renders at once where it can (plan.batch_size); 0 = automatic
     coverage_samples: int = 0  # camera rays per pixel for the emission seen directly: 1, 4, 9, 16 ...; 0 = automatic

@@ -7,12 +7,13 @@ from ..integrators import pathtracer
 from ..lights import groups as light_groups
 from ..lights.groups import Tap
 from ..restir import di, gi
-from ..sampling import STREAM_SHADE
+from ..sampling import STREAM_CATCHER, STREAM_SHADE
 from .plan import PassPlan
+from .shadow_catcher import matte
 from .work import Chunk
 
 
-def shade(ctx, plan: PassPlan, gi_reused: bool, unbiased: bool, c: Chunk) -> None:
+def shade(ctx, plan: PassPlan, gi_reused: bool, unbiased: bool, c: Chunk, catchers=None) -> None:
     r = plan.rng(STREAM_SHADE, c.index)
     sums = light_groups.zeros(ctx.groups, len(c.hits.surf))  # this stage's light by light group, or None
     taps = () if sums is None else (Tap(sums),)
@@ -29,3 +30,7 @@ def shade(ctx, plan: PassPlan, gi_reused: bool, unbiased: bool, c: Chunk) -> Non
         # the unbiased mode's reservoirs hold only samples their surface sees (gi.clear_occluded)
         c.indirect = c.indirect + gi.shade(ctx.geom_accel, c.hits.surf, c.gi_res, c.glossy, verified=unbiased,
                                            sums=c.indirect_g)
+    if catchers is not None and c.catcher is not None:  # the catchers' light with and without the other objects
+        matte(c, c.catcher)
+        c.sc_with, c.sc_without = catchers.light_pair(ctx, c.hits.surf.take(c.catcher),
+                                                      lambda: plan.rng(STREAM_CATCHER, c.index))

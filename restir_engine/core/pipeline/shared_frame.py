@@ -15,6 +15,7 @@ from ..parallel.processes import WorkerTeam
 from ..sampling import finite
 from . import methods
 from .film import Film, film_keys
+from .shadow_catcher import catcher_triangles, film_mode
 from .frame import Cancelled, FrameResult
 from .frame_render import out_of_time
 from .settings import RenderSettings, validate
@@ -50,10 +51,11 @@ def slot_bytes(pixels: int, st: RenderSettings) -> int:
     return int((pixels * (per + PIXEL_BYTES)) * SLACK) + FIXED_BYTES
 
 
-def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = False, groups: int = 0) -> int:
+def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = False, groups: int = 0,
+               catchers: bool = False) -> int:
     from ..parallel.team import ALIGN
     return sum(-(-(w * h * c * 8) // ALIGN) * ALIGN
-               for _key, c in film_keys(gi, denoise_data, adaptive, groups)) + ALIGN
+               for _key, c in film_keys(gi, denoise_data, adaptive, groups, catchers)) + ALIGN
 
 
 def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
@@ -70,8 +72,10 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         adaptive = settings.use_adaptive_sampling
         lg = getattr(scene, "light_groups", None)
         group_names = () if lg is None else tuple(lg.names)
-        film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data, adaptive, len(group_names)))
-        film = Film(w, h, gi, settings.denoise_data, zeros, adaptive, group_names)
+        catchers = film_mode(settings, catcher_triangles(scene) is not None)
+        film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data, adaptive, len(group_names),
+                                                catchers is not None))
+        film = Film(w, h, gi, settings.denoise_data, zeros, adaptive, group_names, catchers)
         slots = team.ensure_slots(slot_bytes(w * h, settings))
         usable = isinstance(history, SharedHistory) and history.team == team.id and history.fits(cam)
         seg, packed = wire.pack(scene)

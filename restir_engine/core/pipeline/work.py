@@ -36,6 +36,10 @@ class Chunk:
     direct_g: np.ndarray = None    # (G, 3, n) direct light by light group (lights/groups.py)         [paths, shade]
     indirect_g: np.ndarray = None  # (G, 3, n) indirect light by light group                          [paths, shade]
     path_indirect_g: np.ndarray = None  # path_indirect by light group                                 [paths]
+    catcher: np.ndarray = None     # (k,) its surfaces on shadow catchers (shadow_catcher.py)         [primary]
+    sc_with: np.ndarray = None     # (3, k) their light with every object                             [shade]
+    sc_without: np.ndarray = None  # (3, k) their light in the scene of the catchers alone            [shade]
+    sc_behind: np.ndarray = None   # (3, k) the world the catchers hide                               [primary]
 
     @property
     def surfaces(self) -> slice:
