@@ -338,18 +338,22 @@ class MaterialRegistry(MixShaderReader, TextureReader):
             self._normal(material, node, row, g, varying)
             return self._with_program(row, g, varying)
         if t == "BSDF_TRANSLUCENT":
-            # Cycles: Lambertian transmission, Color/π on the side away from the viewer, none toward it
-            row = {"f0": 0.0, "metallic": 0.0, "translucent": True}
-            g, varying = self._compiler(material), {}
-            row["base_color"] = self._param(material, g, node.inputs["Color"], "color", "base_color", varying, row,
-                                            "base_tex")
-            self._normal(material, node, row, g, varying)
-            return self._with_program(row, g, varying)
+            return self._translucent(material, node)
         if t in {"MIX_SHADER", "ADD_SHADER"}:
             return self._mix(material, node, depth)
         self._warn(material, f"shader '{node.name}' ({t}) is not supported; approximated by the viewport colour")
         return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                 "roughness": float(material.roughness), "f0": 0.04}
+
+    def _translucent(self, material, node) -> dict:
+        """A Translucent BSDF: Lambertian transmission as Cycles, Color/π on the side away from the viewer, none
+        toward it (its Color and Normal from any graph)."""
+        row = {"f0": 0.0, "metallic": 0.0, "translucent": True}
+        g, varying = self._compiler(material), {}
+        row["base_color"] = self._param(material, g, node.inputs["Color"], "color", "base_color", varying, row,
+                                        "base_tex")
+        self._normal(material, node, row, g, varying)
+        return self._with_program(row, g, varying)
 
     def _emission(self, material, g: GraphCompiler, color_socket, strength_socket, row: dict, varying: dict) -> None:
         """Emission colour x strength -> the row's constant "emission" (with "emit_tex" for a plain image), or

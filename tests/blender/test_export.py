@@ -103,15 +103,21 @@ def test_principled_parameters_and_emission(scene):
     assert not s.warnings
 
 
-def test_unsupported_node_is_approximated_and_reported(scene):
+def shader_plane(name: str, node_type: str):
+    """A plane whose material ``name`` is one shader node of ``node_type`` on the output; returns the node."""
     bpy.ops.mesh.primitive_plane_add()
-    m = bpy.data.materials.new("Cartoon")
+    m = bpy.data.materials.new(name)
     if bpy.app.version < (5, 0, 0):
         m.use_nodes = True
     nodes = m.node_tree.nodes
-    g = nodes.new("ShaderNodeBsdfToon")
+    g = nodes.new(node_type)
     m.node_tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
     bpy.context.active_object.data.materials.append(m)
+    return g
+
+
+def test_unsupported_node_is_approximated_and_reported(scene):
+    shader_plane("Cartoon", "ShaderNodeBsdfToon")
     s = export()
     assert any("Cartoon" in w and "BSDF_TOON" in w and "not supported" in w for w in s.warnings)
 
@@ -119,15 +125,7 @@ def test_unsupported_node_is_approximated_and_reported(scene):
 def test_translucent_bsdf_is_exported_as_translucent(scene):
     """A Translucent BSDF becomes a translucent row of its colour, without a warning (the lobe:
     tests/materials/test_translucent.py)."""
-    bpy.ops.mesh.primitive_plane_add()
-    m = bpy.data.materials.new("Leaf")
-    if bpy.app.version < (5, 0, 0):
-        m.use_nodes = True
-    nodes = m.node_tree.nodes
-    g = nodes.new("ShaderNodeBsdfTranslucent")
-    g.inputs["Color"].default_value = (0.2, 0.7, 0.1, 1)
-    m.node_tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
-    bpy.context.active_object.data.materials.append(m)
+    shader_plane("Leaf", "ShaderNodeBsdfTranslucent").inputs["Color"].default_value = (0.2, 0.7, 0.1, 1)
     s = export()
     i = s.geometry.material[0]
     assert s.materials.translucent[i] and np.allclose(s.materials.base_color[i], (0.2, 0.7, 0.1))

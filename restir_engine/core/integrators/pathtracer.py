@@ -462,9 +462,15 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     if first is None:
         first = _no_first_bounce(ctx)
     else:
-        first.lo = finite(first.lo)
-        first.lo_d = finite(first.lo_d)
-        indirect[:, first.rows] = first.throughput * first.lo
-        if indirect_g is not None:
-            indirect_g[:, :, first.rows] = first.throughput * first.lo_g
+        _through_first(first, indirect, indirect_g)
     return PathResult(direct, indirect, first, direct_g, indirect_g)
+
+
+def _through_first(first: FirstBounce, indirect, indirect_g) -> None:
+    """The first bounces' radiance made finite, and the indirect light (by light group where kept) it carries to
+    the primary surfaces: throughput · lo."""
+    first.lo = finite(first.lo)
+    first.lo_d = finite(first.lo_d)
+    indirect[:, first.rows] = first.throughput * first.lo
+    if indirect_g is not None:
+        indirect_g[:, :, first.rows] = first.throughput * first.lo_g

@@ -279,14 +279,11 @@ class Surface:
         viewer, so that every stage (BSDF evaluation and sampling, next-event estimation, ReSTIR's targets) sees a
         Lambertian lobe on the far side of the surface and nothing on the viewer's. Sets ``translucent`` ((n,) bool, or
         None where no hit is translucent); returns the sign applied to each hit's normals ((n,) float32) or None."""
-        self.translucent = None
         flags = ctx.scene.materials.translucent
-        if flags is None or not flags.any():
+        tr = flags[mat] if flags is not None and flags.any() else None
+        self.translucent = tr if tr is not None and tr.any() else None
+        if self.translucent is None:
             return None
-        tr = flags[mat]
-        if not tr.any():
-            return None
-        self.translucent = tr
         away = np.where(tr, np.float32(-1.0), np.float32(1.0))
         self.ng = self.ng * away
         self.ns = self.ns * away

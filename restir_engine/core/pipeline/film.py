@@ -65,6 +65,14 @@ def film_keys(gi: bool, denoise_data: bool, adaptive: bool = False, groups: int 
     return keys
 
 
+def _add_catchers(flat: dict, c, pixels: np.ndarray) -> None:
+    """A chunk's shadow catcher sums (pipeline/shadow_catcher.py) into the flat accumulators at its catcher surfaces'
+    ``pixels`` (unique)."""
+    for key, value in (("sc_with", c.sc_with), ("sc_without", c.sc_without), ("sc_behind", c.sc_behind)):
+        flat[key][pixels] += np.ascontiguousarray(value.T)
+    flat["sc_cov"][pixels] += 1.0
+
+
 def _pixels(pixels: np.ndarray):
     """A slice where ``pixels`` (sorted, unique) is a contiguous range, else the index array itself."""
     if len(pixels) and int(pixels[-1]) - int(pixels[0]) + 1 == len(pixels):
@@ -127,10 +135,7 @@ class Film:
             if self.group_names:
                 add_groups(c, span, pix, chain)
             if c.catcher is not None and len(c.catcher):
-                pc = c.pixels[hit[c.catcher]]  # the catcher surfaces' pixels (unique)
-                for key, value in (("sc_with", c.sc_with), ("sc_without", c.sc_without), ("sc_behind", c.sc_behind)):
-                    flat[key][pc] += np.ascontiguousarray(value.T)
-                flat["sc_cov"][pc] += 1.0
+                _add_catchers(flat, c, c.pixels[hit[c.catcher]])
             if resampled:
                 flat["res_m"][pix] += c.res.M
                 flat["res_w"][pix] += c.res.W
