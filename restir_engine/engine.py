@@ -204,10 +204,11 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self.report({"ERROR"}, str(exc))
             self.error_set(str(exc))
             return None
-        for msg in core_scene.warnings[:MAX_REPORTED_WARNINGS]:
+        unique = list(dict.fromkeys(core_scene.warnings))  # a reason met in several places is named once
+        for msg in unique[:MAX_REPORTED_WARNINGS]:
             self.report({"WARNING"}, msg)
-        if len(core_scene.warnings) > MAX_REPORTED_WARNINGS:
-            self.report({"WARNING"}, f"... and {len(core_scene.warnings) - MAX_REPORTED_WARNINGS} more warnings")
+        if len(unique) > MAX_REPORTED_WARNINGS:
+            self.report({"WARNING"}, f"... and {len(unique) - MAX_REPORTED_WARNINGS} more warnings")
         return core_scene
 
     def _memory_plan(self, core_scene, settings: RenderSettings, denoising: bool):

@@ -13,6 +13,7 @@ import numpy as np
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
 from .coat import coat_set
+from .flat_nodes import FlatTree, flat_output
 from .limits import clamped_radiance
 from .material_textures import TextureReader
 from .mix_shaders import MixShaderReader
@@ -115,6 +116,7 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         tree = material.node_tree
         outs = [n for n in tree.nodes if n.type == "OUTPUT_MATERIAL" and n.is_active_output
                 and n.target in {"ALL", "CYCLES"}] or [n for n in tree.nodes if n.type == "OUTPUT_MATERIAL"]
+        outs = [flat_output(outs[0])] if outs else []
         if not outs or not outs[0].inputs["Surface"].is_linked:
             volume_too = bool(outs) and "Volume" in outs[0].inputs and outs[0].inputs["Volume"].is_linked
             self._warn(material, "no surface shader connected to the Material Output; rendered black" +
@@ -163,7 +165,8 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         (Value), constants included; None without AOV outputs."""
         if not uses_nodes(material):
             return None
-        nodes = [n for n in material.node_tree.nodes if n.type == "OUTPUT_AOV" and not n.mute and n.aov_name]
+        flat = FlatTree()
+        nodes = [flat.node(n) for n in material.node_tree.nodes if n.type == "OUTPUT_AOV" and not n.mute and n.aov_name]
         if not nodes:
             return None
         g = self._compiler(material)
@@ -283,7 +286,7 @@ class MaterialRegistry(MixShaderReader, TextureReader):
                 dr = self._param(material, g, inp["Diffuse Roughness"], "float", "diffuse_roughness", varying)
                 row["diffuse_roughness"] = float(np.clip(dr, 0, 1))
             if "Alpha" in inp:
-                self._alpha(material, inp["Alpha"], row)
+                self._alpha(material, inp["Alpha"], row, g, varying)
             self._normal(material, node, row, g, varying)
             return self._with_program(row, g, varying)
         if t == "BSDF_GLASS":
@@ -341,6 +344,8 @@ class MaterialRegistry(MixShaderReader, TextureReader):
             return self._translucent(material, node)
         if t in {"MIX_SHADER", "ADD_SHADER"}:
             return self._mix(material, node, depth)
+        if t.startswith("VOLUME_") or t == "PRINCIPLED_VOLUME":  # as Cycles: volume closures add nothing to a surface
+            return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
         self._warn(material, f"shader '{node.name}' ({t}) is not supported; approximated by the viewport colour")
         return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                 "roughness": float(material.roughness), "f0": 0.04}
@@ -474,12 +479,28 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         row["bump_distance"] = sign * self._float_input(material, node.inputs["Distance"])
         return True
 
-    def _alpha(self, material, socket, row: dict) -> None:
-        """Principled Alpha: constant, or an Image Texture's Alpha (or Color, as luminance) -> row alpha fields."""
-        tex = self._factor_texture(material, socket)
-        if tex >= 0:
-            row.update(alpha=1.0, alpha_tex=tex, alpha_sign=1.0)
+    def _alpha(self, material, socket, row: dict, g: GraphCompiler, varying: dict) -> None:
+        """Principled Alpha: constant, a plain Image Texture's Alpha (or Color, as luminance) -> row alpha fields;
+        any other graph -> the node program's "alpha" (clamped to [0, 1] as Cycles clamps it)."""
+        if socket.is_linked and self._plain_factor_image(socket):
+            tex = self._factor_texture(material, socket)
+            if tex >= 0:
+                row.update(alpha=1.0, alpha_tex=tex, alpha_sign=1.0)
+                return
+        reg = g.emit("saturate", {}, [g.value(socket, "float")], ("float",))[0]
+        if reg.const is None:
+            varying["alpha"] = reg
+            row["alpha_program"] = True
             return
-        a = float(np.clip(self._float_input(material, socket), 0, 1))
+        a = float(np.clip(reg.constant_value(), 0, 1))
         if a < 1:
             row["alpha"] = a
+
+    @staticmethod
+    def _plain_factor_image(socket) -> bool:
+        """Whether ``socket`` is fed straight by an Image Texture the fixed texture path samples as Blender would
+        (the render UV map, Linear or Closest, Repeat, flat projection)."""
+        node = socket.links[0].from_node
+        return (node.type == "TEX_IMAGE" and node.image is not None and not node.mute
+                and not node.inputs["Vector"].is_linked and node.interpolation in {"Linear", "Closest"}
+                and node.extension == "REPEAT" and node.projection == "FLAT")

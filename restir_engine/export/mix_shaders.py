@@ -41,10 +41,17 @@ class MixShaderReader:
                     self._warn(material, "a textured transparency under a constant Mix factor is approximated")
                 out["alpha"] = float(np.clip(1 - w * (0.5 if tex >= 0 else 1.0), 0, 1))
             out["mix_normalize"] = True
-        for row, weight, tex, sign in parts:
+        see_through = 0.0  # the share of leaves' own Alpha (Principled): transparent, as a Transparent BSDF's
+        for i, (row, weight, tex, sign) in enumerate(parts):
             if row.get("transparent"):
                 continue
-            if row.get("alpha", 1.0) < 1 or row.get("alpha_tex", -1) >= 0:
+            a = float(row.get("alpha", 1.0))
+            if a < 1:
+                if tex >= 0:
+                    self._warn(material, "an Alpha under a textured Mix factor is approximated by its value")
+                see_through += weight * (1 - a) * (0.5 if tex >= 0 else 1.0)
+                weight *= a
+            if row.get("alpha_tex", -1) >= 0 or row.get("alpha_program"):
                 self._warn(material, "alpha inside a Mix/Add shader is ignored (rendered opaque)")
             e = np.asarray(row.get("emission", (0, 0, 0)), np.float32)
             if e.any():
@@ -54,9 +61,12 @@ class MixShaderReader:
                 if row.get("emit_tex", -1) >= 0:
                     emit_tex = row["emit_tex"]
             if _has_bsdf(row):
-                comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, alpha=1.0, alpha_tex=-1,
+                comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, alpha=1.0, alpha_tex=-1, alpha_program=False,
                             name=f"{material.name} ({len(comps) + 1})")
                 comps.append((self.add_row(comp), float(weight), int(tex), float(sign)))
+        if see_through > 0:
+            out["alpha"] = float(np.clip(out.get("alpha", 1.0) - see_through, 0, 1))
+            out["mix_normalize"] = True
         out.update(emission=tuple(emission.tolist()), mix=comps)
         if emit_tex >= 0:
             out["emit_tex"] = emit_tex
@@ -67,6 +77,8 @@ class MixShaderReader:
         (those go to the fixed texture path)."""
         if coat_set(node):  # a coated Principled BSDF is a coat and a base component (export/coat.py)
             return True
+        if node.type == "BSDF_PRINCIPLED" and "Alpha" in node.inputs and node.inputs["Alpha"].is_linked:
+            return True  # its alpha joins the mix's transparent share per hit
         if node.type not in {"MIX_SHADER", "ADD_SHADER"} or node.name in seen:
             return False
         seen.add(node.name)
@@ -115,9 +127,15 @@ class MixShaderReader:
                     walk(sk.links[0].from_node, ww, level + 1)
         walk(node, g.constant(1.0, "float"), 0)
         out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
-        comps, outputs, emission = [], {}, None
+        comps, outputs, emission, clear = [], {}, None, None
         for name in order:
             leaf, w = weights[name]
+            if leaf.type == "BSDF_PRINCIPLED" and "Alpha" in leaf.inputs:  # its see-through share, per hit
+                a = g.emit("saturate", {}, [g.value(leaf.inputs["Alpha"], "float")], ("float",))[0]
+                if a.const is None or a.constant_value() < 1:
+                    share = g.emit("multiply", {}, [w, g.emit("one_minus", {}, [a], ("float",))[0]], ("float",))[0]
+                    clear = share if clear is None else g.emit("add", {}, [clear, share], ("float",))[0]
+                    w = g.emit("multiply", {}, [w, a], ("float",))[0]
             coat = coat_factors(g, leaf) if coat_set(leaf) else None
             row = self._shader(material, leaf, depth + 1, base_only=coat is not None)
             tint = None
@@ -133,20 +151,9 @@ class MixShaderReader:
                     outputs[f"mix:{len(comps)}"] = cw
                     comps.append((index, 1.0, -1, 0.0))
                 w = g.emit("multiply", {}, [w, layer], ("float",))[0]
-                if leaf is node:  # the coated BSDF itself: its alpha is the whole row's cut-out
-                    for key in ("alpha", "alpha_tex", "alpha_sign"):
-                        if key in row:
-                            out[key] = row.pop(key)
-            if row.get("transparent"):
-                if w.const is None:
-                    self._warn(material, "a Transparent BSDF under a varying Mix factor is not supported; rendered "
-                               "opaque")
-                    continue
-                out["alpha"] = float(np.clip(1 - w.constant_value(), 0, 1))
-                out["mix_normalize"] = True
+            if row.get("transparent"):  # opacity 1 - w; summed over transparent leaves
+                clear = w if clear is None else g.emit("add", {}, [clear, w], ("float",))[0]
                 continue
-            if row.get("alpha", 1.0) < 1 or row.get("alpha_tex", -1) >= 0:
-                self._warn(material, "alpha inside a Mix/Add shader is ignored (rendered opaque)")
             e = self._leaf_emission(g, leaf)
             if e is not None:
                 e = g.emit("scale", {}, [e, w], ("color",))[0]
@@ -154,7 +161,7 @@ class MixShaderReader:
                     e = g.emit("multiply", {}, [e, tint], ("color",))[0]
                 emission = e if emission is None else g.emit("add", {}, [emission, e], ("color",))[0]
             if _has_bsdf(row):
-                comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, alpha=1.0, alpha_tex=-1,
+                comp = dict(row, emission=(0.0, 0.0, 0.0), emit_tex=-1, alpha=1.0, alpha_tex=-1, alpha_program=False,
                             name=f"{material.name} ({len(comps) + 1})")
                 prog = comp.get("program")
                 if prog is not None and prog.has("emission"):
@@ -167,6 +174,22 @@ class MixShaderReader:
                 else:
                     outputs[f"mix:{len(comps)}"] = w
                     comps.append((self.add_row(comp), 1.0, -1, 0.0))
+        if clear is not None:  # the transparent share: a cut-out; the opaque points' weights divided by the opacity
+            opacity = g.emit("saturate", {}, [g.emit("one_minus", {}, [clear], ("float",))[0]], ("float",))[0]
+            if opacity.const is not None:
+                out["alpha"] = opacity.constant_value()
+            else:
+                outputs["alpha"] = opacity
+                out["alpha_program"] = True
+            inv = g.emit("reciprocal", {}, [opacity], ("float",))[0]
+            for k, (index, weight, tex, sign) in enumerate(comps):
+                w = outputs.get(f"mix:{k}")
+                if w is None and inv.const is not None:
+                    comps[k] = (index, weight * inv.constant_value(), tex, sign)
+                    continue
+                w = g.constant(weight, "float") if w is None else w
+                outputs[f"mix:{k}"] = g.emit("multiply", {}, [w, inv], ("float",))[0]
+                comps[k] = (index, 1.0, tex, sign)
         if emission is not None:
             if emission.const is not None:
                 out["emission"] = emission.constant_value()

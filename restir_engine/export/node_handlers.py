@@ -396,6 +396,16 @@ def _light_falloff(g, node, f):
     return {"Quadratic": strength, "Linear": strength, "Constant": strength}
 
 
+def _ambient_occlusion(g, node, f):
+    g.warn(f"'{node.name}' (Ambient Occlusion) is taken as unoccluded (AO 1, Color passed through)")
+    return {"Color": g.inp(node, "Color", "color", f), "AO": g.constant(1.0, "float")}
+
+
+def _bevel(g, node, f):
+    g.warn(f"'{node.name}' (Bevel) is not rounded: its Normal is the surface's")
+    return {"Normal": g.inp(node, "Normal", "vector", f, default="normal")}
+
+
 HANDLERS = {
     "TEX_COORD": _texcoord, "TANGENT": _tangent, "LIGHT_PATH": _light_path, "UVMAP": _uvmap,
     "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
@@ -417,4 +427,5 @@ HANDLERS = {
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
     "TEX_BRICK": _brick, "BLACKBODY": _blackbody, "LIGHT_FALLOFF": _light_falloff,
+    "AMBIENT_OCCLUSION": _ambient_occlusion, "BEVEL": _bevel,
 }

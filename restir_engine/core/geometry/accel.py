@@ -111,7 +111,7 @@ class Accel:
             live = np.flatnonzero(hits.prim >= 0)
             if live.size == 0:
                 return
-            go = live[~self.cutout.opaque(hits.prim[live], hits.u[live], hits.v[live])]
+            go = live[~self.cutout.opaque(hits.prim[live], hits.u[live], hits.v[live], cols(d, live))]
             if go.size == 0:
                 return
             t = hits.t[go]

@@ -77,6 +77,7 @@ def updated_context(last: TraceContext, scene, rows: np.ndarray, max_bounces: in
         still = Accel(geom.verts[still_rows])
     derived = updated_derived(last.geom_derived, geom, rows)
     cut = old.cutout
+    cut = None if cut is None else cut.with_geometry(geom)
     accel = SplitAccel(still, still_rows, geom.verts[moving], moving, cut, derived.ng_rows if cut else None)
     lights, emit_accel = moved_lights(last, scene, rows, derived)
     return dataclasses.replace(last, scene=scene, geom_accel=accel, lights=lights, emit_accel=emit_accel,

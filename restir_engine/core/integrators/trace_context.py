@@ -192,6 +192,7 @@ def moved_context(base: TraceContext, scene: Scene, rows: np.ndarray, still: tup
     if still is None:
         still = _still_part(base, rows)
     cut = base.geom_accel.cutout
+    cut = None if cut is None else cut.with_geometry(geom)
     accel = SplitAccel(still[0], still[1], geom.verts[rows], rows, cut, derived.ng_rows if cut else None)
     lights, emit_accel = moved_lights(base, scene, rows, derived)
     return dataclasses.replace(base, scene=scene, geom_accel=accel, lights=lights, emit_accel=emit_accel,

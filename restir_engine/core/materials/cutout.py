@@ -2,17 +2,19 @@
 Transparent BSDF), for camera, shadow and bounce rays alike.
 
 A hit on a cut-out material is opaque with probability α (the material's constant alpha, times an image texture's
-value t or 1 - t at the hit's UV) and otherwise the ray continues behind it. The decision is a hash of the hit
-(triangle and barycentrics, salted apart from the Mix pick), so every ray that reaches the same point agrees (a
-shadow ray is blocked exactly where a camera ray would stop), and over the points of a pixel the surface covers a
-fraction α of them: Cycles' transparency of a white Transparent BSDF, on average.
+value t or 1 - t at the hit's UV, times its node program's "alpha" at the hit) and otherwise the ray continues
+behind it. The decision is a hash of the hit (triangle and barycentrics, salted apart from the Mix pick), so every
+ray that reaches the same point agrees (a shadow ray is blocked exactly where a camera ray would stop), and over the
+points of a pixel the surface covers a fraction α of them: Cycles' transparency of a white Transparent BSDF, on
+average.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..sampling import barycentric
+from ..sampling import barycentric, norm
 from .mix import hash_uniform
+from .nodes import HitAttributes, run_programs
 from .textures import sample
 
 SALT = 0x5BD1E995
@@ -20,16 +22,19 @@ SALT = 0x5BD1E995
 
 class Cutout:
     """Which hits of a triangle set are opaque. ``geometry`` (scene.TriangleSet), ``materials`` (MaterialTable with
-    alpha, alpha_tex, alpha_sign)."""
+    alpha, alpha_tex, alpha_sign, alpha_program)."""
 
     def __init__(self, geometry, materials):
         mat = geometry.material
         self.alpha = materials.alpha[mat].astype(np.float32)
         self.tex = materials.alpha_tex[mat]
         self.sign = materials.alpha_sign[mat]
-        self.cut = (self.alpha < 1) | (self.tex >= 0)
+        programs = getattr(materials, "alpha_program", None)
+        self.program = programs[mat] if programs is not None else np.zeros(len(mat), bool)
+        self.cut = (self.alpha < 1) | (self.tex >= 0) | self.program
         self.uvs = geometry.uvs
         self.textures = materials.textures
+        self.geometry, self.materials = geometry, materials
 
     @staticmethod
     def of(geometry, materials) -> "Cutout | None":
@@ -37,13 +42,23 @@ class Cutout:
         a = getattr(materials, "alpha", None)
         if a is None or len(geometry) == 0:
             return None
-        if not ((a < 1).any() or (materials.alpha_tex >= 0).any()):
+        programs = getattr(materials, "alpha_program", None)
+        if not ((a < 1).any() or (materials.alpha_tex >= 0).any() or (programs is not None and programs.any())):
             return None
         c = Cutout(geometry, materials)
         return c if c.cut.any() else None
 
-    def opaque(self, prim: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """(n,) bool for hits (prim >= 0) at barycentrics (u, v)."""
+    def with_geometry(self, geometry) -> "Cutout":
+        """The same test on ``geometry``, the same triangles with moved corners (node programs read its positions
+        and normals)."""
+        import copy
+        out = copy.copy(self)
+        out.geometry = geometry
+        return out
+
+    def opaque(self, prim: np.ndarray, u: np.ndarray, v: np.ndarray, d: np.ndarray | None = None) -> np.ndarray:
+        """(n,) bool for hits (prim >= 0) at barycentrics (u, v) of rays along ``d`` (3, n) (node programs read
+        the view from it: Backfacing, Incoming; None: unknown)."""
         out = np.ones(len(prim), bool)
         sel = np.flatnonzero(self.cut[prim])
         if sel.size == 0:
@@ -58,6 +73,22 @@ class Cutout:
                 uv = barycentric(c[:, 0], c[:, 1], c[:, 2], u[sel][rows][:, None], v[sel][rows][:, None])
                 val = np.clip(sample(self.textures[t], uv)[:, 0], 0, 1)
                 a[rows] *= np.where(self.sign[p[rows]] > 0, val, 1 - val)
+        rows = np.flatnonzero(self.program[p])
+        if rows.size:
+            a[rows] *= self._program_alpha(p[rows], u[sel][rows], v[sel][rows], None if d is None else d[:, sel][:, rows])
         xi = hash_uniform(p ^ SALT, u[sel], v[sel])
         out[sel] = xi < a
+        return out
+
+    def _program_alpha(self, prim, u, v, d) -> np.ndarray:
+        """The node programs' "alpha" (clamped to [0, 1]) at hits on materials that have one."""
+        wo = None if d is None else (-d / np.maximum(norm(d), np.float32(1e-30))).astype(np.float32)
+        out = np.ones(len(prim), np.float32)
+
+        def attrs(r):
+            return HitAttributes(self.geometry, prim[r], u[r], v[r], self.textures,
+                                 wo=None if wo is None else wo[:, r])
+        for r, got in run_programs(self.materials, self.geometry.material[prim], attrs, ("alpha",)):
+            if "alpha" in got:
+                out[r] = np.clip(got["alpha"], 0, 1)
         return out

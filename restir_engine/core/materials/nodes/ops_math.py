@@ -376,4 +376,5 @@ OPERATIONS = {
     "add": lambda attrs, params, a, b: f32(f32(a) + f32(b)),
     "one_minus": lambda attrs, params, a: f32(1 - f32(a)),
     "saturate": lambda attrs, params, a: f32(np.clip(f32(a), 0, 1)),
+    "reciprocal": lambda attrs, params, a: f32(1 / np.maximum(f32(a), np.float32(1e-6))),
 }

@@ -1,0 +1,247 @@
+"""Shader nodes inside node groups, and transparency from any node graph, as third-party files build them (the glTF
+add-on's materials: a Principled BSDF inside a group, an alpha cut-off by Math nodes, a Mix with a Transparent BSDF
+by Backfacing for single-sided surfaces).
+
+Statistics: a cut-out pixel is a Bernoulli draw per sample (the surface is there with probability α at each point),
+so a column of H pixels at N samples has mean 1 - α(x) (a white world behind a black surface) with standard error
+sqrt(α(1 - α) / (N H)); columns are checked at 5 standard errors (0.005 % false alarms per column)."""
+import math
+
+import bpy
+import numpy as np
+from bpy_scenes import _with_uvs, render_passes
+from harness.render import configure_restir
+from harness.scenes import camera, enable_nodes, plane, reset
+
+from restir_engine.export import export_scene
+
+N, W, H = 64, 32, 8
+
+
+def _white_world(scene):
+    world = bpy.data.worlds.new("White")
+    enable_nodes(world)
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1, 1, 1, 1)
+    scene.world = world
+
+
+def _facing_plane(build, back=False):
+    """A plane of the material ``build()`` makes, filling an orthographic camera's W x H view (seen from the front,
+    or from behind), in front of a white world."""
+    scene = reset()
+    _white_world(scene)
+    material = build()
+    _with_uvs(plane("Sheet", 1.0, (0, 0, 0), material=material, scale=(1.0, H / W, 1.0)))
+    if back:
+        camera((0, 0, -5), (math.pi, 0, 0), ortho_scale=1.0)
+    else:
+        camera((0, 0, 5), (0, 0, 0), ortho_scale=1.0)
+    scene.render.resolution_x, scene.render.resolution_y = W, H
+    configure_restir(scene, N, 1, seed=3, integrator="PATH")
+    return scene
+
+
+def _gradient(tree):
+    """A Gradient Texture's Fac over Generated coordinates: x from 0 to 1 across the plane."""
+    g = tree.nodes.new("ShaderNodeTexGradient")
+    return g.outputs["Fac"]
+
+
+def _black_principled(tree):
+    b = tree.nodes["Principled BSDF"]
+    b.inputs["Base Color"].default_value = (0, 0, 0, 1)
+    b.inputs["Specular IOR Level"].default_value = 0.0
+    return b
+
+
+def _column_check(img, opacity):
+    """Each column's mean against 1 - opacity(x) at 5 standard errors (the world is white behind)."""
+    x = (np.arange(W) + 0.5) / W
+    a = opacity(x)
+    got = img[..., :3].mean(axis=(0, 2))
+    se = np.sqrt(np.maximum(a * (1 - a), 1e-4) / (N * H))
+    z = (got - (1 - a)) / se
+    assert np.abs(z).max() < 5.0, (np.round(got, 3), np.round(1 - a, 3))
+
+
+def test_principled_alpha_from_a_graph_is_a_cut_out_per_hit(addon):
+    """Alpha = Gradient (x across the plane): the plane's opacity follows x; before, a graph on Alpha was folded to
+    the socket's value (opaque), 1 - α = 0 everywhere, a z of about 50 at mid-plane."""
+    def build():
+        mat = bpy.data.materials.new("Ramp")
+        enable_nodes(mat)
+        t = mat.node_tree
+        b = _black_principled(t)
+        t.links.new(_gradient(t), b.inputs["Alpha"])
+        return mat
+    scene = _facing_plane(build)
+    _column_check(render_passes(scene)["Combined"], lambda x: x)
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    i = sc.materials.names.index("Ramp")
+    assert sc.materials.alpha_program[i] and "alpha" in sc.materials.programs[sc.materials.program[i]].outputs
+
+
+def test_transparent_mix_by_a_varying_factor_and_alpha_in_mixes(addon):
+    """Mix(Fac = x², Principled (Alpha 0.5, black), Transparent): opacity (1 - x²) x 0.5, the Principled's own
+    alpha joining the Transparent BSDF's share."""
+    scene = _facing_plane(_veil)
+    _column_check(render_passes(scene)["Combined"], lambda x: (1 - x * x) * 0.5)
+
+
+def _veil():
+    mat = bpy.data.materials.new("Veil")
+    enable_nodes(mat)
+    t = mat.node_tree
+    b = _black_principled(t)
+    b.inputs["Alpha"].default_value = 0.5
+    sq = t.nodes.new("ShaderNodeMath")
+    sq.operation = "POWER"
+    t.links.new(_gradient(t), sq.inputs[0])
+    sq.inputs[1].default_value = 2.0
+    mix = t.nodes.new("ShaderNodeMixShader")
+    clear = t.nodes.new("ShaderNodeBsdfTransparent")
+    t.links.new(sq.outputs[0], mix.inputs["Fac"])
+    t.links.new(b.outputs[0], mix.inputs[1])
+    t.links.new(clear.outputs[0], mix.inputs[2])
+    t.links.new(mix.outputs[0], t.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def test_constant_alpha_inside_a_mix_is_transparent_share(addon):
+    """Add(Principled Alpha 0.3, Volume Absorption): as Cycles, the volume adds nothing to the surface and the
+    Principled's alpha makes it 70 % see-through (before: rendered opaque with a warning)."""
+    scene = _facing_plane(_thin)
+    _column_check(render_passes(scene)["Combined"], lambda x: np.full_like(x, 0.3))
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    assert not [w for w in sc.warnings if "Thin" in w]
+
+
+def _thin():
+    mat = bpy.data.materials.new("Thin")
+    enable_nodes(mat)
+    t = mat.node_tree
+    b = _black_principled(t)
+    b.inputs["Alpha"].default_value = 0.3
+    vol = t.nodes.new("ShaderNodeVolumeAbsorption")
+    add = t.nodes.new("ShaderNodeAddShader")
+    t.links.new(b.outputs[0], add.inputs[0])
+    t.links.new(vol.outputs[0], add.inputs[1])
+    t.links.new(add.outputs[0], t.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def _single_sided():
+    """The glTF add-on's single-sided material: Mix(Fac = Backfacing, red Emission, Transparent)."""
+    mat = bpy.data.materials.new("OneSided")
+    enable_nodes(mat)
+    t = mat.node_tree
+    t.nodes.remove(t.nodes["Principled BSDF"])
+    geo = t.nodes.new("ShaderNodeNewGeometry")
+    red = t.nodes.new("ShaderNodeEmission")
+    red.inputs["Color"].default_value = (1, 0, 0, 1)
+    clear = t.nodes.new("ShaderNodeBsdfTransparent")
+    mix = t.nodes.new("ShaderNodeMixShader")
+    t.links.new(geo.outputs["Backfacing"], mix.inputs["Fac"])
+    t.links.new(red.outputs[0], mix.inputs[1])
+    t.links.new(clear.outputs[0], mix.inputs[2])
+    t.links.new(mix.outputs[0], t.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def test_backfacing_transparency_shows_one_side(addon):
+    """From the front the plane is red emission; from behind it is not there (the white world)."""
+    front = render_passes(_facing_plane(_single_sided))["Combined"][..., :3].mean(axis=(0, 1))
+    np.testing.assert_allclose(front, (1, 0, 0), atol=1e-4)
+    back = render_passes(_facing_plane(_single_sided, back=True))["Combined"][..., :3].mean(axis=(0, 1))
+    np.testing.assert_allclose(back, (1, 1, 1), atol=1e-4)
+
+
+def _grouped_material(name):
+    """A Principled BSDF inside a node group: Base Color from a Checker outside (through a group input and a
+    reroute inside), Roughness typed on the group node, Metallic set inside, Alpha from a Gradient outside; the
+    group's output reaches the Material Output through a reroute."""
+    grp = bpy.data.node_groups.new(f"{name}Group", "ShaderNodeTree")
+    grp.interface.new_socket("Color", in_out="INPUT", socket_type="NodeSocketColor")
+    grp.interface.new_socket("Rough", in_out="INPUT", socket_type="NodeSocketFloat")
+    grp.interface.new_socket("Alpha", in_out="INPUT", socket_type="NodeSocketFloat")
+    grp.interface.new_socket("BSDF", in_out="OUTPUT", socket_type="NodeSocketShader")
+    gi, go = grp.nodes.new("NodeGroupInput"), grp.nodes.new("NodeGroupOutput")
+    p = grp.nodes.new("ShaderNodeBsdfPrincipled")
+    p.inputs["Metallic"].default_value = 0.7
+    rr = grp.nodes.new("NodeReroute")
+    grp.links.new(gi.outputs["Color"], rr.inputs[0])
+    grp.links.new(rr.outputs[0], p.inputs["Base Color"])
+    grp.links.new(gi.outputs["Rough"], p.inputs["Roughness"])
+    grp.links.new(gi.outputs["Alpha"], p.inputs["Alpha"])
+    grp.links.new(p.outputs[0], go.inputs["BSDF"])
+    mat = bpy.data.materials.new(name)
+    enable_nodes(mat)
+    t = mat.node_tree
+    t.nodes.remove(t.nodes["Principled BSDF"])
+    node = t.nodes.new("ShaderNodeGroup")
+    node.node_tree = grp
+    node.inputs["Rough"].default_value = 0.3
+    chk = t.nodes.new("ShaderNodeTexChecker")
+    chk.inputs["Color1"].default_value = (0.9, 0.1, 0.1, 1)
+    chk.inputs["Color2"].default_value = (0.1, 0.2, 0.9, 1)
+    t.links.new(chk.outputs["Color"], node.inputs["Color"])
+    t.links.new(_gradient(t), node.inputs["Alpha"])
+    out_rr = t.nodes.new("NodeReroute")
+    t.links.new(node.outputs[0], out_rr.inputs[0])
+    t.links.new(out_rr.outputs[0], t.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def _flat_material(name):
+    """The same material without the group."""
+    mat = bpy.data.materials.new(name)
+    enable_nodes(mat)
+    t = mat.node_tree
+    p = t.nodes["Principled BSDF"]
+    p.inputs["Metallic"].default_value = 0.7
+    p.inputs["Roughness"].default_value = 0.3
+    chk = t.nodes.new("ShaderNodeTexChecker")
+    chk.inputs["Color1"].default_value = (0.9, 0.1, 0.1, 1)
+    chk.inputs["Color2"].default_value = (0.1, 0.2, 0.9, 1)
+    t.links.new(chk.outputs["Color"], p.inputs["Base Color"])
+    t.links.new(_gradient(t), p.inputs["Alpha"])
+    return mat
+
+
+def test_shader_node_group_renders_as_its_flat_graph(addon):
+    """The grouped material and its flat twin give the same image, bit for bit at the same seed (before: the group
+    was 'not supported' and rendered in the viewport colour), and the same rows and program outputs."""
+    images, rows = [], []
+    for build in (_flat_material, _grouped_material):
+        scene = _facing_plane(lambda: build("Lacquer"))
+        images.append(render_passes(scene)["Combined"])
+        sc = export_scene(bpy.context.evaluated_depsgraph_get())
+        i = sc.materials.names.index("Lacquer")
+        rows.append((float(sc.materials.metallic[i]), float(sc.materials.roughness[i]),
+                     sorted(sc.materials.programs[sc.materials.program[i]].outputs), bool(sc.materials.alpha_program[i])))
+        assert not [w for w in sc.warnings if "Lacquer" in w], sc.warnings
+    assert rows[0] == rows[1]
+    assert abs(rows[0][0] - 0.7) < 1e-6 and abs(rows[0][1] - 0.3) < 1e-6 and rows[0][2] == ["alpha", "base_color"]
+    np.testing.assert_array_equal(images[0], images[1])
+    assert images[0][..., :3].std() > 0.05  # a pattern, not a flat colour
+
+
+def test_ambient_occlusion_passes_its_colour_through(addon):
+    """Ambient Occlusion (no rays from node programs here) is taken as unoccluded: its Color output is its Color
+    input, named in a warning (before: a constant black)."""
+    def build():
+        mat = bpy.data.materials.new("Occluded")
+        enable_nodes(mat)
+        t = mat.node_tree
+        t.nodes.remove(t.nodes["Principled BSDF"])
+        e = t.nodes.new("ShaderNodeEmission")
+        ao = t.nodes.new("ShaderNodeAmbientOcclusion")
+        ao.inputs["Color"].default_value = (0.2, 0.5, 0.7, 1)
+        t.links.new(ao.outputs["Color"], e.inputs["Color"])
+        t.links.new(e.outputs[0], t.nodes["Material Output"].inputs["Surface"])
+        return mat
+    _facing_plane(build)
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    i = sc.materials.names.index("Occluded")
+    np.testing.assert_allclose(sc.materials.emission[i], (0.2, 0.5, 0.7), atol=1e-6)
+    assert any("Ambient Occlusion" in w and "unoccluded" in w for w in sc.warnings)
