@@ -170,6 +170,9 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
         else:
             warnings.append(f"Light '{obj.name}': type {light.type} is not supported")
             continue
+        if not getattr(light, "normalize", True):
+            # Normalize off (Blender 4.2+): the power is not spread over the light's surface, as Cycles reads it
+            radiance = power / np.pi
         mat = registry.add_row({"name": f"(light {obj.name})", "base_color": (0, 0, 0), "f0": 0.0,
                                 "emission": tuple(radiance), "two_sided_emission": False})
         parts.append((world.astype(np.float32), mat, spot, visible, sphere, groups.get(getattr(obj, "lightgroup", ""),

@@ -21,6 +21,12 @@ from .node_graph import GraphCompiler
 
 
 
+#: The Sheen BSDF's albedo under a uniform white world, averaged over view directions with weight cos θ (the lobe's
+#: share of the light it receives), at roughness SHEEN_ROUGHNESS, measured from Cycles (Blender 5.2, one bounce)
+SHEEN_ROUGHNESS = (0.0, 0.1, 0.3, 0.5, 0.75, 1.0)
+SHEEN_ALBEDO = {"MICROFIBER": (0.0, 0.00003, 0.0178, 0.0967, 0.260, 0.434),
+                "ASHIKHMIN": (0.0, 0.0006, 0.0499, 0.156, 0.304, 0.434)}
+
 #: a Holdout shader: black and emitting nothing; camera rays that meet it leave the pixel transparent (alpha 0)
 HOLDOUT_ROW = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "metallic": 0.0, "holdout": True}
 
@@ -342,6 +348,8 @@ class MaterialRegistry(MixShaderReader, TextureReader):
             return self._with_program(row, g, varying)
         if t == "BSDF_TRANSLUCENT":
             return self._translucent(material, node)
+        if t == "BSDF_SHEEN":
+            return self._sheen(material, node)
         if t in {"MIX_SHADER", "ADD_SHADER"}:
             return self._mix(material, node, depth)
         if t.startswith("VOLUME_") or t == "PRINCIPLED_VOLUME":  # as Cycles: volume closures add nothing to a surface
@@ -349,6 +357,24 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         self._warn(material, f"shader '{node.name}' ({t}) is not supported; approximated by the viewport colour")
         return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                 "roughness": float(material.roughness), "f0": 0.04}
+
+    def _sheen(self, material, node) -> dict:
+        """A Sheen BSDF, approximated (named in a warning) by a Lambertian of its Color times the lobe's albedo
+        averaged over the hemisphere (cosine-weighted, by roughness: :data:`SHEEN_ALBEDO`): the right amount of
+        light, spread evenly instead of toward grazing angles."""
+        self._warn(material, f"'{node.name}' (Sheen BSDF) is approximated by a diffuse of its average reflectance")
+        rough = float(np.clip(self._float_input(material, node.inputs["Roughness"]), 0, 1))
+        table = SHEEN_ALBEDO.get(getattr(node, "distribution", "MICROFIBER"), SHEEN_ALBEDO["MICROFIBER"])
+        albedo = float(np.interp(rough, SHEEN_ROUGHNESS, table))
+        g, varying = self._compiler(material), {}
+        colour = g.emit("scale", {}, [g.value(node.inputs["Color"], "color"), g.constant(albedo, "float")],
+                        ("color",))[0]
+        row = {"f0": 0.0, "metallic": 0.0, "base_color": (1.0, 1.0, 1.0)}
+        if colour.const is not None:
+            row["base_color"] = colour.constant_value()
+        else:
+            varying["base_color"] = colour
+        return self._with_program(row, g, varying)
 
     def _translucent(self, material, node) -> dict:
         """A Translucent BSDF: Lambertian transmission as Cycles, Color/π on the side away from the viewer, none

@@ -82,3 +82,34 @@ def test_light_falloff(addon, output):
     np.testing.assert_allclose(got, np.array([10.0, 5.0, 2.5]) * np.array(em.inputs["Color"].default_value[:3]) * 4,
                                rtol=1e-6)
     assert bool(warns) == (output != "Quadratic")
+
+
+@pytest.mark.parametrize("kind", ["POINT", "SPOT", "AREA_DISK", "AREA_RECTANGLE"])
+def test_normalize_off_does_not_spread_the_power_over_the_light(addon, kind):
+    """Light > Normalize off (Blender 4.2+): Cycles does not divide the power by the light's surface, so the
+    radiance is the normalized one times the area (measured with Cycles 5.2 on a lit cube: 4πr² for point lights at
+    r = 0.05, 0.2 and 0.5, the disk's and the rectangle's area for area lights). Before, Normalize was ignored (a
+    ratio of 1)."""
+    from harness.scenes import camera, reset
+
+    from restir_engine.export import export_scene
+    reset()
+    camera((0, -5, 0), (np.pi / 2, 0, 0))
+    light = bpy.data.lights.new("Probe", kind.split("_")[0])
+    if kind.startswith("AREA"):
+        light.shape = kind.split("_")[1]
+        light.size, light.size_y = 0.7, 2.0
+        # the world-space area, with the object's scale (1, 1.5, 1) below
+        area = np.pi * 0.35 * 0.35 * 1.5 if light.shape == "DISK" else 0.7 * 2.0 * 1.5
+    else:
+        light.shadow_soft_size = 0.2
+        area = 4 * np.pi * 0.2 ** 2
+    obj = bpy.data.objects.new("Probe", light)
+    obj.scale = (1.0, 1.5, 1.0) if kind.startswith("AREA") else (1, 1, 1)
+    bpy.context.scene.collection.objects.link(obj)
+    radiance = []
+    for normalize in (True, False):
+        light.normalize = normalize
+        sc = export_scene(bpy.context.evaluated_depsgraph_get())
+        radiance.append(sc.materials.emission[sc.materials.names.index("(light Probe)")])
+    np.testing.assert_allclose(radiance[1], radiance[0] * area, rtol=1e-4)
