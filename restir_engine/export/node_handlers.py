@@ -77,6 +77,9 @@ def _attribute(g, node, f):
     if node.attribute_type != "GEOMETRY":
         return None
     name = node.attribute_name
+    if not name:  # as Cycles: an Attribute node without a name finds nothing and gives 0 on every output
+        zero = g.constant(0.0, "float")
+        return {"Color": g.constant(0.0, "color"), "Vector": g.constant(0.0, "vector"), "Fac": zero, "Alpha": zero}
     col = g.attribute(f"attr:{name}", "color")
     return {"Color": col, "Vector": Reg(col.index, "vector", col.const), "Fac": g.convert(Reg(col.index, "vector"),
                                                                                           "float"),

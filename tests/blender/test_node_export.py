@@ -64,3 +64,16 @@ def test_node_programs_render_the_same_in_worker_processes(addon):
     assert two.stats["processes"] == 2
     assert one.passes["Combined"][..., :3].mean() > 0.05
     assert np.array_equal(one.passes["Combined"], two.passes["Combined"])
+
+
+def test_attribute_node_without_a_name_gives_zero(addon):
+    """As Cycles (the glTF add-on's test files have such nodes): an Attribute node whose name is empty finds no
+    attribute, so its Color is black (before: the mesh's first colour attribute was read)."""
+    def wire(tree, bsdf):
+        a = _node(tree, "ShaderNodeAttribute")
+        a.attribute_name = ""
+        tree.links.new(a.outputs["Color"], bsdf.inputs["Base Color"])
+    sc, _ = _principled_plane(wire)
+    i = sc.materials.names.index("Wired")
+    np.testing.assert_array_equal(sc.materials.base_color[i], (0, 0, 0))
+    assert sc.materials.program[i] == -1
