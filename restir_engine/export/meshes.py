@@ -235,44 +235,47 @@ def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None
         materials = slot_materials(obj)
         mats_key = (key, tuple(m.name_full if m else "" for m in materials))
         if mats_key not in slot_cache:
-            slot_cache[mats_key] = np.array([registry.material_index(m) for m in materials] or [0], np.int32)
+            index = np.array([registry.material_index(m) for m in materials] or [0], np.int32)
+            # what the materials read of the mesh (objects sharing a mesh may link different materials)
+            slot_cache[mats_key] = (index, (registry.uses_textures(index), registry.uses_normal_maps(index),
+                                            frozenset(registry.attribute_names(index))))
+        slot_index, wants = slot_cache[mats_key]
         slots_seen.append(mats_key[1])
-        if key not in cache:
-            want_uv = registry.uses_textures(slot_cache[mats_key])
-            want_tangents = registry.uses_normal_maps(slot_cache[mats_key])
-            want_attrs = frozenset(registry.attribute_names(slot_cache[mats_key]))
+        read_key = (key, wants)
+        if read_key not in cache:
+            want_uv, want_tangents, want_attrs = wants
             # the name guards against a freed mesh's address reused by another one
             kept = (key, data.name_full if data is not None else obj.name_full, want_uv, want_tangents, want_attrs)
             if mesh_cache is not None and kept in mesh_cache:
-                cache[key] = mesh_cache[kept]
+                cache[read_key] = mesh_cache[kept]
             elif obj.type == "POINTCLOUD":
-                cache[key] = read_points(data) if data is not None else None
+                cache[read_key] = read_points(data) if data is not None else None
                 reads += 1
-                if cache[key] is not None:
+                if cache[read_key] is not None:
                     warnings.append(f"Point cloud '{obj.name}': {len(data.points)} points rendered as spheres of "
-                                    f"{cache[key]['triangles_per_point']} triangles each (Cycles traces exact "
+                                    f"{cache[read_key]['triangles_per_point']} triangles each (Cycles traces exact "
                                     "spheres)")
                 if mesh_cache is not None:
-                    mesh_cache[kept] = cache[key]
+                    mesh_cache[kept] = cache[read_key]
             else:
                 try:
                     mesh = obj.to_mesh()
                 except RuntimeError:
                     mesh = None
                 if mesh is None:
-                    cache[key] = None
+                    cache[read_key] = None
                     continue
                 try:
-                    cache[key] = _read_mesh(mesh, want_uv, want_tangents, warnings, want_attrs)
+                    cache[read_key] = _read_mesh(mesh, want_uv, want_tangents, warnings, want_attrs)
                     reads += 1
                 finally:
                     obj.to_mesh_clear()
                 if mesh_cache is not None:
-                    mesh_cache[kept] = cache[key]
-        arrays = cache[key]
+                    mesh_cache[kept] = cache[read_key]
+        arrays = cache[read_key]
         if arrays is None:
             continue
-        blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_cache[mats_key], obj.name,
+        blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_index, obj.name,
                        instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, asset_name(obj),
                                                          bool(getattr(obj, "is_holdout", False)),
                                                          float(getattr(obj, "pass_index", 0)),

@@ -50,8 +50,10 @@ def _light_path(g, node, f):
 
 
 def _uvmap(g, node, f):
+    """The render UV map, or the one the node names (read as the mesh's corner attribute of that name: (u, v, 0);
+    0 where a mesh has no such map, as Cycles)."""
     if node.uv_map:
-        g.warn(f"'{node.name}' names UV map '{node.uv_map}'; the render UV map is used")
+        return {"UV": g.attribute(f"attr:{node.uv_map}", "vector")}
     return {"UV": g.attribute("uv", "vector")}
 
 

@@ -77,3 +77,56 @@ def test_attribute_node_without_a_name_gives_zero(addon):
     i = sc.materials.names.index("Wired")
     np.testing.assert_array_equal(sc.materials.base_color[i], (0, 0, 0))
     assert sc.materials.program[i] == -1
+
+
+def test_uv_map_node_reads_the_map_it_names(addon):
+    """A UV Map node naming a second UV map (the glTF importer's texCoord indices) reads that map: here the first map
+    mirrored in u, so a Gradient through it runs right to left (before: the render UV map, left to right)."""
+    from bpy_scenes import render_passes
+    from harness.render import configure_restir
+
+    def graph(tree, socket):
+        uv = _node(tree, "ShaderNodeUVMap")
+        uv.uv_map = "Mirrored"
+        grad = _node(tree, "ShaderNodeTexGradient")
+        tree.links.new(uv.outputs["UV"], grad.inputs["Vector"])
+        tree.links.new(grad.outputs["Color"], socket)
+
+    def setup(obj):
+        layer = obj.data.uv_layers.new(name="Mirrored")
+        layer.data.foreach_set("uv", np.array([1, 0, 0, 0, 0, 1, 1, 1], np.float32))
+        obj.data.uv_layers["UVMap"].active_render = True
+    graph.setup = setup
+    scene = node_planes([graph], 1, 16)
+    configure_restir(scene, 4, 1, seed=1, integrator="PATH")
+    img = render_passes(scene)["Combined"][..., 0].mean(axis=0)
+    x = (np.arange(16) + 0.5) / 16
+    np.testing.assert_allclose(img, 1 - x, atol=1 / 16)
+
+
+def test_objects_sharing_a_mesh_read_what_their_own_materials_need(addon):
+    """Two objects of one mesh with object-linked materials: the second one's colour attribute is read although the
+    first object's material reads none (before: the mesh was read once, for the first object)."""
+    def wire(tree, bsdf):
+        pass
+    sc, _ = _principled_plane(wire)
+    first = bpy.data.objects["NodesPlane0"]
+    attr = first.data.color_attributes.new("Col", "FLOAT_COLOR", "POINT")
+    attr.data.foreach_set("color", np.tile([0.1, 0.7, 0.3, 1.0], 4).astype(np.float32))
+    second = bpy.data.objects.new("SharedPlane", first.data)
+    bpy.context.scene.collection.objects.link(second)
+    second.location.x += 0.1
+    mat = bpy.data.materials.new("ByAttribute")
+    mat.use_nodes = True
+    t = mat.node_tree
+    ca = _node(t, "ShaderNodeVertexColor")
+    ca.layer_name = "Col"
+    t.links.new(ca.outputs["Color"], t.nodes["Principled BSDF"].inputs["Base Color"])
+    second.material_slots[0].link = "OBJECT"
+    second.material_slots[0].material = mat
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    i = sc.materials.names.index("ByAttribute")
+    rows = np.flatnonzero(sc.geometry.material == i)
+    assert len(rows) == 2
+    np.testing.assert_allclose(sc.geometry.attributes["Col"][rows][..., :3], np.tile([0.1, 0.7, 0.3], (2, 3, 1)),
+                               atol=1e-6)
