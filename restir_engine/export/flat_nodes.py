@@ -33,6 +33,20 @@ class FlatTree:
         return got
 
 
+def cycles_output(tree, node_type: str):
+    """The output node of type ``node_type`` ("OUTPUT_MATERIAL", "OUTPUT_WORLD", "OUTPUT_LIGHT") that Cycles renders:
+    one whose target is Cycles rather than All, then the active one; never an EEVEE-only output. None if there is
+    none."""
+    best = None
+    for node in tree.nodes:
+        if node.type != node_type or getattr(node, "target", "ALL") not in {"ALL", "CYCLES"}:
+            continue
+        key = (getattr(node, "target", "ALL") == "CYCLES", bool(getattr(node, "is_active_output", False)))
+        if best is None or key > best[0]:
+            best = (key, node)
+    return None if best is None else best[1]
+
+
 def flat_output(material_output) -> "FlatNode":
     """The proxy of a material's (or world's, or light's) output node, the root the shader readers start from."""
     return FlatTree().node(material_output)

@@ -77,8 +77,9 @@ def _light_node_scale(light, warnings: list, name: str):
     tree = light.node_tree
     if tree is None or not getattr(light, "use_nodes", True):
         return np.ones(3)
-    outs = [n for n in tree.nodes if n.type == "OUTPUT_LIGHT" and n.is_active_output] or \
-           [n for n in tree.nodes if n.type == "OUTPUT_LIGHT"]
+    from .flat_nodes import cycles_output, flat_output
+    out = cycles_output(tree, "OUTPUT_LIGHT")
+    outs = [flat_output(out)] if out is not None else []
     if not outs or not outs[0].inputs["Surface"].is_linked:
         return np.zeros(3)
     node = outs[0].inputs["Surface"].links[0].from_node

@@ -13,7 +13,7 @@ import numpy as np
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
 from .coat import coat_set
-from .flat_nodes import FlatTree, flat_output
+from .flat_nodes import FlatTree, cycles_output, flat_output
 from .limits import clamped_radiance
 from .material_textures import TextureReader
 from .mix_shaders import MixShaderReader
@@ -120,9 +120,8 @@ class MaterialRegistry(MixShaderReader, TextureReader):
             return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                     "roughness": float(material.roughness), "f0": 0.04}
         tree = material.node_tree
-        outs = [n for n in tree.nodes if n.type == "OUTPUT_MATERIAL" and n.is_active_output
-                and n.target in {"ALL", "CYCLES"}] or [n for n in tree.nodes if n.type == "OUTPUT_MATERIAL"]
-        outs = [flat_output(outs[0])] if outs else []
+        out = cycles_output(tree, "OUTPUT_MATERIAL")
+        outs = [flat_output(out)] if out is not None else []
         if not outs or not outs[0].inputs["Surface"].is_linked:
             volume_too = bool(outs) and "Volume" in outs[0].inputs and outs[0].inputs["Volume"].is_linked
             self._warn(material, "no surface shader connected to the Material Output; rendered black" +

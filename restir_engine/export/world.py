@@ -35,8 +35,9 @@ def _export_world(scene, warnings: list):
     if not uses_nodes(world):
         return np.array(world.color[:3], np.float32), None, None
     tree = world.node_tree
-    outputs = [n for n in tree.nodes if n.type == "OUTPUT_WORLD" and n.is_active_output] or \
-              [n for n in tree.nodes if n.type == "OUTPUT_WORLD"]
+    from .flat_nodes import cycles_output, flat_output
+    out = cycles_output(tree, "OUTPUT_WORLD")
+    outputs = [flat_output(out)] if out is not None else []
     if not outputs or not outputs[0].inputs["Surface"].is_linked:
         return none
     node = outputs[0].inputs["Surface"].links[0].from_node

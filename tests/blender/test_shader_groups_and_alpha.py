@@ -270,3 +270,28 @@ def test_sheen_bsdf_is_named_and_reflects_its_average(addon):
     np.testing.assert_allclose(sc.materials.base_color[i], np.array([0.9, 0.3, 0.6]) * albedo, rtol=1e-5)
     assert float(sc.materials.metallic[i]) == 0 and float(sc.materials.f0[i]) == 0
     assert any("Sheen BSDF" in w and "approximated" in w for w in sc.warnings)
+
+
+def test_the_output_cycles_renders_is_used(addon):
+    """A material with an active EEVEE-only output and an inactive Cycles output renders the Cycles one, as Cycles
+    does (the glTF add-on's test files carry such pairs; before: the EEVEE output's shader was used)."""
+    def build():
+        mat = bpy.data.materials.new("TwoOutputs")
+        enable_nodes(mat)
+        t = mat.node_tree
+        t.nodes.remove(t.nodes["Principled BSDF"])
+        eevee = t.nodes["Material Output"]
+        eevee.target = "EEVEE"
+        red, green = t.nodes.new("ShaderNodeEmission"), t.nodes.new("ShaderNodeEmission")
+        red.inputs["Color"].default_value = (1, 0, 0, 1)
+        green.inputs["Color"].default_value = (0, 1, 0, 1)
+        t.links.new(red.outputs[0], eevee.inputs["Surface"])
+        cycles = t.nodes.new("ShaderNodeOutputMaterial")
+        cycles.target = "CYCLES"
+        t.links.new(green.outputs[0], cycles.inputs["Surface"])
+        eevee.is_active_output = True
+        return mat
+    _facing_plane(build)
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    i = sc.materials.names.index("TwoOutputs")
+    np.testing.assert_allclose(sc.materials.emission[i], (0, 1, 0), atol=1e-6)
