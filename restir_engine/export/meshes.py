@@ -39,8 +39,15 @@ def _read_mesh(mesh, want_uv: bool, want_tangents: bool = False, warnings: list 
     tris.foreach_get("loops", loops)
     nrm = np.empty(nt * 9, np.float32)
     try:
-        tris.foreach_get("split_normals", nrm)
-        nrm = nrm.reshape(nt, 3, 3)
+        if getattr(mesh, "normals_domain", "CORNER") == "FACE":
+            # every face flat: the triangles' own normals, as Cycles shades flat faces (the corner normals of a mesh
+            # deformed by an armature can lag behind its positions)
+            tn = np.empty(nt * 3, np.float32)
+            tris.foreach_get("normal", tn)
+            nrm = np.repeat(tn.reshape(nt, 1, 3), 3, axis=1)
+        else:
+            tris.foreach_get("split_normals", nrm)
+            nrm = nrm.reshape(nt, 3, 3)
     except (AttributeError, RuntimeError, TypeError):
         cn = np.empty(len(mesh.loops) * 3, np.float32)
         mesh.corner_normals.foreach_get("vector", cn)
