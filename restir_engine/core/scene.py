@@ -115,6 +115,8 @@ class MaterialTable:
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
     alpha_tex   (m,) int32  texture whose value t further scales alpha, -1 = none
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
+    transparent_shadow (m,) bool  shadow rays pass the cut-out's transparent points (Material > Settings >
+                        Transparent Shadows); off: the surface shadows as if opaque
     alpha_program (m,) bool  the node program's "alpha" field (0..1, per hit) further scales alpha (an Alpha or a
                         Transparent BSDF's Mix factor from any node graph)
     program     (m,) int32  index into ``programs`` of the material's node program (-1 = none): fields that vary
@@ -155,6 +157,7 @@ class MaterialTable:
     alpha_tex: np.ndarray = None
     alpha_sign: np.ndarray = None
     alpha_program: np.ndarray = None
+    transparent_shadow: np.ndarray = None
     mix_normalize: np.ndarray = None
     mix_first: np.ndarray = None
     mix_count: np.ndarray = None
@@ -186,6 +189,7 @@ class MaterialTable:
             two_sided_emission=col("two_sided_emission", True, bool),
             alpha=col("alpha", 1.0), alpha_tex=col("alpha_tex", -1, np.int32), alpha_sign=col("alpha_sign", 1.0),
             alpha_program=col("alpha_program", False, bool),
+            transparent_shadow=col("transparent_shadow", True, bool),
             mix_normalize=col("mix_normalize", False, bool),
             normal_tex=col("normal_tex", -1, np.int32), normal_strength=col("normal_strength", 1.0),
             bump_tex=col("bump_tex", -1, np.int32), bump_strength=col("bump_strength", 1.0),

@@ -50,6 +50,8 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         if key not in self.index:
             row = self._convert(material)
             row["name"] = material.name
+            if not getattr(material, "use_transparent_shadow", True):
+                row["transparent_shadow"] = False
             aov = self._aov_program(material)
             if aov is not None:
                 row["aov_program"] = aov

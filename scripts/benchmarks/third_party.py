@@ -7,7 +7,8 @@ tests/scenes) is opened in a process of its own (a file that crashes or hangs co
 current frame, at 96x72. Where a file has no camera, one is added looking at the visible geometry's bounding box
 from the front-right-above; where it has no Light object, a sun (3 W/m², angle 10°) is added. Both engines render
 the same prepared scene with the same sampling settings as the accuracy tests (box filter, no clamping, no
-denoising, --bounces): Cycles, then our path tracer (--method, or our defaults with --method defaults).
+denoising, --bounces; Cycles' transparent bounces raised to TRANSPARENT_LAYERS): Cycles, then our path tracer
+(--method, or our defaults with --method defaults).
 
 Per file: the relative error of the image mean (RGB summed), and of each of 4x4 regions, where a region's error is
 |ours - Cycles| / max(Cycles, 0.1 x the image mean) (a black region is judged against a tenth of the image). A file
@@ -32,6 +33,10 @@ import numpy as np
 
 OUT = os.path.join(ROOT, "docs", "results", "third_party")
 MEAN_TOL, REGION_TOL, REGIONS = 0.05, 0.10, 4
+#: Cycles' transparent bounce limit here: our alpha cut-outs are followed through up to
+#: accel.MAX_CUTOUT_LAYERS surfaces, where Cycles would stop a path at --bounces transparent surfaces (a cube whose
+#: faces are partly transparent is several layers deep) and leave it black
+TRANSPARENT_LAYERS = 32
 
 
 def errors(ours: np.ndarray, ref: np.ndarray) -> tuple[float, float]:
@@ -99,10 +104,12 @@ def render_one(path: str, size, samples: int, bounces: int, method: str, noise: 
     added = _prepare(scene, size)
     rec = {"file": os.path.basename(path), "added": added}
     configure_cycles(scene, samples, bounces, seed=1)
+    scene.cycles.transparent_max_bounces = TRANSPARENT_LAYERS
     ref, rec["cycles_s"] = render_scene(scene)
     ref = ref["Combined"][..., :3]
     if noise:
         configure_cycles(scene, samples, bounces, seed=2)
+        scene.cycles.transparent_max_bounces = TRANSPARENT_LAYERS
         ref2 = render_scene(scene)[0]["Combined"][..., :3]
         rec["cycles_noise_mean"], rec["cycles_noise_region"] = errors(ref2, ref)
     settings = {} if method == "defaults" else {"integrator": method}

@@ -8,6 +8,7 @@ sqrt(α(1 - α) / (N H)); columns are checked at 5 standard errors (0.005 % fals
 import math
 
 import bpy
+import pytest
 import numpy as np
 from bpy_scenes import _with_uvs, render_passes
 from harness.render import configure_restir
@@ -295,3 +296,36 @@ def test_the_output_cycles_renders_is_used(addon):
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     i = sc.materials.names.index("TwoOutputs")
     np.testing.assert_allclose(sc.materials.emission[i], (0, 1, 0), atol=1e-6)
+
+
+@pytest.mark.parametrize("transparent_shadows", [True, False])
+def test_transparent_shadows_setting(addon, transparent_shadows):
+    """A sheet of Alpha 0.5 (above the camera) between a sun straight above and a white diffuse floor: with
+    Material > Settings > Transparent Shadows on, half the sun reaches the floor (L = 0.8/π x E x 0.5); off, the
+    sheet shadows as if opaque (L = 0), as Cycles (the glTF add-on's vertex-colour file turns it off; before, light
+    always passed). Tolerance: 5 standard errors of the image mean (Bernoulli shadow rays)."""
+    from harness.scenes import black_world, light
+
+    scene = reset()
+    black_world(scene)
+    floor = bpy.data.materials.new("Floor")
+    enable_nodes(floor)
+    fb = floor.node_tree.nodes["Principled BSDF"]
+    fb.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1)
+    fb.inputs["Specular IOR Level"].default_value = 0.0
+    plane("Floor", 4.0, (0, 0, 0), material=floor)
+    veil = bpy.data.materials.new("Veil")
+    enable_nodes(veil)
+    veil.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = 0.5
+    veil.use_transparent_shadow = transparent_shadows
+    plane("Sheet", 8.0, (0, 0, 1), material=veil)
+    light("SUN", (0, 0, 5), (0, 0, 0), energy=1.0)
+    bpy.data.lights[-1].angle = 0.0
+    camera((0, 0, 0.5), (0, 0, 0), ortho_scale=2.0)  # under the sheet
+    scene.render.resolution_x, scene.render.resolution_y = 16, 16
+    configure_restir(scene, N, 1, seed=5, integrator="PATH")
+    got = float(render_passes(scene)["Combined"][..., :3].mean())
+    t = 0.5 if transparent_shadows else 0.0
+    full = 0.8 / math.pi
+    se = full * math.sqrt(0.25 / (N * 256))
+    assert abs(got - full * t) < 5 * se + 1e-6, (got, full * t)

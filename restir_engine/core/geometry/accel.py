@@ -96,22 +96,24 @@ class Accel:
     def _chunks(self, n: int):
         return [(s, min(n, s + CHUNK_RAYS)) for s in range(0, n, CHUNK_RAYS)]
 
-    def intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
+    def intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None,
+                  shadow: bool = False) -> Hits:
         """Closest hit of each ray (origins/directions (3, n) float32 rows; directions need not be unit,
-        ``t`` is then in units of the direction length), through transparent cut-out points."""
+        ``t`` is then in units of the direction length), through transparent cut-out points (for ``shadow``
+        rays only those of materials with transparent shadows)."""
         hits = self._intersect(origins, directions, tmax)
         if self.cutout is not None:
-            self._pass_through(hits, origins, directions, tmax)
+            self._pass_through(hits, origins, directions, tmax, shadow)
         return hits
 
-    def _pass_through(self, hits: Hits, o: np.ndarray, d: np.ndarray, tmax) -> None:
+    def _pass_through(self, hits: Hits, o: np.ndarray, d: np.ndarray, tmax, shadow: bool = False) -> None:
         """Replace hits on transparent cut-out points by what lies behind them (in place; t stays measured from
         the original origins)."""
         for _layer in range(MAX_CUTOUT_LAYERS):
             live = np.flatnonzero(hits.prim >= 0)
             if live.size == 0:
                 return
-            go = live[~self.cutout.opaque(hits.prim[live], hits.u[live], hits.v[live], cols(d, live))]
+            go = live[~self.cutout.opaque(hits.prim[live], hits.u[live], hits.v[live], cols(d, live), shadow)]
             if go.size == 0:
                 return
             t = hits.t[go]
@@ -158,7 +160,7 @@ class Accel:
             rows = np.flatnonzero(out)
             if rows.size:
                 far = np.ascontiguousarray(tmax, dtype=np.float32)[rows]
-                out[rows] = self.intersect(cols(origins, rows), cols(directions, rows), far).prim >= 0
+                out[rows] = self.intersect(cols(origins, rows), cols(directions, rows), far, shadow=True).prim >= 0
         return out
 
     def _occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:

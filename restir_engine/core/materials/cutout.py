@@ -32,6 +32,8 @@ class Cutout:
         programs = getattr(materials, "alpha_program", None)
         self.program = programs[mat] if programs is not None else np.zeros(len(mat), bool)
         self.cut = (self.alpha < 1) | (self.tex >= 0) | self.program
+        shadows = getattr(materials, "transparent_shadow", None)
+        self.shadow_cut = self.cut & (shadows[mat] if shadows is not None else True)
         self.uvs = geometry.uvs
         self.textures = materials.textures
         self.geometry, self.materials = geometry, materials
@@ -56,11 +58,13 @@ class Cutout:
         out.geometry = geometry
         return out
 
-    def opaque(self, prim: np.ndarray, u: np.ndarray, v: np.ndarray, d: np.ndarray | None = None) -> np.ndarray:
+    def opaque(self, prim: np.ndarray, u: np.ndarray, v: np.ndarray, d: np.ndarray | None = None,
+               shadow: bool = False) -> np.ndarray:
         """(n,) bool for hits (prim >= 0) at barycentrics (u, v) of rays along ``d`` (3, n) (node programs read
-        the view from it: Backfacing, Incoming; None: unknown)."""
+        the view from it: Backfacing, Incoming; None: unknown). For ``shadow`` rays a material whose Transparent
+        Shadows setting is off is opaque everywhere, as in Cycles."""
         out = np.ones(len(prim), bool)
-        sel = np.flatnonzero(self.cut[prim])
+        sel = np.flatnonzero((self.shadow_cut if shadow else self.cut)[prim])
         if sel.size == 0:
             return out
         p = prim[sel]
