@@ -236,6 +236,7 @@ def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None
     reads = 0
     slots_seen: list = []
     slot_cache: dict = {}
+    unsupported_visibility: dict = {}  # object name -> the ray kinds it hides from that are not honoured
     for inst, obj in geometry_instances(depsgraph):
         data = obj.data
         key = data.as_pointer() if (obj.type in {"MESH", "POINTCLOUD"} and data is not None) else obj.as_pointer()
@@ -286,7 +287,16 @@ def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None
                        instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, asset_name(obj),
                                                          bool(getattr(obj, "is_holdout", False)),
                                                          float(getattr(obj, "pass_index", 0)),
-                                                         bool(getattr(obj, "is_shadow_catcher", False)))))
+                                                         bool(getattr(obj, "is_shadow_catcher", False)),
+                                                         bool(getattr(obj, "visible_shadow", True)))))
+        unseen = [f for f in ("camera", "glossy", "transmission") if not getattr(obj, f"visible_{f}", True)]
+        if unseen and obj.name not in unsupported_visibility:
+            unsupported_visibility[obj.name] = unseen
+    if unsupported_visibility:
+        names = list(unsupported_visibility)
+        warnings.append(f"Object > Visibility > Ray Visibility: only Shadow is honoured; {', '.join(names[:3])}"
+                        f"{' and others' if len(names) > 3 else ''} stay visible to "
+                        f"{', '.join(sorted({f for v in unsupported_visibility.values() for f in v}))} rays")
 
     return blocks, reads, slots_seen
 
@@ -439,7 +449,8 @@ def _object_table(blocks) -> ObjectTable:
                        names=tuple(b[5][2] for b in blocks), assets=tuple(b[5][3] for b in blocks),
                        holdout=np.array([b[5][4] for b in blocks], bool),
                        pass_index=np.array([b[5][5] for b in blocks], np.float32),
-                       shadow_catcher=np.array([b[5][6] for b in blocks], bool))
+                       shadow_catcher=np.array([b[5][6] for b in blocks], bool),
+                       casts_shadow=np.array([b[5][7] for b in blocks], bool))
 
 
 def asset_name(obj) -> str:

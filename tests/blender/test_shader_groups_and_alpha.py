@@ -329,3 +329,31 @@ def test_transparent_shadows_setting(addon, transparent_shadows):
     full = 0.8 / math.pi
     se = full * math.sqrt(0.25 / (N * 256))
     assert abs(got - full * t) < 5 * se + 1e-6, (got, full * t)
+
+
+def test_objects_that_cast_no_shadow(addon):
+    """Object > Visibility > Ray Visibility > Shadow off: an opaque sheet between the sun and the floor lets the
+    whole sun through to the floor (L = 0.8/π x E exactly: no random cut-out here), as Cycles; camera visibility,
+    which is not honoured, is named in a warning."""
+    from harness.scenes import black_world, light
+
+    scene = reset()
+    black_world(scene)
+    floor = bpy.data.materials.new("Floor")
+    enable_nodes(floor)
+    fb = floor.node_tree.nodes["Principled BSDF"]
+    fb.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1)
+    fb.inputs["Specular IOR Level"].default_value = 0.0
+    plane("Floor", 4.0, (0, 0, 0), material=floor)
+    sheet = plane("Sheet", 8.0, (0, 0, 1))
+    light("SUN", (0, 0, 5), (0, 0, 0), energy=1.0)
+    bpy.data.lights[-1].angle = 0.0
+    camera((0, 0, 0.5), (0, 0, 0), ortho_scale=2.0)
+    scene.render.resolution_x, scene.render.resolution_y = 8, 8
+    configure_restir(scene, 4, 1, seed=5, integrator="PATH")
+    assert float(render_passes(scene)["Combined"][..., :3].mean()) < 1e-6  # the sheet's shadow
+    sheet.visible_shadow = False
+    np.testing.assert_allclose(render_passes(scene)["Combined"][..., :3], 0.8 / math.pi, rtol=1e-4)
+    sheet.visible_camera = False
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    assert any("Ray Visibility" in w and "Sheet" in w and "camera" in w for w in sc.warnings)

@@ -34,6 +34,7 @@ class Cutout:
         self.cut = (self.alpha < 1) | (self.tex >= 0) | self.program
         shadows = getattr(materials, "transparent_shadow", None)
         self.shadow_cut = self.cut & (shadows[mat] if shadows is not None else True)
+        self.shadow_pass = _shadowless(geometry)  # (n,) bool or None: triangles shadow rays ignore
         self.uvs = geometry.uvs
         self.textures = materials.textures
         self.geometry, self.materials = geometry, materials
@@ -45,10 +46,11 @@ class Cutout:
         if a is None or len(geometry) == 0:
             return None
         programs = getattr(materials, "alpha_program", None)
-        if not ((a < 1).any() or (materials.alpha_tex >= 0).any() or (programs is not None and programs.any())):
+        if not ((a < 1).any() or (materials.alpha_tex >= 0).any() or (programs is not None and programs.any())
+                or _shadowless(geometry) is not None):
             return None
         c = Cutout(geometry, materials)
-        return c if c.cut.any() else None
+        return c if c.cut.any() or c.shadow_pass is not None else None
 
     def with_geometry(self, geometry) -> "Cutout":
         """The same test on ``geometry``, the same triangles with moved corners (node programs read its positions
@@ -64,7 +66,9 @@ class Cutout:
         the view from it: Backfacing, Incoming; None: unknown). For ``shadow`` rays a material whose Transparent
         Shadows setting is off is opaque everywhere, as in Cycles."""
         out = np.ones(len(prim), bool)
-        sel = np.flatnonzero((self.shadow_cut if shadow else self.cut)[prim])
+        if shadow and self.shadow_pass is not None:
+            out[self.shadow_pass[prim]] = False  # an object that casts no shadow: shadow rays pass it
+        sel = np.flatnonzero((self.shadow_cut if shadow else self.cut)[prim] & out)
         if sel.size == 0:
             return out
         p = prim[sel]
@@ -96,3 +100,12 @@ class Cutout:
             if "alpha" in got:
                 out[r] = np.clip(got["alpha"], 0, 1)
         return out
+
+
+def _shadowless(geometry):
+    """(n,) bool of the triangles whose object casts no shadow (Ray Visibility > Shadow off), or None if none."""
+    objects, inst = getattr(geometry, "objects", None), getattr(geometry, "instance", None)
+    flags = getattr(objects, "casts_shadow", None) if objects is not None else None
+    if flags is None or inst is None or flags.all():
+        return None
+    return ~flags[inst]
