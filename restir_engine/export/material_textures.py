@@ -36,6 +36,9 @@ class TextureReader:
         key = (image.name_full, "alpha" if alpha else "luminance" if luminance else "rgb", closest)
         if key in self.texture_index:
             return self.texture_index[key]
+        if getattr(image, "source", "FILE") == "TILED" and len(getattr(image, "tiles", ())) > 1:
+            self._warn(material, f"image '{image.name}' has UDIM tiles, which are not supported: its first tile "
+                       "is repeated over every tile")
         kept = TEXTURES.key(image, key)
         data = TEXTURES.get(kept)
         if data is None:

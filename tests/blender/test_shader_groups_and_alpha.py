@@ -357,3 +357,21 @@ def test_objects_that_cast_no_shadow(addon):
     sheet.visible_camera = False
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     assert any("Ray Visibility" in w and "Sheet" in w and "camera" in w for w in sc.warnings)
+
+
+def test_udim_images_are_named(addon):
+    """An image with UDIM tiles (not supported: its first tile repeats over every tile) is named in a warning
+    rather than silently wrong."""
+    def build():
+        image = bpy.data.images.new("Tiles", 8, 8, tiled=True)
+        image.tiles.new(1002)
+        mat = bpy.data.materials.new("Tiled")
+        enable_nodes(mat)
+        t = mat.node_tree
+        tex = t.nodes.new("ShaderNodeTexImage")
+        tex.image = image
+        t.links.new(tex.outputs["Color"], t.nodes["Principled BSDF"].inputs["Base Color"])
+        return mat
+    _facing_plane(build)
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    assert any("UDIM" in w and "Tiles" in w for w in sc.warnings)
