@@ -375,3 +375,42 @@ def test_udim_images_are_named(addon):
     _facing_plane(build)
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     assert any("UDIM" in w and "Tiles" in w for w in sc.warnings)
+
+
+def test_sunlight_through_a_glass_pane(addon):
+    """A smooth glass pane (IOR 1.5, 2 cm) between a wide sun (40°, straight above) and a white diffuse floor, the
+    camera under the pane: the floor's light comes only from paths through the pane to the sun's disk (its shadow
+    rays are blocked by the glass), L = 0.8/π x E x T with T = (1 - R)² (1 + R² + ...) ≈ 0.9231 (R = 0.04 at normal
+    incidence; 0.9216 for the paths within the bounce limit, within the tolerance). Before, a ray leaving glass never
+    met a sun and the floor was black. Tolerance: 5 standard errors of the image mean (from the pixels' spread)."""
+    from harness.scenes import black_world, light
+
+    scene = reset()
+    black_world(scene)
+    floor = bpy.data.materials.new("Floor")
+    enable_nodes(floor)
+    fb = floor.node_tree.nodes["Principled BSDF"]
+    fb.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1)
+    fb.inputs["Specular IOR Level"].default_value = 0.0
+    plane("Floor", 4.0, (0, 0, 0), material=floor)
+    glass = bpy.data.materials.new("Pane")
+    enable_nodes(glass)
+    t = glass.node_tree
+    t.nodes.remove(t.nodes["Principled BSDF"])
+    g = t.nodes.new("ShaderNodeBsdfGlass")
+    g.inputs["Roughness"].default_value = 0.0
+    g.inputs["IOR"].default_value = 1.5
+    t.links.new(g.outputs[0], t.nodes["Material Output"].inputs["Surface"])
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0, 0, 1.01))
+    pane = bpy.context.active_object
+    pane.scale = (40.0, 40.0, 0.02)
+    pane.data.materials.append(glass)
+    light("SUN", (0, 0, 5), (0, 0, 0), energy=1.0)
+    bpy.data.lights[-1].angle = math.radians(40.0)
+    camera((0, 0, 0.5), (0, 0, 0), ortho_scale=2.0)
+    scene.render.resolution_x, scene.render.resolution_y = 16, 16
+    configure_restir(scene, 256, 8, seed=7, integrator="PATH")
+    img = render_passes(scene)["Combined"][..., :3].mean(axis=2)
+    expected = 0.8 / math.pi * 0.9216
+    se = img.std() / math.sqrt(img.size)
+    assert abs(img.mean() - expected) < 5 * se + 0.002 * expected, (img.mean(), expected, se)

@@ -282,6 +282,26 @@ def _world_on_rays(ctx: TraceContext, d, esc, prev_pdf, origin_n, add) -> None:
     add(esc, le, None if ctx.groups is None else ctx.groups.world)
 
 
+def _suns_on_rays(ctx: TraceContext, d, esc, prev_pdf, add) -> None:
+    """The suns of non-zero angle seen by escaping delta rays ``esc`` (from glass, where no light was sampled; the
+    other vertices light-sample the suns and their BSDF rays never collect them): a sun's disk radiance
+    E / (π sin² θ) within its half-angle θ, weight 1."""
+    lamps = ctx.scene.lamps
+    esc = esc[prev_pdf[esc] >= DELTA_PDF]
+    if esc.size == 0:
+        return
+    de = cols(d, esc)
+    de = de / np.maximum(norm(de), np.float32(1e-30))
+    for k in np.flatnonzero(lamps.sun_cos < 1.0 - 1e-9):  # a loop over suns, not rays
+        inside = np.flatnonzero(de.T @ lamps.sun_dir[k].astype(np.float32) >= lamps.sun_cos[k])
+        if inside.size == 0:
+            continue
+        sin2 = max(1.0 - float(lamps.sun_cos[k]) ** 2, 1e-30)
+        le = np.repeat((lamps.sun_irradiance[k] / (np.pi * sin2)).astype(np.float32)[:, None], inside.size, axis=1)
+        group = None if ctx.groups is None else ctx.groups.of_lights(np.full(inside.size, ctx.lights.n_tri + k))
+        add(esc[inside], le, group)
+
+
 def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) -> None:
     """Emissive triangles hit by the rays ``hsel`` (primitives ``hp``), MIS-weighted against light sampling."""
     light = ctx.lights.geom_to_light[hp]
@@ -328,6 +348,8 @@ def _emission_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, world_co
         esc = esc[world_collect[esc]]
     if esc.size and world:  # film transparency affects camera rays only
         _world_on_rays(ctx, d, esc, prev_pdf, origin_n, add)
+    if esc.size and gather and len(ctx.scene.lamps.sun_dir):
+        _suns_on_rays(ctx, d, esc if collect is None else esc[collect[esc]], prev_pdf, add)
     hsel = np.flatnonzero(hit)
     hp = hits.prim[hsel]
     if hsel.size and gather:

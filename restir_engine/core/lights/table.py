@@ -8,7 +8,8 @@ uniformly in area, p_ω = p_select · (1/A) · d² / |cos θ_light|, and a spher
 from the receiver (as Cycles), p_ω = p_select / (2π (1 - cos θ_max)): no sample lands on its far side.
 Light points for resampling (light_tiles.sample_points) are uniform in area on both kinds.
 Suns are sampled uniformly in their cone and are handled by light sampling only (a BSDF ray
-that escapes never collects a sun), which keeps the MIS estimator unbiased.
+that escapes never collects a sun, except a delta ray from glass, where no light is sampled), which keeps the MIS
+estimator unbiased.
 """
 from __future__ import annotations
 
