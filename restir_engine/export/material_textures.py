@@ -14,6 +14,26 @@ MAGENTA = (1.0, 0.0, 1.0)
 class TextureReader:
     """MaterialRegistry's image readers (``self.textures``, ``self.texture_index``, ``self._warn``)."""
 
+    def _plain_image(self, material, socket) -> int | None:
+        """The texture index of an Image Texture's Color wired straight into ``socket`` (see
+        :meth:`_plain_image_node`), else None."""
+        node = self._plain_image_node(socket)
+        if node is None or socket.links[0].from_socket.name != "Color":
+            return None
+        return self._texture(material, node.image, closest=node.interpolation == "Closest")
+
+    @staticmethod
+    def _plain_image_node(socket):
+        """The Image Texture wired straight into ``socket`` and sampled as the fixed texture path samples (the render
+        UV map, Linear or Closest, Repeat, flat projection), else None."""
+        link = socket.links[0] if socket.is_linked else None
+        node = link.from_node if link is not None else None
+        if (node is None or node.type != "TEX_IMAGE" or node.image is None or node.mute or link.is_muted
+                or node.inputs["Vector"].is_linked or node.interpolation not in {"Linear", "Closest"}
+                or node.extension != "REPEAT" or node.projection != "FLAT"):
+            return None
+        return node
+
     def _factor_texture(self, material, socket) -> int:
         """Texture index of an Image Texture driving a float socket (its Color as luminance, or its Alpha), or -1."""
         if not socket.is_linked:

@@ -14,18 +14,13 @@ from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
 from .coat import coat_set
 from .flat_nodes import FlatTree, cycles_output, flat_output
+from .sheen import sheen_row
 from .limits import clamped_radiance
 from .material_textures import TextureReader
 from .mix_shaders import MixShaderReader
 from .node_graph import GraphCompiler
 
 
-
-#: The Sheen BSDF's albedo under a uniform white world, averaged over view directions with weight cos θ (the lobe's
-#: share of the light it receives), at roughness SHEEN_ROUGHNESS, measured from Cycles (Blender 5.2, one bounce)
-SHEEN_ROUGHNESS = (0.0, 0.1, 0.3, 0.5, 0.75, 1.0)
-SHEEN_ALBEDO = {"MICROFIBER": (0.0, 0.00003, 0.0178, 0.0967, 0.260, 0.434),
-                "ASHIKHMIN": (0.0, 0.0006, 0.0499, 0.156, 0.304, 0.434)}
 
 #: a Holdout shader: black and emitting nothing; camera rays that meet it leave the pixel transparent (alpha 0)
 HOLDOUT_ROW = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "metallic": 0.0, "holdout": True}
@@ -207,18 +202,6 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         varying[field] = reg
         return (1.0, 1.0, 1.0) if kind == "color" else float(getattr(socket, "default_value", 0.0))
 
-    def _plain_image(self, material, socket) -> int | None:
-        """The texture index of an Image Texture's Color wired straight into ``socket`` and sampled as the fixed
-        texture path samples (the render UV map, Linear or Closest, Repeat), else None."""
-        link = socket.links[0] if socket.is_linked else None
-        node = link.from_node if link is not None else None
-        if (node is None or node.type != "TEX_IMAGE" or node.image is None or node.mute or link.is_muted
-                or link.from_socket.name != "Color" or node.inputs["Vector"].is_linked
-                or node.interpolation not in {"Linear", "Closest"} or node.extension != "REPEAT"
-                or node.projection != "FLAT"):
-            return None
-        return self._texture(material, node.image, closest=node.interpolation == "Closest")
-
     def _color_input(self, material, socket, key_tex: str, row: dict, fallback):
         """Constant colour of a socket (its graph folded), or 1 with a texture index when an Image Texture drives
         it plainly (``key_tex``); a colour that varies otherwise is approximated by the socket's value (reported)."""
@@ -261,41 +244,7 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         if t == "BSDF_PRINCIPLED" and not base_only and coat_set(node):
             return self._mix_program(material, node, depth)
         if t == "BSDF_PRINCIPLED":
-            row: dict = {}
-            inp = node.inputs
-            g, varying = self._compiler(material), {}
-            row["base_color"] = self._param(material, g, inp["Base Color"], "color", "base_color", varying, row,
-                                            "base_tex")
-            row["metallic"] = self._param(material, g, inp["Metallic"], "float", "metallic", varying)
-            row["roughness"] = self._param(material, g, inp["Roughness"], "float", "roughness", varying)
-            ior_reg = g.value(inp["IOR"], "float") if "IOR" in inp else g.constant(1.5, "float")
-            level = g.value(inp["Specular IOR Level"], "float") if "Specular IOR Level" in inp else \
-                g.constant(0.5, "float")
-            f0 = g.emit("principled_f0", {}, [ior_reg, level], ("float",))[0]
-            if f0.const is not None:
-                row["f0"] = f0.constant_value()
-            else:
-                varying["f0"] = f0
-            ior = ior_reg.constant_value() if ior_reg.const is not None else float(inp["IOR"].default_value)
-            if "Specular Tint" in inp:
-                row["specular_tint"] = self._param(material, g, inp["Specular Tint"], "color", "specular_tint",
-                                                   varying)
-            row["multiscatter"] = self._multiscatter(material, node)
-            if "Anisotropic" in inp and (inp["Anisotropic"].is_linked or float(inp["Anisotropic"].default_value) > 0):
-                self._warn(material, "Principled 'Anisotropic' is not supported; rendered isotropic")
-            self._emission(material, g, inp["Emission Color"], inp["Emission Strength"], row, varying)
-            for name in ("Sheen Weight", "Subsurface Weight"):
-                if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
-                    self._warn(material, f"Principled '{name}' is not supported and was ignored")
-            if "Transmission Weight" in inp:
-                self._principled_transmission(material, inp, row, ior)
-            if "Diffuse Roughness" in inp:
-                dr = self._param(material, g, inp["Diffuse Roughness"], "float", "diffuse_roughness", varying)
-                row["diffuse_roughness"] = float(np.clip(dr, 0, 1))
-            if "Alpha" in inp:
-                self._alpha(material, inp["Alpha"], row, g, varying)
-            self._normal(material, node, row, g, varying)
-            return self._with_program(row, g, varying)
+            return self._principled(material, node)
         if t == "BSDF_GLASS":
             c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
             ior = self._float_input(material, node.inputs["IOR"])
@@ -350,7 +299,7 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         if t == "BSDF_TRANSLUCENT":
             return self._translucent(material, node)
         if t == "BSDF_SHEEN":
-            return self._sheen(material, node)
+            return sheen_row(self, material, node)
         if t in {"MIX_SHADER", "ADD_SHADER"}:
             return self._mix(material, node, depth)
         if t.startswith("VOLUME_") or t == "PRINCIPLED_VOLUME":  # as Cycles: volume closures add nothing to a surface
@@ -359,22 +308,42 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         return {"base_color": tuple(material.diffuse_color[:3]), "metallic": float(material.metallic),
                 "roughness": float(material.roughness), "f0": 0.04}
 
-    def _sheen(self, material, node) -> dict:
-        """A Sheen BSDF, approximated (named in a warning) by a Lambertian of its Color times the lobe's albedo
-        averaged over the hemisphere (cosine-weighted, by roughness: :data:`SHEEN_ALBEDO`): the right amount of
-        light, spread evenly instead of toward grazing angles."""
-        self._warn(material, f"'{node.name}' (Sheen BSDF) is approximated by a diffuse of its average reflectance")
-        rough = float(np.clip(self._float_input(material, node.inputs["Roughness"]), 0, 1))
-        table = SHEEN_ALBEDO.get(getattr(node, "distribution", "MICROFIBER"), SHEEN_ALBEDO["MICROFIBER"])
-        albedo = float(np.interp(rough, SHEEN_ROUGHNESS, table))
+    def _principled(self, material, node) -> dict:
+        """The row of a Principled BSDF without a Coat (a coated one is a mix: export/coat.py)."""
+        row: dict = {}
+        inp = node.inputs
         g, varying = self._compiler(material), {}
-        colour = g.emit("scale", {}, [g.value(node.inputs["Color"], "color"), g.constant(albedo, "float")],
-                        ("color",))[0]
-        row = {"f0": 0.0, "metallic": 0.0, "base_color": (1.0, 1.0, 1.0)}
-        if colour.const is not None:
-            row["base_color"] = colour.constant_value()
+        row["base_color"] = self._param(material, g, inp["Base Color"], "color", "base_color", varying, row,
+                                        "base_tex")
+        row["metallic"] = self._param(material, g, inp["Metallic"], "float", "metallic", varying)
+        row["roughness"] = self._param(material, g, inp["Roughness"], "float", "roughness", varying)
+        ior_reg = g.value(inp["IOR"], "float") if "IOR" in inp else g.constant(1.5, "float")
+        level = g.value(inp["Specular IOR Level"], "float") if "Specular IOR Level" in inp else \
+            g.constant(0.5, "float")
+        f0 = g.emit("principled_f0", {}, [ior_reg, level], ("float",))[0]
+        if f0.const is not None:
+            row["f0"] = f0.constant_value()
         else:
-            varying["base_color"] = colour
+            varying["f0"] = f0
+        ior = ior_reg.constant_value() if ior_reg.const is not None else float(inp["IOR"].default_value)
+        if "Specular Tint" in inp:
+            row["specular_tint"] = self._param(material, g, inp["Specular Tint"], "color", "specular_tint",
+                                               varying)
+        row["multiscatter"] = self._multiscatter(material, node)
+        if "Anisotropic" in inp and (inp["Anisotropic"].is_linked or float(inp["Anisotropic"].default_value) > 0):
+            self._warn(material, "Principled 'Anisotropic' is not supported; rendered isotropic")
+        self._emission(material, g, inp["Emission Color"], inp["Emission Strength"], row, varying)
+        for name in ("Sheen Weight", "Subsurface Weight"):
+            if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
+                self._warn(material, f"Principled '{name}' is not supported and was ignored")
+        if "Transmission Weight" in inp:
+            self._principled_transmission(material, inp, row, ior)
+        if "Diffuse Roughness" in inp:
+            dr = self._param(material, g, inp["Diffuse Roughness"], "float", "diffuse_roughness", varying)
+            row["diffuse_roughness"] = float(np.clip(dr, 0, 1))
+        if "Alpha" in inp:
+            self._alpha(material, inp["Alpha"], row, g, varying)
+        self._normal(material, node, row, g, varying)
         return self._with_program(row, g, varying)
 
     def _translucent(self, material, node) -> dict:
@@ -509,7 +478,7 @@ class MaterialRegistry(MixShaderReader, TextureReader):
     def _alpha(self, material, socket, row: dict, g: GraphCompiler, varying: dict) -> None:
         """Principled Alpha: constant, a plain Image Texture's Alpha (or Color, as luminance) -> row alpha fields;
         any other graph -> the node program's "alpha" (clamped to [0, 1] as Cycles clamps it)."""
-        if socket.is_linked and self._plain_factor_image(socket):
+        if self._plain_image_node(socket) is not None:
             tex = self._factor_texture(material, socket)
             if tex >= 0:
                 row.update(alpha=1.0, alpha_tex=tex, alpha_sign=1.0)
@@ -522,12 +491,3 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         a = float(np.clip(reg.constant_value(), 0, 1))
         if a < 1:
             row["alpha"] = a
-
-    @staticmethod
-    def _plain_factor_image(socket) -> bool:
-        """Whether ``socket`` is fed straight by an Image Texture the fixed texture path samples as Blender would
-        (the render UV map, Linear or Closest, Repeat, flat projection)."""
-        node = socket.links[0].from_node
-        return (node.type == "TEX_IMAGE" and node.image is not None and not node.mute
-                and not node.inputs["Vector"].is_linked and node.interpolation in {"Linear", "Closest"}
-                and node.extension == "REPEAT" and node.projection == "FLAT")

@@ -174,22 +174,8 @@ class MixShaderReader:
                 else:
                     outputs[f"mix:{len(comps)}"] = w
                     comps.append((self.add_row(comp), 1.0, -1, 0.0))
-        if clear is not None:  # the transparent share: a cut-out; the opaque points' weights divided by the opacity
-            opacity = g.emit("saturate", {}, [g.emit("one_minus", {}, [clear], ("float",))[0]], ("float",))[0]
-            if opacity.const is not None:
-                out["alpha"] = opacity.constant_value()
-            else:
-                outputs["alpha"] = opacity
-                out["alpha_program"] = True
-            inv = g.emit("reciprocal", {}, [opacity], ("float",))[0]
-            for k, (index, weight, tex, sign) in enumerate(comps):
-                w = outputs.get(f"mix:{k}")
-                if w is None and inv.const is not None:
-                    comps[k] = (index, weight * inv.constant_value(), tex, sign)
-                    continue
-                w = g.constant(weight, "float") if w is None else w
-                outputs[f"mix:{k}"] = g.emit("multiply", {}, [w, inv], ("float",))[0]
-                comps[k] = (index, 1.0, tex, sign)
+        if clear is not None:
+            _cut_out_share(g, clear, out, outputs, comps)
         if emission is not None:
             if emission.const is not None:
                 out["emission"] = emission.constant_value()
@@ -252,6 +238,27 @@ class MixShaderReader:
                     key = (leaf.name, ltx, lsg)
                     merged[key] = (leaf, merged[key][1] + lw if key in merged else lw, ltx, lsg)
         return list(merged.values())
+
+
+def _cut_out_share(g: GraphCompiler, clear, out: dict, outputs: dict, comps: list) -> None:
+    """A mix row's transparent share ``clear`` (a register): its opacity as the row's cut-out alpha (constant, or
+    the program's "alpha"), and the components' weights (``comps``, the program's "mix:<k>") divided by it, since
+    only the opaque points are shaded."""
+    opacity = g.emit("saturate", {}, [g.emit("one_minus", {}, [clear], ("float",))[0]], ("float",))[0]
+    if opacity.const is not None:
+        out["alpha"] = opacity.constant_value()
+    else:
+        outputs["alpha"] = opacity
+        out["alpha_program"] = True
+    inv = g.emit("reciprocal", {}, [opacity], ("float",))[0]
+    for k, (index, weight, tex, sign) in enumerate(comps):
+        w = outputs.get(f"mix:{k}")
+        if w is None and inv.const is not None:
+            comps[k] = (index, weight * inv.constant_value(), tex, sign)
+            continue
+        w = g.constant(weight, "float") if w is None else w
+        outputs[f"mix:{k}"] = g.emit("multiply", {}, [w, inv], ("float",))[0]
+        comps[k] = (index, 1.0, tex, sign)
 
 
 def _has_bsdf(row: dict) -> bool:

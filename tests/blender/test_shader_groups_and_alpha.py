@@ -251,7 +251,7 @@ def test_ambient_occlusion_passes_its_colour_through(addon):
 def test_sheen_bsdf_is_named_and_reflects_its_average(addon):
     """A Sheen BSDF (glTF's sheen, velvet) is approximated by a diffuse of its colour times the lobe's mean albedo
     at its roughness (before: a diffuse of the viewport colour, several times too bright), and named."""
-    from restir_engine.export.materials import SHEEN_ALBEDO, SHEEN_ROUGHNESS
+    from restir_engine.export.sheen import SHEEN_ALBEDO, SHEEN_ROUGHNESS
 
     def build():
         mat = bpy.data.materials.new("Velvet")
@@ -298,12 +298,9 @@ def test_the_output_cycles_renders_is_used(addon):
     np.testing.assert_allclose(sc.materials.emission[i], (0, 1, 0), atol=1e-6)
 
 
-@pytest.mark.parametrize("transparent_shadows", [True, False])
-def test_transparent_shadows_setting(addon, transparent_shadows):
-    """A sheet of Alpha 0.5 (above the camera) between a sun straight above and a white diffuse floor: with
-    Material > Settings > Transparent Shadows on, half the sun reaches the floor (L = 0.8/π x E x 0.5); off, the
-    sheet shadows as if opaque (L = 0), as Cycles (the glTF add-on's vertex-colour file turns it off; before, light
-    always passed). Tolerance: 5 standard errors of the image mean (Bernoulli shadow rays)."""
+def _sunlit_floor():
+    """A white diffuse floor (0.8, no specular) under a sun of 1 W/m² straight above (angle 0), a black world and an
+    orthographic camera 0.5 above the floor looking down (under anything placed higher), 16 x 16 pixels."""
     from harness.scenes import black_world, light
 
     scene = reset()
@@ -314,15 +311,24 @@ def test_transparent_shadows_setting(addon, transparent_shadows):
     fb.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1)
     fb.inputs["Specular IOR Level"].default_value = 0.0
     plane("Floor", 4.0, (0, 0, 0), material=floor)
+    light("SUN", (0, 0, 5), (0, 0, 0), energy=1.0, angle=0.0)
+    camera((0, 0, 0.5), (0, 0, 0), ortho_scale=2.0)
+    scene.render.resolution_x, scene.render.resolution_y = 16, 16
+    return scene
+
+
+@pytest.mark.parametrize("transparent_shadows", [True, False])
+def test_transparent_shadows_setting(addon, transparent_shadows):
+    """A sheet of Alpha 0.5 (above the camera) between a sun straight above and a white diffuse floor: with
+    Material > Settings > Transparent Shadows on, half the sun reaches the floor (L = 0.8/π x E x 0.5); off, the
+    sheet shadows as if opaque (L = 0), as Cycles (the glTF add-on's vertex-colour file turns it off; before, light
+    always passed). Tolerance: 5 standard errors of the image mean (Bernoulli shadow rays)."""
+    scene = _sunlit_floor()
     veil = bpy.data.materials.new("Veil")
     enable_nodes(veil)
     veil.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = 0.5
     veil.use_transparent_shadow = transparent_shadows
     plane("Sheet", 8.0, (0, 0, 1), material=veil)
-    light("SUN", (0, 0, 5), (0, 0, 0), energy=1.0)
-    bpy.data.lights[-1].angle = 0.0
-    camera((0, 0, 0.5), (0, 0, 0), ortho_scale=2.0)  # under the sheet
-    scene.render.resolution_x, scene.render.resolution_y = 16, 16
     configure_restir(scene, N, 1, seed=5, integrator="PATH")
     got = float(render_passes(scene)["Combined"][..., :3].mean())
     t = 0.5 if transparent_shadows else 0.0
@@ -335,20 +341,8 @@ def test_objects_that_cast_no_shadow(addon):
     """Object > Visibility > Ray Visibility > Shadow off: an opaque sheet between the sun and the floor lets the
     whole sun through to the floor (L = 0.8/π x E exactly: no random cut-out here), as Cycles; camera visibility,
     which is not honoured, is named in a warning."""
-    from harness.scenes import black_world, light
-
-    scene = reset()
-    black_world(scene)
-    floor = bpy.data.materials.new("Floor")
-    enable_nodes(floor)
-    fb = floor.node_tree.nodes["Principled BSDF"]
-    fb.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1)
-    fb.inputs["Specular IOR Level"].default_value = 0.0
-    plane("Floor", 4.0, (0, 0, 0), material=floor)
+    scene = _sunlit_floor()
     sheet = plane("Sheet", 8.0, (0, 0, 1))
-    light("SUN", (0, 0, 5), (0, 0, 0), energy=1.0)
-    bpy.data.lights[-1].angle = 0.0
-    camera((0, 0, 0.5), (0, 0, 0), ortho_scale=2.0)
     scene.render.resolution_x, scene.render.resolution_y = 8, 8
     configure_restir(scene, 4, 1, seed=5, integrator="PATH")
     assert float(render_passes(scene)["Combined"][..., :3].mean()) < 1e-6  # the sheet's shadow
@@ -383,16 +377,7 @@ def test_sunlight_through_a_glass_pane(addon):
     rays are blocked by the glass), L = 0.8/π x E x T with T = (1 - R)² (1 + R² + ...) ≈ 0.9231 (R = 0.04 at normal
     incidence; 0.9216 for the paths within the bounce limit, within the tolerance). Before, a ray leaving glass never
     met a sun and the floor was black. Tolerance: 5 standard errors of the image mean (from the pixels' spread)."""
-    from harness.scenes import black_world, light
-
-    scene = reset()
-    black_world(scene)
-    floor = bpy.data.materials.new("Floor")
-    enable_nodes(floor)
-    fb = floor.node_tree.nodes["Principled BSDF"]
-    fb.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1)
-    fb.inputs["Specular IOR Level"].default_value = 0.0
-    plane("Floor", 4.0, (0, 0, 0), material=floor)
+    scene = _sunlit_floor()
     glass = bpy.data.materials.new("Pane")
     enable_nodes(glass)
     t = glass.node_tree
@@ -405,10 +390,7 @@ def test_sunlight_through_a_glass_pane(addon):
     pane = bpy.context.active_object
     pane.scale = (40.0, 40.0, 0.02)
     pane.data.materials.append(glass)
-    light("SUN", (0, 0, 5), (0, 0, 0), energy=1.0)
-    bpy.data.lights[-1].angle = math.radians(40.0)
-    camera((0, 0, 0.5), (0, 0, 0), ortho_scale=2.0)
-    scene.render.resolution_x, scene.render.resolution_y = 16, 16
+    bpy.data.lights["SUN light"].angle = math.radians(40.0)
     configure_restir(scene, 256, 8, seed=7, integrator="PATH")
     img = render_passes(scene)["Combined"][..., :3].mean(axis=2)
     expected = 0.8 / math.pi * 0.9216
