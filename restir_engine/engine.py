@@ -215,7 +215,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
         """(bands, band margin, memory estimate) of the frame, or None where it cannot fit in the machine's free
         memory (refused with the estimate before any work, rather than failing part-way)."""
         free = memory.available_memory()
-        bands, margin = band_plan(core_scene, settings, free)
+        bands, margin = band_plan(core_scene, settings, free, keeps_history=self.is_animation)
         estimate = memory.banded_estimate(core_scene, settings, bands, margin, keeps_history=self.is_animation)
         if denoising:
             estimate = memory.with_denoising(estimate, settings, keeps_history=self.is_animation)

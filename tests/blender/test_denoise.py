@@ -179,3 +179,21 @@ def test_non_finite_and_negative_input_is_read_as_black(addon):
     noisy[7, 8] = -5.0
     out = denoiser().denoise(noisy)
     assert np.isfinite(out).all() and out.min() >= 0
+
+
+def test_the_denoiser_leaves_its_inputs_untouched(addon):
+    """The passes handed to the denoiser (Combined, Denoising Albedo and Normal, out of range and non-finite) are
+    read, never cleaned in place: the frame keeps them as rendered; the alpha of Combined is kept."""
+    from restir_engine.core.pipeline.denoiser import DenoiseSettings
+    from restir_engine.denoise import denoiser
+    _clean, noisy = _noisy((32, 48))
+    image = np.concatenate([noisy, np.full((32, 48, 1), 0.5, np.float32)], -1)
+    image[1, 2, 0] = np.nan
+    albedo = np.full((32, 48, 3), 1.5, np.float32)
+    normal = np.full((32, 48, 3), -2.0, np.float32)
+    normal[3, 4] = np.nan
+    before = [a.copy() for a in (image, albedo, normal)]
+    out = denoiser().denoise_rgba(image, albedo, normal, DenoiseSettings("RGB_ALBEDO_NORMAL", "ACCURATE", "HIGH"))
+    for a, b in zip((image, albedo, normal), before):
+        np.testing.assert_array_equal(a, b)
+    assert out.shape == image.shape and np.isfinite(out).all() and (out[..., 3] == 0.5).all()

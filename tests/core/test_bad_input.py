@@ -262,17 +262,17 @@ def test_a_frame_that_cannot_fit_is_refused_before_any_work(addon, monkeypatch):
         return with_data_passes(settings_from_scene(cornell), bpy.context.view_layer)
     cornell = cornell_box("EMISSIVE", (64, 48))
     configure_restir(cornell, 1, 1, direct_method="RESTIR", indirect_method="RESTIR_GI")
-    est = memory.frame_estimate(export(), settings())
+    est = memory.frame_estimate(export(), settings(), keeps_history=False)  # F12 of a still keeps no history
     assert est.low == est.high
     monkeypatch.setattr(memory, "available_memory", lambda: est.low - 1)
     with pytest.raises(RuntimeError, match=r"needs about .* MB of memory .* is free.*Path Tracing"):
         render_passes(cornell)
     cornell.restir.integrator = "PATH"
-    assert memory.frame_estimate(export(), settings()).high < est.low
+    assert memory.frame_estimate(export(), settings(), keeps_history=False).high < est.low
     assert np.isfinite(render_passes(cornell)["Combined"]).all()
     cornell.restir.integrator = "RESTIR"
     cornell.restir.direct_method = cornell.restir.indirect_method = "AUTO"
-    auto = memory.frame_estimate(export(), settings())
+    auto = memory.frame_estimate(export(), settings(), keeps_history=False)
     assert auto.low < auto.high
     monkeypatch.setattr(memory, "available_memory", lambda: (auto.low + auto.high) // 2)
     img = render_passes(cornell)["Combined"]
@@ -289,6 +289,13 @@ def test_the_memory_estimate_orders_the_methods():
     auto = memory.per_pixel_range(RenderSettings(integrator="RESTIR", direct_method="AUTO", indirect_method="AUTO"))
     assert path[0] == path[1] < di[0] == di[1] < both[0] == both[1]
     assert auto[0] < auto[1] == both[1]
+    # a still keeps no history: less for each ReSTIR method, nothing less for the path tracer
+    still = {name: memory.per_pixel_range(RenderSettings(**kw), keeps_history=False) for name, kw in (
+        ("path", dict(integrator="PATH")), ("di", dict(integrator="RESTIR", direct_method="RESTIR",
+                                                       indirect_method="PATH")),
+        ("both", dict(integrator="RESTIR", direct_method="RESTIR", indirect_method="RESTIR_GI")))}
+    assert still["path"] == path and still["di"][0] < di[0] and still["both"][0] < both[0]
+    assert path[0] < still["di"][0] < still["both"][0]
 
 
 def _fuzzed_scene(rng):

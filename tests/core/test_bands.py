@@ -76,6 +76,7 @@ def test_band_count_follows_the_memory_budget():
     _low, high = memory.per_pixel_range(st)
     assert n > 1 and high * 3840 * (-(-2160 // n) + 2 * m) <= memory.BAND_BYTES * 1.05
     assert 0 < m <= bands.margin_rows(st, scene.camera)
+    assert bands.plan(scene, st, None, keeps_history=False)[0] < n  # a still holds no second G-buffer: wider bands
     scene.camera = dataclasses.replace(cam, width=7680, height=4320, window=(0, 0, 7680, 4320))
     n8, m8 = bands.plan(scene, st, None)  # 8K: the 97-row radius would dwarf a band: cut to a quarter of it
     assert m8 < bands.margin_rows(st, scene.camera) and 2 * m8 <= (-(-4320 // n8))

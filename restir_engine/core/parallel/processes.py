@@ -107,8 +107,9 @@ class WorkerTeam:
             self.slot_segs = [wire.create_segment(self.slot_bytes) for _ in range(3)]
         return [s.name for s in self.slot_segs]
 
-    def film(self, nbytes: int):
-        """(segment name, zeros(shape) over it): the film's segment, zero-filled, at least ``nbytes``."""
+    def film(self, nbytes: int, dtype):
+        """(segment name, zeros(shape) of ``dtype`` over it): the film's segment, zero-filled, at least
+        ``nbytes``."""
         seg = self.film_seg
         if seg is None or seg.size < nbytes:
             wire.unlink_segments([seg] if seg is not None else [])
@@ -118,7 +119,7 @@ class WorkerTeam:
             view[:] = 0
             del view
         from .team import film_zeros
-        return seg.name, film_zeros(seg)
+        return seg.name, film_zeros(seg, dtype)
 
     # -- messages ------------------------------------------------------------------------------------------------
     def run(self, msg, should_stop=None, timeout: float | None = None, on_poll=None):

@@ -88,11 +88,11 @@ class Arena:
         return np.frombuffer(self.buffer, dtype, count, start).reshape(shape)
 
 
-def film_zeros(segment):
-    """zeros(shape) of a film (pipeline/film.Film) over a zero-filled shared segment: float64 arrays in the order
+def film_zeros(segment, dtype):
+    """zeros(shape) of a film (pipeline/film.Film) over a zero-filled shared segment: ``dtype`` arrays in the order
     asked, so the rendering process and every worker see the same accumulators."""
     arena = Arena(segment.buf, segment.name)
-    return lambda shape: arena.empty(shape, np.float64)
+    return lambda shape: arena.empty(shape, dtype)
 
 
 class Team:

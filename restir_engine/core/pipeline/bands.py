@@ -101,14 +101,15 @@ def render_in_bands(render_one, scene, settings, bands: int, progress=None, shou
     return FrameResult(passes, samples or 0, time.perf_counter() - t0, cancelled, stats, keep)
 
 
-def plan(scene, settings, free: int | None) -> tuple[int, int]:
+def plan(scene, settings, free: int | None, keeps_history: bool = True) -> tuple[int, int]:
     """(bands, margin rows) of a frame of ``scene``: one band while one band's working set (memory.band_budget)
     holds the whole window; else bands whose rows with both margins fit it, each at least MIN_BAND_ROWS tall, the
     margin (the spatial radius) cut to a quarter of what fits where the radius is large against the band (a pixel
-    at a band's edge then reuses from fewer neighbours, as at the image's edge: still unbiased)."""
+    at a band's edge then reuses from fewer neighbours, as at the image's edge: still unbiased). A frame that
+    ``keeps_history`` holds its first pass's G-buffer and reservoirs in each band's working set."""
     _x0, _y0, w, h = scene.camera.window
     budget = memory.band_budget(free)
-    _low, high = memory.per_pixel_range(settings)
+    _low, high = memory.per_pixel_range(settings, keeps_history)
     m = margin_rows(settings, scene.camera)
     if high * w * h <= budget:
         return 1, m

@@ -138,9 +138,10 @@ class Denoiser:
         color = _clean(color)
         guides = {}
         if albedo is not None and settings.input_passes != "RGB":
-            guides["albedo"] = np.clip(_clean(albedo), 0.0, 1.0)
+            guides["albedo"] = _clipped(_clean(albedo), 0.0)
             if normal is not None and settings.input_passes == "RGB_ALBEDO_NORMAL":
-                guides["normal"] = np.clip(np.nan_to_num(np.asarray(normal, np.float32)[..., :3]), -1.0, 1.0)
+                n = np.ascontiguousarray(np.asarray(normal, np.float32)[..., :3])
+                guides["normal"] = _clipped(np.nan_to_num(n, copy=np.shares_memory(n, normal)), -1.0)
         out = np.empty_like(color)
         quality = QUALITY[settings.quality]
         with self._lock:
@@ -158,9 +159,13 @@ class Denoiser:
 
     def denoise_rgba(self, image: np.ndarray, albedo: np.ndarray | None = None, normal: np.ndarray | None = None,
                      settings: DenoiseSettings = DenoiseSettings()) -> np.ndarray:
-        """A float32 copy of the (h, w, 4) ``image`` with its colour denoised (:meth:`denoise`) and its alpha kept."""
-        out = np.array(image, np.float32, copy=True)
-        out[..., :3] = self.denoise(image[..., :3], albedo, normal, settings).reshape(out.shape[:-1] + (3,))
+        """A float32 copy of the (h, w, 4) ``image`` with its colour denoised (:meth:`denoise`) and its alpha kept
+        (the copy made once the denoiser is done, so that it is not held while the denoiser's images are)."""
+        rgb = self.denoise(image[..., :3], albedo, normal, settings)
+        out = np.empty(image.shape, np.float32)
+        out[..., :3] = rgb.reshape(out.shape[:-1] + (3,))
+        del rgb
+        out[..., 3:] = image[..., 3:]
         return out
 
     def close(self) -> None:
@@ -168,6 +173,11 @@ class Denoiser:
             if self._device is not None:
                 self._lib.oidnReleaseDevice(self._device)
                 self._device = None
+
+
+def _clipped(img: np.ndarray, low: float) -> np.ndarray:
+    """``img`` (float32, owned by the caller) clipped to [low, 1] in place."""
+    return np.clip(img, low, 1.0, out=img)
 
 
 def _clean(img: np.ndarray) -> np.ndarray:

@@ -1,7 +1,7 @@
 """The film: running sums of a frame's sample passes and the passes made from them.
 
-Accumulators are float64 (h, w, c) or (h, w) arrays over the camera window, row 0 at the *bottom* (Blender's pass
-order), kept in a pool between frames: a fresh array's pages are faulted in on first write, a reused one is only
+Accumulators are float32 (h, w, c) or (h, w) arrays (:data:`FILM_DTYPE`) over the camera window, row 0 at the
+*bottom* (Blender's pass order), kept in a pool between frames: a fresh array's pages are faulted in on first write, a reused one is only
 zeroed. Keys: emit, direct, indirect (RGB radiance, W·sr⁻¹·m⁻², scene-linear), alpha; res_m, res_w (DI reservoirs'
 M and W); gi_m, gi_w (GI reservoirs'); lg0, lg1, ... (the light of each light group: emission, direct and indirect
 together, lights/groups.py); albedo, dnormal (denoising data: first-hit albedo, camera-space normal);
@@ -21,9 +21,13 @@ from ..parallel.pool import in_worker, pool
 from ..parallel.tasks import map_tasks
 from ..sampling import finite
 
+# the running sums' type: float32 holds a sum of 2^24 samples to a relative 1e-7 per addition (a rounding error
+# far below the noise), and radiance is clamped at export (export/limits.MAX_RADIANCE) so that sums stay finite
+FILM_DTYPE = np.float32
+
 
 class BufferPool:
-    """Float64 accumulators kept between frames (at most ``keep`` free ones)."""
+    """Film accumulators (FILM_DTYPE) kept between frames (at most ``keep`` free ones)."""
 
     def __init__(self, keep: int = 12):
         self.free: list[np.ndarray] = []
@@ -37,7 +41,7 @@ class BufferPool:
                     a = self.free.pop(i)
                     a.fill(0.0)
                     return a
-        return np.zeros(shape, np.float64)
+        return np.zeros(shape, FILM_DTYPE)
 
     def put(self, a: np.ndarray) -> None:
         with self.lock:
@@ -123,7 +127,7 @@ class Film:
             hit = c.hits.rows
             pix = span if len(hit) == len(c.pixels) else c.pixels[hit]  # every pixel hit: no scatter
             chain = None if c.chain is None else c.chain.throughput  # what the glass in front passes
-            rgb = emitted.astype(np.float64) if "aux" in flat else None  # the sample's RGB (adaptive sampling)
+            rgb = emitted.copy() if "aux" in flat else None  # the sample's RGB (adaptive sampling)
             for key, value in (("direct", c.direct), ("indirect", c.indirect)):
                 if value is not None:
                     v = np.ascontiguousarray((value if chain is None else value * chain).T)
@@ -176,7 +180,7 @@ class Film:
             emitted = c.hits.emitted.reshape(3, c.batch, n)
             flat["emit"][span] += emitted.sum(axis=1).T
             flat["alpha"][span] += c.hits.alpha.reshape(c.batch, n).sum(axis=0)
-            rgb = np.ascontiguousarray(emitted.transpose(1, 2, 0), dtype=np.float64) if "aux" in flat else None
+            rgb = np.ascontiguousarray(emitted.transpose(1, 2, 0), dtype=FILM_DTYPE) if "aux" in flat else None
 
             def add_rows(key, value, light=False):  # (3, hits) values of the hit rows, summed into their pixels
                 dense = np.zeros((len(c.pixels), 3), np.float32)

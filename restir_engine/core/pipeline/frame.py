@@ -73,10 +73,13 @@ class FrameRenderer:
     """
 
     def __init__(self, scene: Scene, settings: RenderSettings, history=None, clock=None, team=None,
-                 film_zeros=None):
+                 film_zeros=None, keep_history: bool = True):
         validate(settings)
         t0 = time.perf_counter()
         self.settings = settings
+        # whether the first pass's G-buffer and reservoirs are kept for a next frame or view (a still's are not:
+        # its other passes never read them, and they would hold a second set of the frame's target terms)
+        self.keeps_history = bool(keep_history)
         self.clock = clock or NullClock()
         # the processes rendering this frame's passes together (parallel/team.py; Solo: this one alone), and the
         # film's accumulators where they are shared (Film's ``zeros``)
@@ -249,7 +252,7 @@ class FrameRenderer:
         return self.film.has(key)
 
     def sums(self, key: str):
-        """The film's running sum ``key`` (float64, over the samples done), or None where it is not kept."""
+        """The film's running sum ``key`` (film.FILM_DTYPE, over the samples done), or None where it is not kept."""
         return self.film.acc.get(key)
 
     def release(self) -> None:
@@ -422,7 +425,7 @@ class FrameRenderer:
             gi_res, gi_history = reuse.reuse_gi(run, st, ctx, self.gi, self.gi_space, self.gi_spatial, gb_gi, gi_res,
                                                 self.prev_history, self.reuse_stats)
             hand_back(mine, "gi_res", gi_res)
-        if plan.sample == 0 and gb is not None:
+        if plan.sample == 0 and gb is not None and self.keeps_history:
             self._keep_history(gb, res, gb_gi, gi_history, gi_reused)
         unbiased = st.bias_correction == "UNBIASED"
         with run.stage("shade"):

@@ -31,31 +31,30 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     and a stop keeps the sample passes already completed (raises :class:`Cancelled` if none). ``history`` is the
     result's history of the previous frame (rendered the same way; another kind is not reused).
 
+    ``keep_history``: whether the result carries the frame's temporal history (an animation's next frame needs it,
+    a still's does not, and keeping it holds a second set of the G-buffer and reservoirs while the frame renders).
     ``bands``: horizontal bands the window is rendered in (bands.py; None: as many as keep one band's working set
     within memory.band_budget, 1 for most frames) with ``band_margin`` extra rows each side (None: bands.plan's, or
-    the spatial radius where ``bands`` is given); a banded frame keeps its bands' histories only with
-    ``keep_history`` (an animation's next frame needs them, a still's does not); ``history_slots``: histories worker
-    processes keep (one per band of the banded frame this one belongs to).
+    the spatial radius where ``bands`` is given); ``history_slots``: histories worker processes keep (one per band
+    of the banded frame this one belongs to).
     """
     from . import bands as bands_mod
     if bands is None:
         from . import memory
-        bands, band_margin = bands_mod.plan(scene, settings, memory.available_memory())
+        bands, band_margin = bands_mod.plan(scene, settings, memory.available_memory(), keep_history)
     if bands > 1:
         def one(sc, st, report, stop, hist, clk):
-            result = render_frame(sc, st, report, stop, hist, clk, processes, bands=1,
-                                  history_slots=bands if keep_history else 1)
-            if not keep_history:
-                result.history = None
-            return result
+            return render_frame(sc, st, report, stop, hist, clk, processes, bands=1, keep_history=keep_history,
+                                history_slots=bands if keep_history else 1)
         return bands_mod.render_in_bands(one, scene, settings, bands, progress, should_stop, history, clock,
                                          band_margin)
     team, note = _team(scene, settings, processes)
     if team is not None:
         from .shared_frame import render_frame_shared
-        result = render_frame_shared(scene, settings, team, progress, should_stop, history, clock, history_slots)
+        result = render_frame_shared(scene, settings, team, progress, should_stop, history, clock, history_slots,
+                                     keep_history)
     else:
-        result = _render_here(scene, settings, progress, should_stop, history, clock)
+        result = _render_here(scene, settings, progress, should_stop, history, clock, keep_history)
     if note:
         result.stats["processes_note"] = note
     return result
@@ -85,12 +84,14 @@ def _team(scene: Scene, settings: RenderSettings, processes: int | None):
         return None, f"render worker processes could not start ({exc}): rendering in one process"
 
 
-def _render_here(scene: Scene, settings: RenderSettings, progress, should_stop, history, clock) -> FrameResult:
-    """The frame's sample passes in this process, until its samples, adaptive convergence or Time Limit."""
+def _render_here(scene: Scene, settings: RenderSettings, progress, should_stop, history, clock,
+                 keep_history: bool = True) -> FrameResult:
+    """The frame's sample passes in this process, until its samples, adaptive convergence or Time Limit; the result
+    carries the frame's temporal history where ``keep_history``."""
     if not isinstance(history, TemporalHistory):
         history = None
     t0 = time.perf_counter()
-    fr = FrameRenderer(scene, settings, history, clock)
+    fr = FrameRenderer(scene, settings, history, clock, keep_history=keep_history)
     cancelled = False
     while fr.samples_done < settings.samples and not fr.converged and not out_of_time(settings, t0, fr.samples_done):
         s = fr.samples_done

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from ..modes import DirectMethod, IndirectMethod, Integrator
 from . import methods
 
-BASE = 400        # camera paths, film, passes: the path tracer or light sampling with path-traced indirect light
-DENOISE_DATA = 72  # the denoising data (albedo and normal accumulators, float64, and their passes)
+BASE = 370  # camera paths, film (float32 sums), passes: the path tracer, or light sampling with path-traced indirect
+DENOISE_DATA = 72  # the denoising data (albedo and normal accumulators and their passes)
 DIRECT_REUSE = 720  # DI reservoirs, their target terms and G-buffer, this frame's and the history's
 GI = 800          # GI reservoirs, their target terms and G-buffer, this frame's and the history's
 FIXED = 64 << 20  # bytes that do not grow with the image (tables, pools, the pool's threads)
@@ -44,39 +44,43 @@ class MemoryEstimate:
     render: int = 0   # where the frame is denoised afterwards: the render's own peak (its high), else 0
 
 
-def frame_estimate(scene, settings) -> MemoryEstimate:
-    """The peak memory of rendering ``scene`` (core Scene) with ``settings`` (RenderSettings)."""
+def frame_estimate(scene, settings, keeps_history: bool = True) -> MemoryEstimate:
+    """The peak memory of rendering ``scene`` (core Scene) with ``settings`` (RenderSettings), keeping the frame's
+    temporal history for the next where ``keeps_history``."""
     _x0, _y0, w, h = scene.camera.window
     pixels = int(w) * int(h)
-    low, high = per_pixel_range(settings)
+    low, high = per_pixel_range(settings, keeps_history)
     groups = getattr(scene, "light_groups", None)
-    if groups is not None:  # per light group: a float64 RGB film sum and float32 RGB estimates of the pass's stages
-        low, high = low + len(groups) * 36, high + len(groups) * 60
+    if groups is not None:  # per light group: a float32 RGB film sum and float32 RGB estimates of the pass's stages
+        low, high = low + len(groups) * 24, high + len(groups) * 48
     catchers = getattr(getattr(scene.geometry, "objects", None), "shadow_catcher", None)
     if getattr(settings, "shadow_catcher_pass", False) or (catchers is not None and catchers.any()):
-        low, high = low + 80, high + 116  # shadow catchers: 10 float64 film sums, 3 float32 RGB estimates
+        low, high = low + 40, high + 76  # shadow catchers: 10 float32 film sums, 3 float32 RGB estimates
     scene_bytes = scene_size(scene)
     return MemoryEstimate(FIXED + scene_bytes + low * pixels, FIXED + scene_bytes + high * pixels, pixels,
                           scene_bytes)
 
 
-def per_pixel_range(st) -> tuple[int, int]:
-    """(low, high) bytes per pixel for settings ``st``."""
+def per_pixel_range(st, keeps_history: bool = True) -> tuple[int, int]:
+    """(low, high) bytes per pixel for settings ``st``; a frame that keeps no history (a still) holds no second
+    G-buffer and reservoirs while it renders."""
     low = high = BASE + (DENOISE_DATA if st.denoise_data else 0)
     if st.integrator != Integrator.RESTIR:
         return low, high
     direct = st.direct_method
+    di = DIRECT_REUSE - (0 if keeps_history else HISTORY)
     if direct in (DirectMethod.RESTIR, DirectMethod.RIS) or st.reservoir_passes:
-        low += DIRECT_REUSE
-        high += DIRECT_REUSE
+        low += di
+        high += di
     elif direct == DirectMethod.AUTO:
-        high += DIRECT_REUSE
+        high += di
     if methods.gi_possible(st):
+        gi = GI - (0 if keeps_history else GI_HISTORY)
         if st.indirect_method == IndirectMethod.RESTIR_GI or st.gi_reservoir_passes:
-            low += GI
-            high += GI
+            low += gi
+            high += gi
         elif methods.gi_auto(st):  # the probe's own cost is part of GI's; choosing path tracing costs nothing more
-            high += GI
+            high += gi
     return low, high
 
 
@@ -89,11 +93,11 @@ def banded_estimate(scene, settings, bands: int, margin: int, keeps_history: boo
     """The peak of ``scene`` rendered in ``bands`` bands of ``margin`` extra rows each side: the whole window's film
     and passes (FRAME_WIDE) and histories (where ``keeps_history``), and one band's working set."""
     if bands <= 1:
-        return frame_estimate(scene, settings)
+        return frame_estimate(scene, settings, keeps_history)
     _x0, _y0, w, h = scene.camera.window
     pixels = int(w) * int(h)
     band_pixels = int(w) * min(int(h), -(-int(h) // bands) + 2 * margin)
-    low, high = per_pixel_range(settings)
+    low, high = per_pixel_range(settings, keeps_history)
     hist = history_per_pixel(settings, keeps_history)
     scene_bytes = scene_size(scene)
     whole = FIXED + scene_bytes + (FRAME_WIDE + hist) * pixels

@@ -10,11 +10,13 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..parallel import wire
 from ..parallel.processes import WorkerTeam
 from ..sampling import finite
 from . import methods
-from .film import Film, film_keys
+from .film import FILM_DTYPE, Film, film_keys
 from .shadow_catcher import catcher_triangles, film_mode
 from .frame import Cancelled, FrameResult
 from .frame_render import out_of_time
@@ -54,15 +56,16 @@ def slot_bytes(pixels: int, st: RenderSettings) -> int:
 def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = False, groups: int = 0,
                catchers: bool = False) -> int:
     from ..parallel.team import ALIGN
-    return sum(-(-(w * h * c * 8) // ALIGN) * ALIGN
+    size = np.dtype(FILM_DTYPE).itemsize
+    return sum(-(-(w * h * c * size) // ALIGN) * ALIGN
                for _key, c in film_keys(gi, denoise_data, adaptive, groups, catchers)) + ALIGN
 
 
 def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
-                        history=None, clock=None, keep_histories: int = 1) -> FrameResult:
+                        history=None, clock=None, keep_histories: int = 1, keep_history: bool = True) -> FrameResult:
     """:func:`frame_render.render_frame` on ``team``'s workers (same arguments and result; ``history`` a SharedHistory
     of this team, anything else is not reused); the workers keep the newest ``keep_histories`` histories (one per
-    band of a banded frame)."""
+    band of a banded frame), and this frame's only where ``keep_history``."""
     validate(settings)
     t0 = time.perf_counter()
     with team.lock:
@@ -74,7 +77,7 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         group_names = () if lg is None else tuple(lg.names)
         catchers = film_mode(settings, catcher_triangles(scene) is not None)
         film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data, adaptive, len(group_names),
-                                                catchers is not None))
+                                                catchers is not None), FILM_DTYPE)
         film = Film(w, h, gi, settings.denoise_data, zeros, adaptive, group_names, catchers)
         slots = team.ensure_slots(slot_bytes(w * h, settings))
         usable = isinstance(history, SharedHistory) and history.team == team.id and history.fits(cam)
@@ -82,7 +85,7 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         try:
             team.run(("frame", {"scene": packed, "settings": wire.dumps(settings), "sender": wire.core_name(),
                                 "history": history.token if usable else None, "film": film_name, "slots": slots,
-                                "keep_histories": int(keep_histories),
+                                "keep_histories": int(keep_histories), "keep_history": bool(keep_history),
                                 "costs": team.costs_seg.name, "clock": clock is not None}))
         finally:  # every worker attached (or the team is gone): the name is no longer needed
             wire.unlink_segments([seg])

@@ -21,6 +21,7 @@ import numpy as np
 from ..parallel import wire
 from ..parallel.pool import set_thread_count
 from ..parallel.team import Arena, Team, film_zeros
+from .film import FILM_DTYPE
 
 KEEP_SCENES = 3  # scene segments a worker keeps attached (a context may still refer to the last frames' arrays)
 KEEP_HISTORIES = 1  # temporal histories a worker keeps by default: the last frame's (a banded frame: one per band)
@@ -57,7 +58,7 @@ class _Worker:
             if self.film_seg is not None:
                 self._drop([self.film_seg])
             self.film_seg = wire.attach_segment(name)
-        return film_zeros(self.film_seg)
+        return film_zeros(self.film_seg, FILM_DTYPE)
 
     def _drop(self, segs) -> None:
         for seg in segs:
@@ -78,7 +79,8 @@ class _Worker:
         self.keep_histories = max(KEEP_HISTORIES, int(frame.get("keep_histories", KEEP_HISTORIES)))
         self.clock = StageClock() if frame["clock"] and self.team.leader else None
         self.scene = scene
-        self.fr = FrameRenderer(scene, settings, history, self.clock, team=self.team, film_zeros=zeros)
+        self.fr = FrameRenderer(scene, settings, history, self.clock, team=self.team, film_zeros=zeros,
+                                keep_history=frame.get("keep_history", True))
         return {"build_seconds": self.fr.build_seconds}
 
     def sample_pass(self, left: int):
