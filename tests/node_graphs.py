@@ -443,6 +443,24 @@ def light_path(output="Is Camera Ray"):
     return graph
 
 
+def wireframe(size, pixel_size=False, turn=0.0):
+    """The Wireframe node's Fac of a plane turned by ``turn`` about the view axis (its two triangles' edges), scaled
+    to 0.7 so that its corners stay inside its own cell."""
+    def graph(tree, socket):
+        w = _node(tree, "ShaderNodeWireframe", use_pixel_size=pixel_size)
+        _set(w, "Size", size)
+        mix = _node(tree, "ShaderNodeMix", data_type="RGBA")  # lines over a grey ground (every cell lit)
+        _link(tree, w.outputs["Fac"], mix.inputs["Factor"])
+        _in(mix, "A_Color").default_value = (0.2, 0.3, 0.4, 1.0)
+        _in(mix, "B_Color").default_value = (0.9, 0.8, 0.7, 1.0)
+        _link(tree, _out(mix, "Result_Color"), socket)
+    def setup(obj):
+        obj.rotation_euler = (0, 0, turn)
+        obj.scale = (0.7, 0.7, 0.7)
+    graph.setup = setup
+    return graph
+
+
 def pass_index(output, value):
     """Object Info's Object / Material Index over 8, the object's / material's Pass Index set to ``value``."""
     def graph(tree, socket):
@@ -479,6 +497,7 @@ INPUTS = [
     ("tangent tilted", geometry("Tangent", 0.6)),
     ("object index", pass_index("Object Index", 3)), ("material index", pass_index("Material Index", 5)),
     ("light path camera", light_path()),
+    ("wireframe", wireframe(0.12, turn=0.3)), ("wireframe pixel size", wireframe(2.0, pixel_size=True, turn=-0.2)),
 ]
 
 def _vabs(tree, out):

@@ -99,6 +99,11 @@ def _layer_weight(g, node, f):
     return {"Fresnel": fr, "Facing": fa}
 
 
+def _wireframe(g, node, f):
+    return {"Fac": g.emit("wireframe", {"pixel_size": bool(node.use_pixel_size)},
+                          [g.inp(node, "Size", "float", f)], ("float",))[0]}
+
+
 def _value(g, node, f):
     return {"Value": g.constant(node.outputs[0].default_value, "float")}
 
@@ -432,5 +437,5 @@ HANDLERS = {
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
     "TEX_BRICK": _brick, "BLACKBODY": _blackbody, "LIGHT_FALLOFF": _light_falloff,
-    "AMBIENT_OCCLUSION": _ambient_occlusion, "BEVEL": _bevel,
+    "AMBIENT_OCCLUSION": _ambient_occlusion, "BEVEL": _bevel, "WIREFRAME": _wireframe,
 }

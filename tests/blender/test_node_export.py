@@ -41,13 +41,13 @@ def test_varying_graph_becomes_a_program_and_unsupported_nodes_are_named(addon):
     def wire(tree, bsdf):
         n = _node(tree, "ShaderNodeTexNoise")
         tree.links.new(n.outputs["Fac"], bsdf.inputs["Roughness"])
-        v = _node(tree, "ShaderNodeWireframe")
-        tree.links.new(v.outputs["Fac"], bsdf.inputs["Base Color"])
+        v = _node(tree, "ShaderNodeTexSky")
+        tree.links.new(v.outputs["Color"], bsdf.inputs["Base Color"])
     sc, _ = _principled_plane(wire)
     i = sc.materials.names.index("Wired")
     prog = sc.materials.programs[sc.materials.program[i]]
-    assert set(prog.outputs) == {"roughness"}  # the Wireframe node is not supported: a constant, reported
-    assert any("Wireframe" in w and "not supported" in w for w in sc.warnings)
+    assert set(prog.outputs) == {"roughness"}  # the Sky Texture is not supported on a surface: a constant, reported
+    assert any("Sky Texture" in w and "not supported" in w for w in sc.warnings), sc.warnings
 
 
 def test_node_programs_render_the_same_in_worker_processes(addon):

@@ -90,3 +90,25 @@ def test_program_evaluates_per_hit_and_constants_broadcast():
     np.testing.assert_allclose(out["roughness"], [0.2, 1.0, 0.4], atol=1e-6)
     assert out["base_color"].shape == (3, 3)
     assert float(evaluate_constant("math", {"op": "ADD"}, F(1), F(2), F(0))) == 3.0
+
+
+def test_wireframe_marks_points_within_half_the_size_of_an_edge_line():
+    """A right triangle with legs of 2 along x and y (edges y = 0, x = 0 and x + y = 2): Fac is 1 exactly where the
+    distance to the nearest edge line is below half of Size (world units), or of Size times the footprint with Pixel
+    Size; 0 in a world (no edges)."""
+    from restir_engine.core.materials.nodes.attributes import DirectionAttributes
+    verts = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0]]], F)
+    tris = TriangleSet(verts, np.tile(F([0, 0, 1]), (1, 3, 1)), np.zeros(1, np.int32))
+    # points (x, y) = 2 (b1, b2): distances to the nearest edge 0.038, 0.06, 0.104 (y), 0.09 (x), 0.5 (centre-ish),
+    # 0.0354 from the hypotenuse
+    b1 = F([0.5, 0.5, 0.5, 0.045, 0.3, 0.475])
+    b2 = F([0.019, 0.03, 0.052, 0.5, 0.25, 0.5])
+    dist = np.minimum(np.minimum(2 * b1, 2 * b2), (2 - 2 * b1 - 2 * b2) / np.sqrt(2))
+    attrs = HitAttributes(tris, np.zeros(len(b1), int), b1, b2, [], footprint=F([0.01] * len(b1)))
+    for size, pixel in ((0.1, False), (0.2, False), (10.0, True), (8.0, True)):
+        half = 0.5 * size * (0.01 if pixel else 1.0)
+        got = ops_texture.wireframe(attrs, {"pixel_size": pixel}, F(size))
+        np.testing.assert_array_equal(got, (dist < half).astype(F), err_msg=f"size {size} pixel {pixel}")
+        assert 0 < got.sum() < len(b1)
+    world = DirectionAttributes(np.tile(F([[0], [0], [1]]), (1, 4)), [])
+    np.testing.assert_array_equal(ops_texture.wireframe(world, {}, F(1.0)), np.zeros(4, F))

@@ -36,11 +36,12 @@ def triangle_geometry(verts: np.ndarray):
 
 
 def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarray,
-                     b1: np.ndarray, b2: np.ndarray, wo: np.ndarray | None = None, camera_ray: bool = False
-                     ) -> np.ndarray:
+                     b1: np.ndarray, b2: np.ndarray, wo: np.ndarray | None = None, camera_ray: bool = False,
+                     footprint: np.ndarray | None = None) -> np.ndarray:
     """Emitted radiance (3, n) rows, W·sr⁻¹·m⁻², at barycentrics (b1, b2) of triangles ``tri``, towards unit
     directions ``wo`` (3, n) where a node program reads the view (Layer Weight, Fresnel, Incoming, Backfacing;
-    without ``wo`` the view is along the surface normal); ``camera_ray``: seen by camera rays (Light Path)."""
+    without ``wo`` the view is along the surface normal); ``camera_ray``: seen by camera rays (Light Path);
+    ``footprint`` (n,): the pixel's width there (scene units), where known."""
     mat = tris.material[tri]
     le = np.take(materials.emission, mat, axis=0)
     if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
@@ -50,7 +51,7 @@ def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarra
     le = np.ascontiguousarray(le.T, dtype=np.float32)
     for rows, out in run_programs(materials, mat, lambda r: HitAttributes(
             tris, tri[r], b1[r], b2[r], materials.textures, wo=None if wo is None else cols(wo, r),
-            camera_ray=camera_ray), ("emission",)):
+            camera_ray=camera_ray, footprint=None if footprint is None else footprint[r]), ("emission",)):
         le[:, rows] = out["emission"]
     return le
 

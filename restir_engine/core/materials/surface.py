@@ -81,7 +81,11 @@ class Surface:
 
     def _attributes(self, ctx, r, wo, **given) -> HitAttributes:
         """What node programs read at hits ``r`` (indices): the view ``wo`` (3, k) and whatever else is ``given``
-        (normals, footprint), whether they are camera hits, and the ray length."""
+        (normals), the pixel's footprint at the ray's length (:func:`pixel_spread`), whether they are camera hits,
+        and the ray length."""
+        if given.get("footprint") is None:
+            spread = pixel_spread(ctx.scene.camera)
+            given["footprint"] = spread[0] + spread[1] * np.asarray(self._t, np.float32)[r]
         return HitAttributes(ctx.scene.geometry, self.prim[r], self.b1[r], self.b2[r], ctx.scene.materials.textures,
                              wo=wo, camera_ray=self.camera, ray_length=np.asarray(self._t, np.float32)[r], **given)
 

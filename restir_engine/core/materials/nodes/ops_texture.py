@@ -58,6 +58,29 @@ def fresnel(attrs, params, ior, normal):
     return _fresnel_dielectric(_dot(attrs.get("incoming"), f32(normal)), eta)
 
 
+def wireframe(attrs, params, size):
+    """Wireframe node: 1 where the hit lies within half of ``size`` of a line through one of its triangle's edges,
+    else 0 (world units; with ``params["pixel_size"]`` Size counts pixels: times the width of the pixel's footprint
+    there). Edges are the triangles' (a quad shows its diagonal, as Cycles renders triangles); a world
+    has no edges (0)."""
+    prim = getattr(attrs, "prim", None)
+    if prim is None:
+        return np.zeros(len(attrs), np.float32)
+    corners = np.take(attrs.tris.verts, prim, axis=0)  # (n, 3 corners, 3)
+    p = attrs.get("position")
+    half = _F(0.5) * f32(size)
+    if params.get("pixel_size"):  # Size in pixels: the pixel's width at the hit
+        half = half * attrs.get("footprint")
+    limit = half * half
+    near = np.zeros(len(prim), bool)
+    for i in range(3):
+        a = corners[:, i].T
+        edge = corners[:, (i + 1) % 3].T - a
+        c = np.cross(edge.T, (p - a).T).T  # |edge x (p - a)|² = |edge|² · distance² to the edge's line
+        near |= _dot(c, c) < _dot(edge, edge) * limit
+    return near.astype(np.float32)
+
+
 def layer_weight(attrs, params, blend, normal):
     """Layer Weight node: (Fresnel, Facing) for a Blend in [0, 1]."""
     blend = f32(blend)
@@ -331,8 +354,8 @@ OPERATIONS = {
     "layer_weight": layer_weight, "mapping": mapping, "vector_rotate": vector_rotate, "image": image_texture,
     "environment": environment_texture, "noise": noise_texture, "white_noise": white_noise,
     "checker": checker, "gradient": gradient, "color_ramp": color_ramp, "rgb_curves": rgb_curves,
-    "float_curve": float_curve,
+    "float_curve": float_curve, "wireframe": wireframe,
 }
 #: operations that read the hits: never folded into constants at export
 READS_HITS = frozenset({"attribute", "fresnel", "layer_weight", "image", "environment", "camera_coords",
-                        "window_coords"})
+                        "window_coords", "wireframe"})
