@@ -65,6 +65,7 @@ class ObjectTable:
     pass_index: np.ndarray = None  # (k,) float32 the object's Pass Index (Object Info > Object Index)
     shadow_catcher: np.ndarray = None  # (k,) bool: Object > Visibility > Mask > Shadow Catcher (pipeline/shadow_catcher.py)
     casts_shadow: np.ndarray = None  # (k,) bool: Object > Visibility > Ray Visibility > Shadow (off: shadow rays pass)
+    camera_visible: np.ndarray = None  # (k,) bool: ... > Ray Visibility > Camera (off: camera rays pass)
 
 
 @dataclass

@@ -288,13 +288,15 @@ def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None
                                                          bool(getattr(obj, "is_holdout", False)),
                                                          float(getattr(obj, "pass_index", 0)),
                                                          bool(getattr(obj, "is_shadow_catcher", False)),
-                                                         bool(getattr(obj, "visible_shadow", True)))))
-        unseen = [f for f in ("camera", "glossy", "transmission") if not getattr(obj, f"visible_{f}", True)]
+                                                         bool(getattr(obj, "visible_shadow", True)),
+                                                         bool(getattr(obj, "visible_camera", True)))))
+        unseen = [f for f in ("glossy", "transmission") if not getattr(obj, f"visible_{f}", True)]
         if unseen and obj.name not in unsupported_visibility:
             unsupported_visibility[obj.name] = unseen
     if unsupported_visibility:
         names = list(unsupported_visibility)
-        warnings.append(f"Object > Visibility > Ray Visibility: only Shadow is honoured; {', '.join(names[:3])}"
+        warnings.append(f"Object > Visibility > Ray Visibility: only Camera and Shadow are honoured; "
+                        f"{', '.join(names[:3])}"
                         f"{' and others' if len(names) > 3 else ''} stay visible to "
                         f"{', '.join(sorted({f for v in unsupported_visibility.values() for f in v}))} rays")
 
@@ -450,7 +452,8 @@ def _object_table(blocks) -> ObjectTable:
                        holdout=np.array([b[5][4] for b in blocks], bool),
                        pass_index=np.array([b[5][5] for b in blocks], np.float32),
                        shadow_catcher=np.array([b[5][6] for b in blocks], bool),
-                       casts_shadow=np.array([b[5][7] for b in blocks], bool))
+                       casts_shadow=np.array([b[5][7] for b in blocks], bool),
+                       camera_visible=np.array([b[5][8] for b in blocks], bool))
 
 
 def asset_name(obj) -> str:

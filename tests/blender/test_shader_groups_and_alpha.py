@@ -339,7 +339,7 @@ def test_transparent_shadows_setting(addon, transparent_shadows):
 
 def test_objects_that_cast_no_shadow(addon):
     """Object > Visibility > Ray Visibility > Shadow off: an opaque sheet between the sun and the floor lets the
-    whole sun through to the floor (L = 0.8/π x E exactly: no random cut-out here), as Cycles; camera visibility,
+    whole sun through to the floor (L = 0.8/π x E exactly: no random cut-out here), as Cycles; glossy visibility,
     which is not honoured, is named in a warning."""
     scene = _sunlit_floor()
     sheet = plane("Sheet", 8.0, (0, 0, 1))
@@ -348,9 +348,31 @@ def test_objects_that_cast_no_shadow(addon):
     assert float(render_passes(scene)["Combined"][..., :3].mean()) < 1e-6  # the sheet's shadow
     sheet.visible_shadow = False
     np.testing.assert_allclose(render_passes(scene)["Combined"][..., :3], 0.8 / math.pi, rtol=1e-4)
-    sheet.visible_camera = False
+    sheet.visible_glossy = False
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
-    assert any("Ray Visibility" in w and "Sheet" in w and "camera" in w for w in sc.warnings)
+    assert any("Ray Visibility" in w and "Sheet" in w and "glossy" in w for w in sc.warnings)
+
+
+@pytest.mark.parametrize("integrator", ["PATH", "RESTIR"])
+def test_objects_the_camera_does_not_see(addon, integrator):
+    """Object > Visibility > Ray Visibility > Camera off: a sheet over the left half of the floor, between the
+    camera and the floor, is not seen (Depth is the floor's 0.5 everywhere instead of the sheet's 0.25) and still
+    shadows the floor (left half black, right half lit by the sun alone: L = 0.8/π x E, 1 bounce, no random
+    cut-out), as Cycles; seen by the camera, it covers the left half (Depth 0.25)."""
+    scene = _sunlit_floor()
+    sheet = plane("Blocker", 2.0, (-1, 0, 0.25))
+    scene.view_layers[0].use_pass_z = True
+    configure_restir(scene, 4, 1, seed=5, integrator=integrator)
+    seen = render_passes(scene)
+    np.testing.assert_allclose(seen["Depth"][:, :8], 0.25, rtol=1e-4)
+    sheet.visible_camera = False
+    hidden = render_passes(scene)
+    np.testing.assert_allclose(hidden["Depth"], 0.5, rtol=1e-4)
+    img = hidden["Combined"][..., :3]
+    assert float(img[:, :8].max()) < 1e-6  # the floor in the hidden sheet's shadow
+    np.testing.assert_allclose(img[:, 8:], 0.8 / math.pi, rtol=1e-3)
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    assert not any("Ray Visibility" in w for w in sc.warnings)
 
 
 def test_udim_images_are_named(addon):

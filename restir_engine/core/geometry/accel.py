@@ -97,23 +97,26 @@ class Accel:
         return [(s, min(n, s + CHUNK_RAYS)) for s in range(0, n, CHUNK_RAYS)]
 
     def intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None,
-                  shadow: bool = False) -> Hits:
+                  shadow: bool = False, camera: bool = False) -> Hits:
         """Closest hit of each ray (origins/directions (3, n) float32 rows; directions need not be unit,
         ``t`` is then in units of the direction length), through transparent cut-out points (for ``shadow``
-        rays only those of materials with transparent shadows)."""
+        rays only those of materials with transparent shadows) and, for ``camera`` rays, through objects the
+        camera does not see."""
         hits = self._intersect(origins, directions, tmax)
         if self.cutout is not None:
-            self._pass_through(hits, origins, directions, tmax, shadow)
+            self._pass_through(hits, origins, directions, tmax, shadow, camera)
         return hits
 
-    def _pass_through(self, hits: Hits, o: np.ndarray, d: np.ndarray, tmax, shadow: bool = False) -> None:
+    def _pass_through(self, hits: Hits, o: np.ndarray, d: np.ndarray, tmax, shadow: bool = False,
+                      camera: bool = False) -> None:
         """Replace hits on transparent cut-out points by what lies behind them (in place; t stays measured from
         the original origins)."""
         for _layer in range(MAX_CUTOUT_LAYERS):
             live = np.flatnonzero(hits.prim >= 0)
             if live.size == 0:
                 return
-            go = live[~self.cutout.opaque(hits.prim[live], hits.u[live], hits.v[live], cols(d, live), shadow)]
+            go = live[~self.cutout.opaque(hits.prim[live], hits.u[live], hits.v[live], cols(d, live), shadow,
+                                          camera)]
             if go.size == 0:
                 return
             t = hits.t[go]
@@ -124,7 +127,10 @@ class Accel:
             sub = self._intersect(o2, dg, far)
             hit = sub.prim >= 0
             hits.prim[go] = sub.prim
-            hits.t[go] = np.where(hit, sub.t + t, np.inf)
+            # t from the original origin: the offset of o2 along the ray counted (its part across the ray moves
+            # the hit by the offset's size, far below a pixel)
+            along = dot(o2 - p, dg) / np.maximum(dot(dg, dg), np.float32(1e-30))
+            hits.t[go] = np.where(hit, sub.t + t + along, np.inf)
             hits.u[go] = sub.u
             hits.v[go] = sub.v
 

@@ -60,12 +60,13 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
     cam = ctx.scene.camera
     o, d, tmax = camera_mod.generate_rays(cam, x, y, lens_uv)
     if may_hit is None or may_hit.all():
-        hits = ctx.geom_accel.intersect(o, d, tmax)
+        hits = ctx.geom_accel.intersect(o, d, tmax, camera=True)
     else:
         hits = Hits(len(x))
         idx = np.flatnonzero(may_hit)
         if idx.size:
-            sub = ctx.geom_accel.intersect(cols(o, idx), cols(d, idx), None if tmax is None else tmax[idx])
+            sub = ctx.geom_accel.intersect(cols(o, idx), cols(d, idx), None if tmax is None else tmax[idx],
+                                           camera=True)
             hits.prim[idx], hits.t[idx], hits.u[idx], hits.v[idx] = sub.prim, sub.t, sub.u, sub.v
     emitted, alpha, emitted_g = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
     rows = np.flatnonzero(hits.prim >= 0)
@@ -103,7 +104,7 @@ def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray, lens_uv: np.n
     alpha (n,) and the emission by light group (G, 3, n) or None: the part of :func:`primary` that needs no surface
     (extra rays per pixel for pixel coverage)."""
     o, d, tmax = camera_mod.generate_rays(ctx.scene.camera, x, y, lens_uv)
-    return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax))
+    return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax, camera=True))
 
 
 def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: np.ndarray | None = None):
@@ -238,7 +239,7 @@ def gbuffer(ctx: TraceContext, x: np.ndarray, y: np.ndarray):
     (zero without neighbouring-frame data or where nothing is hit)."""
     cam = ctx.scene.camera
     o, d, tmax = camera_mod.generate_rays(cam, x, y)
-    hits = ctx.geom_accel.intersect(o, d, tmax)
+    hits = ctx.geom_accel.intersect(o, d, tmax, camera=True)
     depth = np.full(len(x), 1e10, np.float32)
     normal = np.zeros((len(x), 3), np.float32)
     vector = np.zeros((len(x), 4), np.float32)

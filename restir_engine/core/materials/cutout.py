@@ -34,7 +34,8 @@ class Cutout:
         self.cut = (self.alpha < 1) | (self.tex >= 0) | self.program
         shadows = getattr(materials, "transparent_shadow", None)
         self.shadow_cut = self.cut & (shadows[mat] if shadows is not None else True)
-        self.shadow_pass = _shadowless(geometry)  # (n,) bool or None: triangles shadow rays ignore
+        self.shadow_pass = _passed_by(geometry, "casts_shadow")  # (n,) bool or None: triangles shadow rays ignore
+        self.camera_pass = _passed_by(geometry, "camera_visible")  # ... and camera rays
         self.uvs = geometry.uvs
         self.textures = materials.textures
         self.geometry, self.materials = geometry, materials
@@ -47,10 +48,11 @@ class Cutout:
             return None
         programs = getattr(materials, "alpha_program", None)
         if not ((a < 1).any() or (materials.alpha_tex >= 0).any() or (programs is not None and programs.any())
-                or _shadowless(geometry) is not None):
+                or _passed_by(geometry, "casts_shadow") is not None
+                or _passed_by(geometry, "camera_visible") is not None):
             return None
         c = Cutout(geometry, materials)
-        return c if c.cut.any() or c.shadow_pass is not None else None
+        return c if c.cut.any() or c.shadow_pass is not None or c.camera_pass is not None else None
 
     def with_geometry(self, geometry) -> "Cutout":
         """The same test on ``geometry``, the same triangles with moved corners (node programs read its positions
@@ -61,13 +63,16 @@ class Cutout:
         return out
 
     def opaque(self, prim: np.ndarray, u: np.ndarray, v: np.ndarray, d: np.ndarray | None = None,
-               shadow: bool = False) -> np.ndarray:
+               shadow: bool = False, camera: bool = False) -> np.ndarray:
         """(n,) bool for hits (prim >= 0) at barycentrics (u, v) of rays along ``d`` (3, n) (node programs read
         the view from it: Backfacing, Incoming; None: unknown). For ``shadow`` rays a material whose Transparent
-        Shadows setting is off is opaque everywhere, as in Cycles."""
+        Shadows setting is off is opaque everywhere, as in Cycles; ``camera`` rays pass objects the camera does
+        not see, shadow rays those that cast no shadow."""
         out = np.ones(len(prim), bool)
         if shadow and self.shadow_pass is not None:
             out[self.shadow_pass[prim]] = False  # an object that casts no shadow: shadow rays pass it
+        if camera and self.camera_pass is not None:
+            out[self.camera_pass[prim]] = False
         sel = np.flatnonzero((self.shadow_cut if shadow else self.cut)[prim] & out)
         if sel.size == 0:
             return out
@@ -102,10 +107,11 @@ class Cutout:
         return out
 
 
-def _shadowless(geometry):
-    """(n,) bool of the triangles whose object casts no shadow (Ray Visibility > Shadow off), or None if none."""
+def _passed_by(geometry, flag: str):
+    """(n,) bool of the triangles whose object's ``flag`` (ObjectTable.casts_shadow: Ray Visibility > Shadow,
+    camera_visible: > Camera) is off, or None if none."""
     objects, inst = getattr(geometry, "objects", None), getattr(geometry, "instance", None)
-    flags = getattr(objects, "casts_shadow", None) if objects is not None else None
+    flags = getattr(objects, flag, None) if objects is not None else None
     if flags is None or inst is None or flags.all():
         return None
     return ~flags[inst]

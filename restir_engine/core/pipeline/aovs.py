@@ -23,7 +23,7 @@ def render_aovs(ctx, aovs, samples: int, seed: int = 0, frame: int = 0) -> dict:
     if index is not None and (index >= 0).any():
         fields = {name: (f"aov:{name}" if kind == "COLOR" else f"aov_value:{name}") for name, kind in aovs}
         for o, d, tmax in camera_ray_sets(cam, k, seed, frame, STREAM_AOV_RAYS):
-            hits = ctx.geom_accel.intersect(o, d, tmax)
+            hits = ctx.geom_accel.intersect(o, d, tmax, camera=True)
             rows = np.flatnonzero(hits.prim >= 0)
             prog = index[geom.material[hits.prim[rows]]]
             for p in np.unique(prog[prog >= 0]):

@@ -91,7 +91,7 @@ def render_cryptomatte(ctx, kinds, depth: int, samples: int, seed: int = 0, fram
         block = np.arange(lo, min(lo + BLOCK_PIXELS, n_pix))
         prims = np.empty((k, len(block)), np.int32)
         for s, (o, d, tmax) in enumerate(camera_ray_sets(cam, k, seed, frame, STREAM_CRYPTO_RAYS, block)):
-            prims[s] = ctx.geom_accel.intersect(o, d, tmax).prim
+            prims[s] = ctx.geom_accel.intersect(o, d, tmax, camera=True).prim
         for kind in kinds:
             names, tri_name = tables[kind]
             ids = np.where(prims >= 0, tri_name[np.maximum(prims, 0)], -1)  # (k, block pixels)
