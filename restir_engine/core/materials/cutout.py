@@ -6,7 +6,8 @@ value t or 1 - t at the hit's UV, times its node program's "alpha" at the hit) a
 behind it. The decision is a hash of the hit (triangle and barycentrics, salted apart from the Mix pick), so every
 ray that reaches the same point agrees (a shadow ray is blocked exactly where a camera ray would stop), and over the
 points of a pixel the surface covers a fraction α of them: Cycles' transparency of a white Transparent BSDF, on
-average.
+average. Objects whose Ray Visibility excludes a kind of ray are passed the same way by that kind: shadow rays pass
+objects that cast no shadow, camera rays objects the camera does not see.
 """
 from __future__ import annotations
 
