@@ -230,3 +230,25 @@ def _mark_boxes(cam: Camera, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     np.add.at(diff, (by1[ok], bx0[ok]), -1)
     np.add.at(diff, (by1[ok], bx1[ok]), 1)
     return np.cumsum(np.cumsum(diff, axis=0), axis=1)[:h, :w] > 0
+
+
+def pixel_spread(camera) -> tuple:
+    """A pixel's footprint on a surface at distance t from the camera ≈ a + b t (scene units): the width of a
+    pixel on the image plane at unit distance (perspective) or on the view plane (orthographic)."""
+    if camera is None:
+        return (np.float32(0.0), np.float32(1e-3))
+    if getattr(camera, "panorama", None) is not None:  # about a full turn over the frame's width
+        return (np.float32(0.0), np.float32(2 * np.pi / max(camera.width, 1)))
+    m = np.asarray(camera.ndc_to_cam, np.float64)
+    lo, hi = m @ np.array([0.0, -1.0, -1.0, 1.0]), m @ np.array([0.0, 1.0, -1.0, 1.0])
+    lo, hi = lo[:3] / lo[3], hi[:3] / hi[3]
+    if camera.ortho:
+        return (np.float32(abs(hi[1] - lo[1]) / max(camera.height, 1)), np.float32(0.0))
+    tan = abs(hi[1] / hi[2] - lo[1] / lo[2]) if abs(hi[2]) > 0 and abs(lo[2]) > 0 else 1.0
+    return (np.float32(0.0), np.float32(tan / max(camera.height, 1)))
+
+
+def pixel_footprint(camera, t) -> np.ndarray:
+    """(n,) float32: a pixel's footprint (scene units) at distances ``t`` (n,) from ``camera`` (pixel_spread)."""
+    a, b = pixel_spread(camera)
+    return a + b * np.asarray(t, np.float32)

@@ -12,7 +12,7 @@ from ..geometry.accel import Hits
 from ..lights import groups as light_groups
 from ..lights.table import emitted_radiance
 from ..materials import volume
-from ..materials.surface import Surface, pixel_spread
+from ..materials.surface import Surface
 from ..sampling import cols, finite
 from .pathtracer import _lamp_emission, lamp_hits, sample_rays
 from .trace_context import TraceContext
@@ -145,10 +145,7 @@ def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: n
         prim = np.maximum(hits.prim, 0)
         em = np.flatnonzero((hits.prim >= 0) & (ctx.lights.geom_to_light[prim] >= 0))
         if em.size:
-            footprint = None
-            if ctx.has_programs:
-                spread = pixel_spread(ctx.scene.camera)
-                footprint = spread[0] + spread[1] * np.asarray(hits.t, np.float32)[em]
+            footprint = camera_mod.pixel_footprint(ctx.scene.camera, hits.t[em]) if ctx.has_programs else None
             le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, prim[em], hits.u[em], hits.v[em],
                                   -cols(d, em) if ctx.has_programs else None, camera, footprint)
             emitted[:, em] += le

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.camera import pixel_footprint
 from ..sampling import barycentric, cols, dot, norm, orthonormal_basis
 from . import microfacet_tables
 from .bsdf import ViewTerms
@@ -21,22 +22,6 @@ from .textures import apply_texture, gradient, sample
 
 #: the BSDF fields a material's node program may compute (scene.MaterialTable.program)
 PARAM_FIELDS = ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness")
-
-
-def pixel_spread(camera) -> tuple:
-    """A pixel's footprint on a surface at distance t from the camera ≈ a + b t (scene units): the width of a
-    pixel on the image plane at unit distance (perspective) or on the view plane (orthographic)."""
-    if camera is None:
-        return (np.float32(0.0), np.float32(1e-3))
-    if getattr(camera, "panorama", None) is not None:  # about a full turn over the frame's width
-        return (np.float32(0.0), np.float32(2 * np.pi / max(camera.width, 1)))
-    m = np.asarray(camera.ndc_to_cam, np.float64)
-    lo, hi = m @ np.array([0.0, -1.0, -1.0, 1.0]), m @ np.array([0.0, 1.0, -1.0, 1.0])
-    lo, hi = lo[:3] / lo[3], hi[:3] / hi[3]
-    if camera.ortho:
-        return (np.float32(abs(hi[1] - lo[1]) / max(camera.height, 1)), np.float32(0.0))
-    tan = abs(hi[1] / hi[2] - lo[1] / lo[2]) if abs(hi[2]) > 0 and abs(lo[2]) > 0 else 1.0
-    return (np.float32(0.0), np.float32(tan / max(camera.height, 1)))
 
 
 class Surface:
@@ -57,7 +42,7 @@ class Surface:
         mat, scale, tint = self._pick_mix_components(ctx, mat, d)
         ng = cols(ctx.geom_ng_rows, prim)
         ns = self._interpolated_normal(ctx, ng)
-        ns, mapped, smooth_n = self._mapped_normal(ctx, mat, ns, ng, d, t)
+        ns, mapped, smooth_n = self._mapped_normal(ctx, mat, ns, ng, d)
         # shading normal on the geometric normal's side, both facing the incoming ray
         s_ng = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
         s_ns = np.where(dot(ns, ng) < 0, -s_ng, s_ng)
@@ -81,11 +66,10 @@ class Surface:
 
     def _attributes(self, ctx, r, wo, **given) -> HitAttributes:
         """What node programs read at hits ``r`` (indices): the view ``wo`` (3, k) and whatever else is ``given``
-        (normals), the pixel's footprint at the ray's length (:func:`pixel_spread`), whether they are camera hits,
-        and the ray length."""
+        (normals), the pixel's footprint at the ray's length (geometry.camera.pixel_footprint), whether they are
+        camera hits, and the ray length."""
         if given.get("footprint") is None:
-            spread = pixel_spread(ctx.scene.camera)
-            given["footprint"] = spread[0] + spread[1] * np.asarray(self._t, np.float32)[r]
+            given["footprint"] = pixel_footprint(ctx.scene.camera, np.asarray(self._t, np.float32)[r])
         return HitAttributes(ctx.scene.geometry, self.prim[r], self.b1[r], self.b2[r], ctx.scene.materials.textures,
                              wo=wo, camera_ray=self.camera, ray_length=np.asarray(self._t, np.float32)[r], **given)
 
@@ -141,7 +125,7 @@ class Surface:
             ns[:, bad] = ng[:, bad]
         return ns
 
-    def _mapped_normal(self, ctx, mat, ns, ng, d, t):
+    def _mapped_normal(self, ctx, mat, ns, ng, d):
         """Normal Map and Bump nodes applied to ``ns`` (in place): the image-only forms (normal_tex, bump_tex) and
         node programs' "normal". Returns (ns, the hits they changed or None, those hits' smooth normals before
         mapping (3, k) or None)."""
@@ -150,7 +134,7 @@ class Surface:
         none = np.empty(0, np.intp)
         nmap = np.flatnonzero(mats.normal_tex[mat] >= 0) if ctx.normal_maps and geom.tangents is not None else none
         bump = np.flatnonzero(mats.bump_tex[mat] >= 0) if ctx.bump_maps and geom.uvs is not None else none
-        programs = self._program_normals(ctx, mat, ns, ng, d, t) if ctx.has_programs else None
+        programs = self._program_normals(ctx, mat, ns, ng, d) if ctx.has_programs else None
         if not (len(nmap) or len(bump) or programs):
             return ns, None, None
         rows, normals = programs or (none, None)
@@ -165,16 +149,15 @@ class Surface:
             ns[:, rows] = normals
         return ns, mapped, smooth_n
 
-    def _program_normals(self, ctx, mat, ns, ng, d, t):
+    def _program_normals(self, ctx, mat, ns, ng, d):
         """(hits, their normals (3, k)) where a node program computes the shading normal (Normal Map, Bump of any
         graph), in the orientation of ``ns`` (the program sees and returns normals facing the ray); None where
         no program does."""
         facing = np.where(dot(ng, d) > 0, np.float32(-1.0), np.float32(1.0))
-        spread = pixel_spread(ctx.scene.camera)
         rows_all, normals = [], []
         for rows, out in run_programs(ctx.scene.materials, mat, lambda r: self._attributes(
-                ctx, r, -cols(d, r), normal=cols(ns, r) * facing[r], true_normal=cols(ng, r) * facing[r],
-                footprint=spread[0] + spread[1] * np.asarray(t, np.float32)[r]), ("normal",)):
+                ctx, r, -cols(d, r), normal=cols(ns, r) * facing[r], true_normal=cols(ng, r) * facing[r]),
+                ("normal",)):
             if "normal" in out:
                 rows_all.append(rows)
                 normals.append(out["normal"] * facing[rows])
