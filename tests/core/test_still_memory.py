@@ -1,7 +1,7 @@
 """A still frame (F12: no next frame) keeps no temporal history, in one process and in a team of two: it renders the
 same image as a frame that keeps one, and between its sample passes it holds less memory by at least the DI and GI
-target terms the kept first pass would hold (tracemalloc of the core's arrays: deterministic, no noise). The film's running
-sums are float32."""
+target terms the kept first pass would hold (tracemalloc of the core's arrays: deterministic, no noise). The film's
+running sums are float32."""
 import tracemalloc
 
 import numpy as np

@@ -1,10 +1,11 @@
 """The film: running sums of a frame's sample passes and the passes made from them.
 
 Accumulators are float32 (h, w, c) or (h, w) arrays (:data:`FILM_DTYPE`) over the camera window, row 0 at the
-*bottom* (Blender's pass order), kept in a pool between frames: a fresh array's pages are faulted in on first write, a reused one is only
-zeroed. Keys: emit, direct, indirect (RGB radiance, W·sr⁻¹·m⁻², scene-linear), alpha; res_m, res_w (DI reservoirs'
-M and W); gi_m, gi_w (GI reservoirs'); lg0, lg1, ... (the light of each light group: emission, direct and indirect
-together, lights/groups.py); albedo, dnormal (denoising data: first-hit albedo, camera-space normal);
+*bottom* (Blender's pass order), kept in a pool between frames: a fresh array's pages are faulted in on first
+write, a reused one is only zeroed. Keys: emit, direct, indirect (RGB radiance, W·sr⁻¹·m⁻², scene-linear),
+alpha; res_m, res_w (DI reservoirs' M and W); gi_m, gi_w (GI reservoirs'); lg0, lg1, ... (the light of each light
+group: emission, direct and indirect together, lights/groups.py); albedo, dnormal (denoising data: first-hit
+albedo, camera-space normal);
 with adaptive sampling (pipeline/adaptive.py) count (each pixel's samples) and aux (twice the RGB of the samples in
 its half set). Passes are their means over each pixel's samples (the frame's samples where no count is kept),
 float32 and finite.
