@@ -2,9 +2,12 @@
 # Run the test suite (headless, through the bpy module) on every supported Blender found here: Blender 5.2 LTS
 # (Python 3.13, .venv313) when a Python 3.13 exists (PATH or pyenv's versions folder), and Blender 5.0
 # (Python 3.11, .venv). Each venv is pinned and cached. The two suites run at the same time (each is mostly one
-# interpreter's work; together they use the cores); their outputs are printed one after the other. Extra arguments
-# go to pytest (e.g. -m "not slow", -m cycles). Then the smoke test on Blender 4.2 LTS and 4.5 LTS
-# (scripts/test_lts.sh; skipped when pytest arguments are given). Fails if any run fails.
+# interpreter's work; together they use the cores); their outputs are printed one after the other. Every test runs
+# on both, except the slow suite (the comparisons with Cycles, tests/cycles): it is dealt out between them
+# (pytest --slow-shard), so each comparison runs once, on one Blender, at its full power; RESTIR_SLOW_SHARDS=off
+# runs it whole on both. Extra arguments go to pytest (e.g. -m "not slow", -m cycles; the whole suite on both).
+# Then the smoke test on Blender 4.2 LTS and 4.5 LTS (scripts/test_lts.sh; skipped when pytest arguments are
+# given). Fails if any run fails.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 versions=()
@@ -23,10 +26,14 @@ trap 'rm -rf "$logs"' EXIT
 pids=()
 for i in "${!versions[@]}"; do
   venv=${venvs[$i]}
+  share=()
+  if [ "$#" -eq 0 ] && [ "${RESTIR_SLOW_SHARDS:-on}" != off ] && [ "${#versions[@]}" -gt 1 ]; then
+    share=(--slow-shard "$i/${#versions[@]}")
+  fi
   ( echo "== Python ${versions[$i]}, bpy $("$venv/bin/python" -c 'import importlib.metadata as m; print(m.version("bpy"))')"
     start=$SECONDS
     rc=0
-    "$venv/bin/python" -m pytest -q -p no:cacheprovider --durations=15 tests "$@" || rc=$?
+    "$venv/bin/python" -m pytest -q -p no:cacheprovider --durations=15 ${share[@]+"${share[@]}"} tests "$@" || rc=$?
     echo "== Python ${versions[$i]}: exit $rc after $((SECONDS - start)) s"
     exit $rc ) > "$logs/$i.log" 2>&1 &
   pids+=($!)

@@ -42,8 +42,25 @@ SUBJECTS = ("core", "restir", "materials", "blender", "cycles", "tools")
 SLOW = {"cycles"}
 
 
+def pytest_addoption(parser):
+    parser.addoption("--slow-shard", default=None, metavar="K/N",
+                     help="run only the K-th (0-based) of N shares of the slow tests (every other test runs); "
+                          "scripts/test.sh gives each Blender one share, so each slow test runs once per CI")
+
+
+def _slow_share(option: str | None):
+    if option is None:
+        return None
+    k, n = (int(v) for v in option.split("/"))
+    if not 0 <= k < n:
+        raise pytest.UsageError(f"--slow-shard {option}: K must be in 0..N-1")
+    return k, n
+
+
 def pytest_collection_modifyitems(config, items):
-    """Mark each test with its subject (its folder under tests/) and the slow suites with ``slow``."""
+    """Mark each test with its subject (its folder under tests/) and the slow suites with ``slow``; with
+    ``--slow-shard K/N`` deselect the slow tests outside the K-th share (the slow tests sorted by name, dealt out in
+    turn: a parametrized test's cases fall into different shares)."""
     for item in items:
         parts = os.path.relpath(str(item.fspath), os.path.dirname(os.path.abspath(__file__))).split(os.sep)
         subject = parts[0] if len(parts) > 1 and parts[0] in SUBJECTS else None
@@ -51,3 +68,11 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(getattr(pytest.mark, subject))
         if subject in SLOW or item.get_closest_marker("slow_case"):
             item.add_marker(pytest.mark.slow)
+    share = _slow_share(config.getoption("--slow-shard"))
+    if share is None:
+        return
+    k, n = share
+    slow = sorted(item.nodeid for item in items if item.get_closest_marker("slow"))
+    outside = {nodeid for i, nodeid in enumerate(slow) if i % n != k}
+    config.hook.pytest_deselected(items=[item for item in items if item.nodeid in outside])
+    items[:] = [item for item in items if item.nodeid not in outside]

@@ -7,6 +7,9 @@ with a reference also shows its power (that it would see a 3 % error).
 """
 from __future__ import annotations
 
+import json
+import os
+
 import numpy as np
 
 Z_MAX = 5.0  # two-sided p ≈ 2e-5 per comparison for t with ~30 degrees of freedom
@@ -81,6 +84,22 @@ def agree(mean_ours, mean_ref, se) -> np.ndarray:
     return np.abs(mean_ours - mean_ref) <= Z_MAX * se + MARGIN * np.abs(mean_ref)
 
 
+def _log_power(ours: np.ndarray, ref: np.ndarray, cells, limit: float, spread=robust_var) -> None:
+    """With ``RESTIR_POWER_LOG=FILE``: append per power cell the per-repetition variances (``spread``) of both sides
+    relative to the reference mean squared, the repetitions, and ``limit``, the relative standard error of the
+    difference the power check allows (a record tells how much precision a comparison has beyond its power check)."""
+    path = os.environ.get("RESTIR_POWER_LOG")
+    if not path:
+        return
+    mb = ref.mean(axis=0)
+    record = {"test": os.environ.get("PYTEST_CURRENT_TEST", "?").rsplit(" ", 1)[0], "n_ours": len(ours),
+              "n_ref": len(ref), "limit": limit,
+              "var_ours": [spread(ours[:, i]) / mb[i] ** 2 for i in cells],
+              "var_ref": [spread(ref[:, i]) / mb[i] ** 2 for i in cells]}
+    with open(path, "a") as f:
+        f.write(json.dumps(record) + "\n")
+
+
 def assert_cells_match(ours: np.ndarray, ref: np.ndarray, names, power=()) -> None:
     """Every cell of ``ours`` (k, cells) in :func:`agree` with ``ref`` (k', cells); every cell in ``power`` (indices)
     able to see a POWER_ERROR error: the bound of the means scaled by 1 + POWER_ERROR, at their expected
@@ -96,6 +115,7 @@ def assert_cells_match(ours: np.ndarray, ref: np.ndarray, names, power=()) -> No
     report = [f"{n}: ours/reference {a / b:.4f} (rel SE {s / b:.4f})" for n, a, b, s in zip(names, ma, mb, se)]
     assert ok.all(), "\n".join(r for r, good in zip(report, ok) if not good)
     k = 1.0 + POWER_ERROR
+    _log_power(ours, ref, list(power), (POWER_ERROR - MARGIN) / Z_MAX)
     for i in power:
         se3 = np.sqrt(k ** 2 * robust_var(ours[:, i]) / len(ours) + robust_var(ref[:, i]) / len(ref))
         assert POWER_ERROR * abs(mb[i]) > Z_MAX * se3 + MARGIN * abs(mb[i]), f"cannot see a 3 % error in {report[i]}"
@@ -109,6 +129,8 @@ def assert_blocks_match(ours: np.ndarray, ref: np.ndarray, max_rel_se: float = 0
     assert np.isfinite(ours).all()
     z, mean_ours, mean_ref, rel_se = compare_cells(ours, ref)
     assert mean_ref[-1] > 0.01  # the scene is lit
+    _log_power(np.asarray(ours, np.float64), np.asarray(ref, np.float64), [-1], max_rel_se,
+               lambda x: float(np.var(x, ddof=1)))
     assert rel_se[-1] < max_rel_se, f"too noisy to detect a 3% error: relative SE {rel_se[-1]:.4f}"
     assert agree(mean_ours, mean_ref, rel_se * np.abs(mean_ref)).all(), \
         f"z={np.round(z, 2)} ours={mean_ours} reference={mean_ref}"

@@ -113,6 +113,7 @@ def _tail(errors: np.ndarray, share: float = 0.02) -> float:
     return float(e[-max(1, int(share * e.size)):].mean())
 
 
+@pytest.mark.slow_case  # statistical: dealt out between the Blenders in CI (tests/conftest.py)
 def test_adaptive_sampling_spends_samples_on_the_noisiest_pixels():
     """Per-pixel error (Cycles' measure: Σ|x − ref| / r(Σ ref)) against a 2048-sample reference, adaptive (Noise
     Threshold 0.01, min 16, at most 1024) versus uniform sampling at the same mean samples per pixel (about 460):

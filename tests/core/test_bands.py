@@ -30,6 +30,7 @@ def test_bands_tile_the_window_exactly(integrator):
         _settings(integrator), regression_room(W, H).camera))
 
 
+@pytest.mark.slow_case  # statistical: dealt out between the Blenders in CI (tests/conftest.py)
 @pytest.mark.parametrize("integrator", ["PATH", "RESTIR"])
 def test_banded_image_agrees_with_the_unbanded_one(integrator):
     """3 x 4 blocks of 24 x 24 pixels, 64 samples: |banded − unbanded| of each block's mean within 5 joint standard

@@ -64,6 +64,7 @@ def test_group_passes_split_combined_exactly(method):
         assert min(p[f"Combined_{n}"].mean() for n in NAMES) > 0.01  # each group lights the room
 
 
+@pytest.mark.slow_case  # statistical: dealt out between the Blenders in CI (tests/conftest.py)
 @pytest.mark.parametrize("method", ["path tracer", "ReSTIR DI + GI unbiased"])
 def test_group_pass_converges_to_its_lights_alone(method):
     """The "panel" pass (emission seen, direct and bounce light of the panel and the sun) against the room rendered

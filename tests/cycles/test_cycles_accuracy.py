@@ -51,13 +51,13 @@ def test_unbiased_restir_direct_light_matches_cycles(addon, kind):
 def test_restir_gi_matches_cycles(addon, kind):
     """The default integrator with ReSTIR GI (unbiased, 4 spatial passes per sample) converges to Cycles with
     three bounces: the same agreement test (5 SE + 0.5 %) and the same power (able to see a 3 % error)."""
-    assert_matches_cycles(kind, 3, 32, integrator="RESTIR", direct_method="AUTO", indirect_method="RESTIR_GI",
+    assert_matches_cycles(kind, 3, 16, integrator="RESTIR", direct_method="AUTO", indirect_method="RESTIR_GI",
                           bias_correction="UNBIASED")
 
 
 def test_negative_lamp_matches_cycles(addon):
     """A point lamp of power -6 W beside the area light subtracts its light as in Cycles (the wall beside it goes
     negative): the path tracer and ReSTIR DI + GI unbiased, two bounces. Before, the negative lamp was left out."""
-    assert_matches_cycles("NEGATIVE", 2, 32, integrator="PATH")
-    assert_matches_cycles("NEGATIVE", 2, 32, integrator="RESTIR", direct_method="RESTIR", indirect_method="RESTIR_GI",
+    assert_matches_cycles("NEGATIVE", 2, 16, integrator="PATH")
+    assert_matches_cycles("NEGATIVE", 2, 16, integrator="RESTIR", direct_method="RESTIR", indirect_method="RESTIR_GI",
                           bias_correction="UNBIASED")

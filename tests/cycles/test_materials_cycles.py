@@ -235,9 +235,9 @@ def test_principled_coat_matches_cycles(addon):
     masks = sphere_masks(size)[:len(COAT_GRID[0])]
     names = [str(spec[:2]) for spec in COAT_GRID[0]]
     build = lambda: material_spheres("AREA", size, COAT_GRID)  # noqa: E731
-    ours, ref = both("coat", build, 0, 128, 256, by_masks(masks), integrator="PATH")
+    ours, ref = both("coat", build, 0, 64, 256, by_masks(masks), integrator="PATH")
     assert_cells_match(ours, ref, names, power=range(6))
-    ours = ours_cells(build, 0, 64, by_masks(masks), integrator="RESTIR", direct_method="RESTIR",
+    ours = ours_cells(build, 0, 32, by_masks(masks), integrator="RESTIR", direct_method="RESTIR",
                       bias_correction="UNBIASED", temporal_reuse=True, spatial_neighbors=5)
     assert_cells_match(ours, ref, names, power=range(6))
 
@@ -250,7 +250,7 @@ def test_coat_graphs_match_cycles(addon):
     from bpy_scenes import COAT_GRAPH_GRID, coat_graph_spheres
     size = (144, 24)
     masks = sphere_masks(size)[:len(COAT_GRAPH_GRID[0])]
-    ours, ref = both("coat_graphs", lambda: coat_graph_spheres(size), 0, 128, 256, by_masks(masks),
+    ours, ref = both("coat_graphs", lambda: coat_graph_spheres(size), 0, 64, 256, by_masks(masks),
                      integrator="PATH")
     assert_cells_match(ours, ref, [f"sphere {k}" for k in range(6)], power=range(6))
 
@@ -285,10 +285,10 @@ def test_volume_absorption_matches_cycles(addon):
     from bpy_scenes import absorbing_glass_scene
     size = (96, 64)
     build = lambda: absorbing_glass_scene(size)  # noqa: E731
-    ours, ref = both("volume_absorption", build, 4, 128, 256, by_masks(image_cells(size)), integrator="PATH")
+    ours, ref = both("volume_absorption", build, 4, 32, 256, by_masks(image_cells(size)), integrator="PATH")
     names = [f"cell {k}" for k in range(16)]
     assert_cells_match(ours, ref, names, power=[4, 5, 6, 7])
-    ours = ours_cells(build, 4, 64, by_masks(image_cells(size)), integrator="RESTIR", direct_method="RESTIR",
+    ours = ours_cells(build, 4, 16, by_masks(image_cells(size)), integrator="RESTIR", direct_method="RESTIR",
                       bias_correction="UNBIASED", indirect_method="PATH")
     assert_cells_match(ours, ref, names, power=[5, 6])
 
@@ -324,5 +324,5 @@ def test_translucent_bsdf_matches_cycles(addon, back):
         assert_cells_match(ours_cells(build, 2, 32, cells, indirect_method="PATH", **restir), ref, names,
                            power=range(4, 12))
     else:
-        assert_cells_match(ours_cells(build, 2, 32, cells, indirect_method="RESTIR_GI", **restir), ref, names,
+        assert_cells_match(ours_cells(build, 2, 16, cells, indirect_method="RESTIR_GI", **restir), ref, names,
                            power=range(4, 12))

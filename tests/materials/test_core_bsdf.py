@@ -100,6 +100,7 @@ def test_white_metal_reflects_all_energy(roughness, theta):
     assert abs(est.mean() - 1.0) < 0.01 + 5 * se, (est.mean(), se)
 
 
+@pytest.mark.slow_case  # recomputes the tables: dealt out between the Blenders in CI (tests/conftest.py)
 def test_stored_ggx_tables_are_the_computed_ones():
     """core/data/ggx_tables.npz (read at start-up instead of seconds of computation) is what
     scripts/make_ggx_tables.py computes."""

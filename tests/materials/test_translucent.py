@@ -39,6 +39,7 @@ def centre_means(scene, reps: int, **settings) -> np.ndarray:
                      .passes["Combined"][31:33, 31:33, :3].mean(axis=(0, 1)) for s in range(reps)])
 
 
+@pytest.mark.slow_case  # statistical: dealt out between the Blenders in CI (tests/conftest.py)
 @pytest.mark.parametrize("method", list(METHODS))
 def test_translucent_sheet_passes_the_light_behind_it(method):
     """The point over the centre of an emitter behind the sheet: L = Color/π · LE · F (the square's form factor), per

@@ -13,6 +13,8 @@ from restir_engine.core.scene import MaterialTable, Scene
 from scenes_core import bounce_room, concat, one_moving_instance, quad, regression_room, tris
 from stats import compare, standard_error
 
+pytestmark = pytest.mark.slow_case  # statistical: dealt out between the Blenders in CI (tests/conftest.py)
+
 Z = 5.0
 
 
