@@ -5,6 +5,10 @@ Run the statistical tests with ``RESTIR_POWER_LOG=FILE`` (tests/stats.py appends
 as a share of what the check allows (``use``: 1.0 is the edge), and ``cut``, the factor by which our side's variance
 per repetition may grow (fewer samples) before that cell reaches ``--target`` of the allowance, with the reference
 side as stored. A cut below 1 means the test has less headroom than the target.
+
+The other half of the check: ``RESTIR_SCALE_OURS=1.03`` scales our side of every comparison (tests/stats.py) by a
+3 % error, and each comparison with a reference must then fail:
+    RESTIR_SCALE_OURS=1.03 .venv313/bin/python -m pytest -q tests/cycles   # every test fails
 """
 from __future__ import annotations
 

@@ -84,6 +84,13 @@ def agree(mean_ours, mean_ref, se) -> np.ndarray:
     return np.abs(mean_ours - mean_ref) <= Z_MAX * se + MARGIN * np.abs(mean_ref)
 
 
+def _probed(ours: np.ndarray) -> np.ndarray:
+    """``ours`` scaled by ``RESTIR_SCALE_OURS`` when it is set (e.g. 1.03: a 3 % error that every comparison with a
+    reference must then fail on; scripts/power_report.py's docstring says how to run it)."""
+    factor = os.environ.get("RESTIR_SCALE_OURS")
+    return ours if not factor else ours * float(factor)
+
+
 def _log_power(ours: np.ndarray, ref: np.ndarray, cells, limit: float, spread=robust_var) -> None:
     """With ``RESTIR_POWER_LOG=FILE``: append per power cell the per-repetition variances (``spread``) of both sides
     relative to the reference mean squared, the repetitions, and ``limit``, the relative standard error of the
@@ -107,7 +114,7 @@ def assert_cells_match(ours: np.ndarray, ref: np.ndarray, names, power=()) -> No
     repetition for the power is the robust one (1.4826 MAD): a rare firefly in one repetition (a caustic path
     through rough glass) inflates the sample variance, and with it the agreement bound, without changing how
     finely the bulk of the estimator resolves the cell; for light-tailed cells the two spreads agree."""
-    ours, ref = np.asarray(ours, np.float64), np.asarray(ref, np.float64)
+    ours, ref = _probed(np.asarray(ours, np.float64)), np.asarray(ref, np.float64)
     assert np.isfinite(ours).all()
     ma, mb = ours.mean(axis=0), ref.mean(axis=0)
     se = np.sqrt(ours.var(axis=0, ddof=1) / len(ours) + ref.var(axis=0, ddof=1) / len(ref))
@@ -126,6 +133,7 @@ def assert_blocks_match(ours: np.ndarray, ref: np.ndarray, max_rel_se: float = 0
     precise enough to see a POWER_ERROR error (relative SE of the whole image's difference below ``max_rel_se``,
     checked by scaling ours by 1 + POWER_ERROR, which must fail) and every block in :func:`agree` with the
     reference."""
+    ours = _probed(np.asarray(ours, np.float64))
     assert np.isfinite(ours).all()
     z, mean_ours, mean_ref, rel_se = compare_cells(ours, ref)
     assert mean_ref[-1] > 0.01  # the scene is lit
