@@ -1,3 +1,4 @@
+import json
 import os
 import sys
 
@@ -43,24 +44,48 @@ SLOW = {"cycles"}
 
 
 def pytest_addoption(parser):
-    parser.addoption("--slow-shard", default=None, metavar="K/N",
-                     help="run only the K-th (0-based) of N shares of the slow tests (every other test runs); "
-                          "scripts/test.sh gives each Blender one share, so each slow test runs once per CI")
+    parser.addoption("--slow-shard", default=None, metavar="K/N[:W0,W1,...]",
+                     help="run only the K-th (0-based) of N shares of the slow tests (every other test runs), the "
+                          "shares in the proportions W (default equal); scripts/test.sh gives each Blender one "
+                          "share, so each slow test runs once per CI")
 
 
 def _slow_share(option: str | None):
+    """(k, weights) of a --slow-shard value, or None."""
     if option is None:
         return None
-    k, n = (int(v) for v in option.split("/"))
-    if not 0 <= k < n:
-        raise pytest.UsageError(f"--slow-shard {option}: K must be in 0..N-1")
-    return k, n
+    part, _, weights = option.partition(":")
+    k, n = (int(v) for v in part.split("/"))
+    w = [int(v) for v in weights.split(",")] if weights else [1] * n
+    if not 0 <= k < n or len(w) != n or min(w) < 1:
+        raise pytest.UsageError(f"--slow-shard {option}: K must be in 0..N-1 and W N positive integers")
+    return k, w
+
+
+def dealt(nodeids, k: int, weights, seconds=None) -> set:
+    """The K-th share of ``nodeids``: longest first (``seconds`` per test, by default tests/data/slow_durations.json;
+    a test not listed counts as the median), each to the share whose time over its weight would be least after it
+    (ties by name), so that the shares' times stand in the proportions ``weights``."""
+    if seconds is None:
+        with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "slow_durations.json")) as f:
+            seconds = json.load(f)["seconds"]
+    known = sorted(seconds.values())
+    typical = known[len(known) // 2] if known else 1.0
+    load = [0.0] * len(weights)
+    mine = set()
+    for nodeid in sorted(nodeids, key=lambda n: (-seconds.get(n, typical), n)):
+        t = seconds.get(nodeid, typical)
+        j = min(range(len(weights)), key=lambda s: ((load[s] + t) / weights[s], s))
+        load[j] += t
+        if j == k:
+            mine.add(nodeid)
+    return mine
 
 
 def pytest_collection_modifyitems(config, items):
     """Mark each test with its subject (its folder under tests/) and the slow suites with ``slow``; with
-    ``--slow-shard K/N`` deselect the slow tests outside the K-th share (the slow tests sorted by name, dealt out in
-    turn: a parametrized test's cases fall into different shares)."""
+    ``--slow-shard K/N`` deselect the slow tests outside the K-th share (:func:`dealt`: a parametrized test's cases
+    fall into different shares)."""
     for item in items:
         parts = os.path.relpath(str(item.fspath), os.path.dirname(os.path.abspath(__file__))).split(os.sep)
         subject = parts[0] if len(parts) > 1 and parts[0] in SUBJECTS else None
@@ -71,8 +96,8 @@ def pytest_collection_modifyitems(config, items):
     share = _slow_share(config.getoption("--slow-shard"))
     if share is None:
         return
-    k, n = share
-    slow = sorted(item.nodeid for item in items if item.get_closest_marker("slow"))
-    outside = {nodeid for i, nodeid in enumerate(slow) if i % n != k}
+    k, weights = share
+    slow = [item.nodeid for item in items if item.get_closest_marker("slow")]
+    outside = set(slow) - dealt(slow, k, weights)
     config.hook.pytest_deselected(items=[item for item in items if item.nodeid in outside])
     items[:] = [item for item in items if item.nodeid not in outside]
