@@ -28,8 +28,7 @@ for i in "${!versions[@]}"; do
   venv=${venvs[$i]}
   share=()
   if [ "$#" -eq 0 ] && [ "${RESTIR_SLOW_SHARDS:-on}" != off ] && [ "${#versions[@]}" -gt 1 ]; then
-    # the shares in proportion 5 : 4: Blender 5.0's suite (numpy 1.26) runs about 15 % slower than 5.2's
-    share=(--slow-shard "$i/${#versions[@]}:5,4")
+    share=(--slow-shard "$i/${#versions[@]}")
   fi
   ( echo "== Python ${versions[$i]}, bpy $("$venv/bin/python" -c 'import importlib.metadata as m; print(m.version("bpy"))')"
     start=$SECONDS

@@ -235,9 +235,9 @@ def test_principled_coat_matches_cycles(addon):
     masks = sphere_masks(size)[:len(COAT_GRID[0])]
     names = [str(spec[:2]) for spec in COAT_GRID[0]]
     build = lambda: material_spheres("AREA", size, COAT_GRID)  # noqa: E731
-    ours, ref = both("coat", build, 0, 64, 256, by_masks(masks), integrator="PATH")
+    ours, ref = both("coat", build, 0, 128, 256, by_masks(masks), integrator="PATH")
     assert_cells_match(ours, ref, names, power=range(6))
-    ours = ours_cells(build, 0, 32, by_masks(masks), integrator="RESTIR", direct_method="RESTIR",
+    ours = ours_cells(build, 0, 64, by_masks(masks), integrator="RESTIR", direct_method="RESTIR",
                       bias_correction="UNBIASED", temporal_reuse=True, spatial_neighbors=5)
     assert_cells_match(ours, ref, names, power=range(6))
 
