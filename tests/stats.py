@@ -133,15 +133,14 @@ def assert_blocks_match(ours: np.ndarray, ref: np.ndarray, max_rel_se: float = 0
     precise enough to see a POWER_ERROR error (relative SE of the whole image's difference below ``max_rel_se``,
     checked by scaling ours by 1 + POWER_ERROR, which must fail) and every block in :func:`agree` with the
     reference."""
-    ours = _probed(np.asarray(ours, np.float64))
+    ours, ref = _probed(np.asarray(ours, np.float64)), np.asarray(ref, np.float64)
     assert np.isfinite(ours).all()
     z, mean_ours, mean_ref, rel_se = compare_cells(ours, ref)
     assert mean_ref[-1] > 0.01  # the scene is lit
-    _log_power(np.asarray(ours, np.float64), np.asarray(ref, np.float64), [-1], max_rel_se,
-               lambda x: float(np.var(x, ddof=1)))
+    _log_power(ours, ref, [-1], max_rel_se, lambda x: float(np.var(x, ddof=1)))
     assert rel_se[-1] < max_rel_se, f"too noisy to detect a 3% error: relative SE {rel_se[-1]:.4f}"
     assert agree(mean_ours, mean_ref, rel_se * np.abs(mean_ref)).all(), \
         f"z={np.round(z, 2)} ours={mean_ours} reference={mean_ref}"
-    _z, wrong, ref_mean, wrong_se = compare_cells(np.asarray(ours) * (1.0 + POWER_ERROR), ref)
+    _z, wrong, ref_mean, wrong_se = compare_cells(ours * (1.0 + POWER_ERROR), ref)
     assert not agree(wrong[-1:], ref_mean[-1:], (wrong_se * np.abs(ref_mean))[-1:]).all(), \
         "the comparison could not detect a 3% unit error"

@@ -68,10 +68,11 @@ class Surface:
         """What node programs read at hits ``r`` (indices): the view ``wo`` (3, k) and whatever else is ``given``
         (normals), the pixel's footprint at the ray's length (geometry.camera.pixel_footprint), whether they are
         camera hits, and the ray length."""
+        t = np.asarray(self._t, np.float32)[r]
         if given.get("footprint") is None:
-            given["footprint"] = pixel_footprint(ctx.scene.camera, np.asarray(self._t, np.float32)[r])
+            given["footprint"] = pixel_footprint(ctx.scene.camera, t)
         return HitAttributes(ctx.scene.geometry, self.prim[r], self.b1[r], self.b2[r], ctx.scene.materials.textures,
-                             wo=wo, camera_ray=self.camera, ray_length=np.asarray(self._t, np.float32)[r], **given)
+                             wo=wo, camera_ray=self.camera, ray_length=t, **given)
 
     def _uv(self, geom, rows) -> np.ndarray:
         """(k, 2) texture coordinates of the hits ``rows``."""
