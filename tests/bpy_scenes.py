@@ -96,6 +96,34 @@ COAT_GRAPH_GRID = [[
 ]]
 
 
+# Anisotropic GGX (one row): Principled metals (Anisotropic 0.8; 0.5 at Rotation 0.125), a red dielectric at
+# Anisotropic 1, Glossy BSDFs (Anisotropy 0.8; -0.6 at Rotation 0.3), and a metal whose Tangent is the UV map's
+# (aniso_spheres wires it); the others take the default radial tangent about the object's Z axis.
+ANISO_GRID = [[
+    ("P", (0.9, 0.6, 0.3), 0.3, {"Metallic": 1.0, "Anisotropic": 0.8}),
+    ("P", (0.8, 0.8, 0.8), 0.5, {"Metallic": 1.0, "Anisotropic": 0.5, "Anisotropic Rotation": 0.125}),
+    ("P", (0.8, 0.1, 0.1), 0.25, {"Anisotropic": 1.0}),
+    ("G", (0.8, 0.8, 0.8), 0.4, {"Anisotropy": 0.8}),
+    ("G", (0.9, 0.5, 0.2), 0.4, {"Anisotropy": -0.6, "Rotation": 0.3}),
+    ("P", (0.7, 0.8, 0.9), 0.35, {"Metallic": 1.0, "Anisotropic": 0.9}),
+]]
+
+
+def aniso_spheres(size=(144, 24), isotropic=False):
+    """material_spheres of :data:`ANISO_GRID`, the last sphere's Tangent from a Tangent node (UV map); with
+    ``isotropic`` every Anisotropic / Anisotropy set to 0 (what ignoring anisotropy would render)."""
+    grid = ANISO_GRID
+    if isotropic:
+        grid = [[(k, c, r, {key: (0.0 if key in ("Anisotropic", "Anisotropy") else v) for key, v in extra.items()})
+                 for k, c, r, extra in row] for row in ANISO_GRID]
+    scene = material_spheres("AREA", size, grid)
+    tree = bpy.data.materials["M05"].node_tree
+    tan = tree.nodes.new("ShaderNodeTangent")
+    tan.direction_type = "UV_MAP"
+    tree.links.new(tan.outputs["Tangent"], tree.nodes["Principled BSDF"].inputs["Tangent"])
+    return scene
+
+
 def coat_graph_spheres(size=(144, 24)):
     """material_spheres of :data:`COAT_GRAPH_GRID` with its node graphs wired in (see there)."""
     scene = material_spheres("AREA", size, COAT_GRAPH_GRID)
@@ -249,6 +277,8 @@ def _grid_material(name, kind, color, roughness, extra):
         g = nodes.new("ShaderNodeBsdfGlossy")
         g.inputs["Color"].default_value = (*color, 1)
         g.inputs["Roughness"].default_value = roughness
+        for key, value in extra.items():
+            g.inputs[key].default_value = value
         m.node_tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
         return m
     m = principled(name, color, roughness=roughness)

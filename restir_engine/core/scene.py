@@ -112,6 +112,11 @@ class MaterialTable:
     absorption  (m, 3)  the material's Volume Absorption coefficient σa, per scene unit of length ((1 − Color) x Density,
                         as Cycles): a ray that travels inside the closed mesh and leaves it through its surface keeps
                         exp(−σa · distance) of its light (0: no volume)
+    aniso_aspect (m,)   the specular lobes' anisotropic aspect k (αx = α/k, αy = α k; 1: isotropic) from Principled
+                        Anisotropic or Glossy Anisotropy (core/materials/anisotropy.py); the node program's
+                        "aniso_aspect" replaces it per hit
+    aniso_rotation (m,) the tangent's rotation about the normal, in turns (program field "aniso_rotation"); the
+                        tangent is the radial one about the object's Z axis unless the program gives "tangent"
     translucent (m,) bool  a Translucent BSDF: Lambertian transmission, base_color/π toward the side away from the
                         viewer and nothing back toward it (Surface turns such hits' frame away from the viewer)
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
@@ -123,7 +128,8 @@ class MaterialTable:
                         Transparent BSDF's Mix factor from any node graph)
     program     (m,) int32  index into ``programs`` of the material's node program (-1 = none): fields that vary
                         per hit ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness",
-                        "emission", "mix:<k>" the weight of Mix component k) evaluated at the hits
+                        "emission", "mix:<k>" the weight of Mix component k, "aniso_aspect", "aniso_rotation",
+                        "tangent") evaluated at the hits
                         (core/materials/nodes), replacing the row's constants
     programs    list of nodes.program.Program
     textures    list of (h, w, 3) float32 linear images, row 0 at the bottom (Blender's order)
@@ -170,6 +176,8 @@ class MaterialTable:
     absorption: np.ndarray = None
     holdout: np.ndarray = None  # (m,) bool: a Holdout shader (camera rays meeting it give alpha 0, black)
     translucent: np.ndarray = None  # (m,) bool: a Translucent BSDF (Lambertian transmission of base_color)
+    aniso_aspect: np.ndarray = None
+    aniso_rotation: np.ndarray = None
     program: np.ndarray = None
     programs: list = field(default_factory=list)
     aov_program: np.ndarray = None  # (m,) index into aov_programs (the material's AOV Output nodes) or -1
@@ -202,6 +210,7 @@ class MaterialTable:
             glass_fresnel=col("glass_fresnel", 1.0), glass_beckmann=col("glass_beckmann", 0.0),
             diffuse_roughness=col("diffuse_roughness", 0.0), holdout=col("holdout", False, bool),
             translucent=col("translucent", False, bool),
+            aniso_aspect=col("aniso_aspect", 1.0), aniso_rotation=col("aniso_rotation", 0.0),
             absorption=col("absorption", (0.0, 0.0, 0.0)),
             **_mix_arrays(rows), **_programs(rows), **_programs(rows, "aov_program"),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

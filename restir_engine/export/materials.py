@@ -291,9 +291,7 @@ class MaterialRegistry(MixShaderReader, TextureReader):
                                             "base_tex")
             row["roughness"] = self._param(material, g, node.inputs["Roughness"], "float", "roughness", varying)
             row["multiscatter"] = self._multiscatter(material, node)
-            if "Anisotropy" in node.inputs and (node.inputs["Anisotropy"].is_linked
-                                                or abs(float(node.inputs["Anisotropy"].default_value)) > 1e-4):
-                self._warn(material, "Glossy BSDF anisotropy is not supported; rendered isotropic")
+            self._anisotropy(material, node, row, g, varying, "Anisotropy", "Rotation")
             self._normal(material, node, row, g, varying)
             return self._with_program(row, g, varying)
         if t == "BSDF_TRANSLUCENT":
@@ -330,14 +328,16 @@ class MaterialRegistry(MixShaderReader, TextureReader):
             row["specular_tint"] = self._param(material, g, inp["Specular Tint"], "color", "specular_tint",
                                                varying)
         row["multiscatter"] = self._multiscatter(material, node)
-        if "Anisotropic" in inp and (inp["Anisotropic"].is_linked or float(inp["Anisotropic"].default_value) > 0):
-            self._warn(material, "Principled 'Anisotropic' is not supported; rendered isotropic")
+        self._anisotropy(material, node, row, g, varying, "Anisotropic", "Anisotropic Rotation")
         self._emission(material, g, inp["Emission Color"], inp["Emission Strength"], row, varying)
         for name in ("Sheen Weight", "Subsurface Weight"):
             if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
                 self._warn(material, f"Principled '{name}' is not supported and was ignored")
         if "Transmission Weight" in inp:
             self._principled_transmission(material, inp, row, ior)
+            if row.get("transmission", 0.0) > 0 and ("aniso_aspect" in row or "aniso_aspect" in varying):
+                self._warn(material, "Principled 'Anisotropic' applies to reflection here; its transmission is "
+                           "rendered isotropic")
         if "Diffuse Roughness" in inp:
             dr = self._param(material, g, inp["Diffuse Roughness"], "float", "diffuse_roughness", varying)
             row["diffuse_roughness"] = float(np.clip(dr, 0, 1))
@@ -345,6 +345,29 @@ class MaterialRegistry(MixShaderReader, TextureReader):
             self._alpha(material, inp["Alpha"], row, g, varying)
         self._normal(material, node, row, g, varying)
         return self._with_program(row, g, varying)
+
+    def _anisotropy(self, material, node, row: dict, g: GraphCompiler, varying: dict, amount: str,
+                    rotation: str) -> None:
+        """A GGX lobe's anisotropy (socket ``amount``) as Cycles maps it for this node (the Principled's or the
+        Glossy's aspect: core/materials/anisotropy.py), its rotation (socket ``rotation``, turns) and Tangent: the
+        row's "aniso_aspect" and "aniso_rotation" (or the program's fields where they vary); a linked Tangent
+        becomes the program's "tangent" (unlinked: the radial tangent about the object's Z axis)."""
+        inp = node.inputs
+        if amount not in inp:
+            return
+        k = g.emit("aniso_aspect", {"glossy": node.type != "BSDF_PRINCIPLED"}, [g.value(inp[amount], "float")],
+                   ("float",))[0]
+        if k.const is not None:
+            if abs(float(k.constant_value()) - 1.0) <= 1e-6:
+                return
+            row["aniso_aspect"] = float(k.constant_value())
+        else:
+            varying["aniso_aspect"] = k
+        if rotation in inp:
+            row["aniso_rotation"] = float(self._param(material, g, inp[rotation], "float", "aniso_rotation", varying))
+        tangent = inp.get("Tangent")
+        if tangent is not None and tangent.is_linked:
+            varying["tangent"] = g.value(tangent, "vector")
 
     def _translucent(self, material, node) -> dict:
         """A Translucent BSDF: Lambertian transmission as Cycles, Color/π on the side away from the viewer, none
@@ -376,8 +399,9 @@ class MaterialRegistry(MixShaderReader, TextureReader):
 
     @staticmethod
     def _with_program(row: dict, g: GraphCompiler, varying: dict, keep=()) -> dict:
-        """The row with its node program (when some field varies; the fields in ``keep`` count as varying)."""
-        prog = g.program(varying, keep=keep)
+        """The row with its node program (when some field varies; the fields in ``keep`` count as varying, and so
+        does a linked Tangent, which the row has no field for)."""
+        prog = g.program(varying, keep=tuple(keep) + (("tangent",) if "tangent" in varying else ()))
         if prog is not None:
             row["program"] = prog
         return row

@@ -130,3 +130,30 @@ def test_objects_sharing_a_mesh_read_what_their_own_materials_need(addon):
     assert len(rows) == 2
     np.testing.assert_allclose(sc.geometry.attributes["Col"][rows][..., :3], np.tile([0.1, 0.7, 0.3], (2, 3, 1)),
                                atol=1e-6)
+
+
+def test_anisotropy_exports_cycles_aspect_rotation_and_tangent(addon):
+    """Principled Anisotropic and Rotation become the row's aspect (√(1 - 0.9 a)) and rotation without a warning; a
+    Noise Texture on Anisotropic and a Tangent node on Tangent become the program's fields; transmission under
+    anisotropy is named (rendered isotropic)."""
+    def constant(tree, bsdf):
+        _set(bsdf, "Metallic", 1.0)
+        _set(bsdf, "Anisotropic", 0.6)
+        _set(bsdf, "Anisotropic Rotation", 0.25)
+    sc, _ = _principled_plane(constant)
+    m, i = sc.materials, sc.materials.names.index("Wired")
+    assert abs(float(m.aniso_aspect[i]) - np.sqrt(1 - 0.9 * 0.6)) < 1e-6
+    assert abs(float(m.aniso_rotation[i]) - 0.25) < 1e-6 and m.program[i] == -1
+    assert not [w for w in sc.warnings if "Wired" in w]
+
+    def varying(tree, bsdf):
+        noise = _node(tree, "ShaderNodeTexNoise")
+        tree.links.new(noise.outputs["Fac"], bsdf.inputs["Anisotropic"])
+        tan = _node(tree, "ShaderNodeTangent")
+        tree.links.new(tan.outputs["Tangent"], bsdf.inputs["Tangent"])
+        _set(bsdf, "Transmission Weight", 0.5)
+    sc, _ = _principled_plane(varying)
+    m, i = sc.materials, sc.materials.names.index("Wired")
+    prog = m.programs[m.program[i]]
+    assert prog.has("aniso_aspect") and prog.has("tangent")
+    assert [w for w in sc.warnings if "Wired" in w and "transmission is rendered isotropic" in w]

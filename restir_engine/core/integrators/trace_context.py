@@ -40,6 +40,7 @@ class TraceContext:
     bump_maps: bool = False    # some material has a Bump node (surface.bump_map)
     has_glass: bool = False    # some material has a smooth glass closure (core/materials/glass.py)
     has_programs: bool = False  # some material has a node program (core/materials/nodes)
+    anisotropic: bool = False  # some material may have an anisotropic GGX lobe (core/materials/anisotropy.py)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -149,9 +150,17 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         has_glass=scene.materials.transmission is not None
                         and bool((scene.materials.transmission > 0).any()),
                         has_programs=bool(getattr(scene.materials, "programs", None)),
-                        world=world,
+                        anisotropic=may_be_anisotropic(scene.materials), world=world,
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)
+
+
+def may_be_anisotropic(mats) -> bool:
+    """Whether some material's aspect is not 1 or its node program computes one."""
+    aspect = getattr(mats, "aniso_aspect", None)
+    if aspect is not None and bool((aspect != 1).any()):
+        return True
+    return any(p.has("aniso_aspect") for p in getattr(mats, "programs", None) or ())
 
 
 def scene_bounds(scene: Scene, geometry_bounds) -> tuple:

@@ -1,5 +1,6 @@
-"""The Principled BSDF as Cycles builds it (Blender 4.x/5.x), without sheen, transmission and anisotropy (a Coat is a
-Mix of a coat and a base row: export/coat.py); vectorized.
+"""The Principled BSDF as Cycles builds it (Blender 4.x/5.x), without sheen and transmission (a Coat is a Mix of a
+coat and a base row: export/coat.py); vectorized. Anisotropic hits replace the specular lobes' D and Smith terms
+with anisotropic GGX (anisotropy.py) at the same α = √(αx αy), so the lobes' weights and compensation stay these.
 
 All directions are (3, n) rows (x, y, z) in the local shading frame (z = shading normal), unit length,
 ``wo`` towards the viewer, ``wi`` towards the light; colours are (3, n) rows (R, G, B), scene-linear.
@@ -29,6 +30,7 @@ import numpy as np
 
 from ..sampling import cosine_hemisphere, dot, orthonormal_basis
 from . import microfacet_tables as tables
+from .anisotropy import AnisoFrame
 from .params import SurfaceParams
 
 INV_PI = np.float32(1.0 / np.pi)
@@ -95,6 +97,7 @@ class ViewTerms:
     metal_a: np.ndarray | None = None
     metal_b: np.ndarray | None = None
     metal_d: np.ndarray | None = None
+    aniso: AnisoFrame | None = None  # the anisotropic surfaces (their vo is the anisotropic view term)
 
     def spec_full(self):
         """spec_a ((3, n) or grey (n,)) and spec_b ((3, n) or None) of every surface, metal columns included."""
@@ -130,6 +133,16 @@ class ViewTerms:
         self.co_s[rows] = np.clip(dot(np.take(wo, rows, axis=1), self.spec_nr), np.float32(1e-4), 1.0)
         vo = self.vo.copy()
         vo[rows] = smith_view(self.alpha2[rows], self.co_s[rows])
+        self.vo = vo
+
+    def with_anisotropy(self, frame: AnisoFrame, wo: np.ndarray) -> None:
+        """Make the surfaces ``frame.rows`` anisotropic (their specular D and Smith terms; the view's vo)."""
+        rows = frame.rows
+        if rows.size == 0 or not self.glossy:
+            return
+        self.aniso = frame
+        vo = self.vo.copy()
+        vo[rows] = frame.smith_v(np.take(wo, rows, axis=1))
         self.vo = vo
 
     @staticmethod
@@ -360,6 +373,10 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     vi += vo_ci
     np.maximum(vi, np.float32(1e-12), out=vi)
     s = np.divide(dh, vi, out=vi)                   # D G2 / (4 cos θo cos θi)
+    if v.aniso is not None:  # anisotropic surfaces: their own D and Smith terms (rows ra)
+        ra = v.aniso.rows
+        s_a, q_a = v.aniso.spec_terms(np.take(wo, ra, axis=1), np.take(wi, ra, axis=1), v.vo[ra])
+        s[ra] = s_a
     if v.spec_n is not None:
         s[rs] *= valid_r
     spec = v.spec_a * s                             # (n,) where every lobe is grey, else (3, n)
@@ -393,6 +410,8 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         np.add.at(f.reshape(-1), (r + np.arange(0, 3 * n, n)[:, None]).ravel(), m.ravel())  # f[:, r] += m
     q /= t
     q *= dh                                         # the specular pdf D cos θh/(4 ωo·h)
+    if v.aniso is not None:
+        q[ra] = q_a
     if v.spec_n is not None:
         ci = wi[2]
         q[rs] *= valid_r
@@ -481,6 +500,14 @@ def sample_bsdf(p: SurfaceParams, wo: np.ndarray, u_lobe: np.ndarray, u1: np.nda
                 t2, b2 = orthonormal_basis(sn)
                 hs = np.take(h, sel, axis=1)
                 h[:, sel] = hs[0] * t2 + hs[1] * b2 + hs[2] * sn
+        if view is not None and view.aniso is not None:  # anisotropic rows: their own normals, in their frame
+            at = np.full(len(u_lobe), -1, np.intp)
+            at[view.aniso.rows] = np.arange(len(view.aniso.rows))
+            k = at[spec]
+            sel = np.flatnonzero(k >= 0)
+            if sel.size:
+                h[:, sel] = view.aniso.sample_normals(k[sel], np.take(wo, spec[sel], axis=1), u1[spec[sel]],
+                                                      u2[spec[sel]])
         o = np.take(wo, spec, axis=1)
         wi[:, spec] = 2.0 * dot(o, h) * h - o
     # eval_view is 0 (f and pdf) below the surface, and its pdf positive wherever f may be

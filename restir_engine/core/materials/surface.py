@@ -11,6 +11,7 @@ import numpy as np
 from ..geometry.camera import pixel_footprint
 from ..sampling import barycentric, cols, dot, norm, orthonormal_basis
 from . import microfacet_tables
+from .anisotropy import AnisoFrame
 from .bsdf import ViewTerms
 from .glass import GLASS_SALT
 from .microfacet_tables import lerp_rows, mu_index
@@ -22,6 +23,9 @@ from .textures import apply_texture, gradient, sample
 
 #: the BSDF fields a material's node program may compute (scene.MaterialTable.program)
 PARAM_FIELDS = ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness")
+#: the anisotropy fields it may compute: the aspect (anisotropy.py), its rotation (turns) and the tangent (world,
+#: (3, k))
+ANISO_FIELDS = ("aniso_aspect", "aniso_rotation", "tangent")
 
 
 class Surface:
@@ -57,6 +61,7 @@ class Surface:
         self._bump_shadowing(mapped, smooth_n, s_ng if away is None else s_ng * away)
         self._view_frame()
         mu = self._specular_normal()
+        self._anisotropy(ctx, mat)
         # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal): looked
         # up once per hit when first used (α and η are constant per material: one interpolation in μo)
         self._mu, self._tables = mu, (ctx.material_albedo, ctx.material_layer)
@@ -178,6 +183,7 @@ class Surface:
                 tm = mat[textured]
                 base = apply_texture(mats.base_color[tm], mats.base_tex[tm], uv, mats.textures)
                 self.params.assign(textured, SurfaceParams.of_table(mats, tm, base))
+        self._aniso_given = None
         self._varying = self._node_params(ctx, mat) if ctx.has_programs else None
         if scale is not None:
             self.params.scale(scale)
@@ -191,8 +197,10 @@ class Surface:
         mats, geom = ctx.scene.materials, ctx.scene.geometry
         varying = []
         for rows, out in run_programs(mats, mat, lambda r: self._attributes(
-                ctx, r, cols(self.wo, r), normal=cols(self.ns, r), true_normal=cols(self.ng, r)), PARAM_FIELDS):
-            if not out:
+                ctx, r, cols(self.wo, r), normal=cols(self.ns, r), true_normal=cols(self.ng, r)),
+                PARAM_FIELDS + ANISO_FIELDS):
+            self._given_anisotropy(rows, out, len(mat))
+            if not any(f in out for f in PARAM_FIELDS):
                 continue
             tm = mat[rows]
             base = out["base_color"].T if "base_color" in out else mats.base_color[tm]
@@ -206,6 +214,60 @@ class Surface:
             if "roughness" in out or "f0" in out:
                 varying.append(rows)
         return np.concatenate(varying) if varying else None
+
+    def _given_anisotropy(self, rows, out: dict, n: int) -> None:
+        """Keep the anisotropy fields a node program computed at hits ``rows`` (``_aniso_given``: field -> (hits
+        given (n,) bool, values (n,) or (3, n)))."""
+        for name in ANISO_FIELDS:
+            if name not in out:
+                continue
+            if self._aniso_given is None:
+                self._aniso_given = {}
+            given, values = self._aniso_given.get(name) or (np.zeros(n, bool), np.ones((3, n) if name == "tangent"
+                                                                                     else n, np.float32))
+            given[rows] = True
+            values[..., rows] = np.broadcast_to(out[name], values[..., rows].shape)
+            self._aniso_given[name] = (given, values)
+
+    def _anisotropy(self, ctx, mat) -> None:
+        """The anisotropic hits' GGX frame (``aniso``: anisotropy.AnisoFrame, or None where no hit is): the
+        material's aspect and Rotation (or its node program's), the tangent from the program
+        (a Tangent input) or the radial tangent about the object's Z axis (Cycles' default), turned about the
+        shading normal by Rotation · 2π, in the local frame about the specular lobes' normal."""
+        self.aniso = None
+        mats, given = ctx.scene.materials, self._aniso_given or {}
+        table = getattr(mats, "aniso_aspect", None)
+        if table is None and "aniso_aspect" not in given:
+            return
+        a = np.ones(len(mat), np.float32) if table is None else table[mat].astype(np.float32)
+        if "aniso_aspect" in given:
+            a = np.where(given["aniso_aspect"][0], given["aniso_aspect"][1], a)
+        rows = np.flatnonzero((np.abs(a - np.float32(1.0)) > np.float32(1e-6)) & (self.params.spec_on > 0))
+        if rows.size == 0:
+            return
+        rot_table = getattr(mats, "aniso_rotation", None)
+        rot = np.zeros(rows.size, np.float32) if rot_table is None else rot_table[mat[rows]].astype(np.float32)
+        if "aniso_rotation" in given:
+            rot = np.where(given["aniso_rotation"][0][rows], given["aniso_rotation"][1][rows], rot)
+        tangent = np.empty((3, rows.size), np.float32)
+        own = np.zeros(rows.size, bool) if "tangent" not in given else given["tangent"][0][rows]
+        if own.any():
+            tangent[:, own] = given["tangent"][1][:, rows[own]]
+        if not own.all():
+            r = rows[~own]
+            attrs = self._attributes(ctx, r, cols(self.wo, r), normal=cols(self.ns, r), true_normal=cols(self.ng, r))
+            tangent[:, ~own] = attrs.get("tangent")
+        n = cols(self.ns, rows)
+        theta = np.float32(2.0 * np.pi) * rot
+        tangent = tangent * np.cos(theta) + np.cross(n.T, tangent.T).T * np.sin(theta) + \
+            n * (dot(n, tangent) * (1.0 - np.cos(theta)))
+        t_l = np.stack([dot(tangent, cols(self.t, rows)), dot(tangent, cols(self.bt, rows)), dot(tangent, n)])
+        if self.spec_n is not None:
+            n_l = cols(self.spec_n, rows)
+        else:
+            n_l = np.zeros((3, rows.size), np.float32)
+            n_l[2] = 1.0
+        self.aniso = AnisoFrame.of(rows, self.params.alpha[rows], a[rows], t_l.astype(np.float32), n_l)
 
     def _per_hit_tables(self, rows) -> None:
         """The GGX albedo and the layer factor at hits ``rows`` from their own α and F0 (the per-material rows
@@ -368,6 +430,8 @@ class Surface:
             v.bump_n, v.bump_a2 = self.bump_n, self.bump_a2
             if self.spec_n is not None:
                 v.with_spec_normal(self.spec_n, self.wo_l)
+            if self.aniso is not None:
+                v.with_anisotropy(self.aniso, self.wo_l)
         return v
 
     def take(self, idx) -> "Surface":
@@ -387,6 +451,7 @@ class Surface:
             a = getattr(self, name)
             setattr(out, name, None if a is None else a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1))
         out.bump_a2 = None if self.bump_a2 is None else self.bump_a2[idx]
+        out.aniso = None if self.aniso is None else self.aniso.take(idx, len(self))
         out.params = self.params.take(idx)
         return out
 

@@ -30,7 +30,7 @@ from ..parallel.team import Solo
 from ..profile import NullClock
 from ..restir import di, gi
 from ..restir.history import TemporalHistory
-from ..restir.target import WIDTH, ShadingTerms
+from ..restir.target import ShadingTerms, width
 from ..sampling import finite
 from ..scene import Scene
 from . import coverage as coverage_mod
@@ -395,10 +395,11 @@ class FrameRenderer:
             with run.stage("initial"):
                 candidates = direct.with_light_tiles(ctx, plan, chunks, st.light_sampler, team)
             self.used_tiles = True
-        # the frame's target terms, one (WIDTH, surfaces) block the chunks write into (reuse gathers from it)
-        terms = team.empty((WIDTH, n_surf), np.float32) if plan.resampled else None
+        # the frame's target terms, one (width, surfaces) block the chunks write into (reuse gathers from it)
+        rows = width(ctx.anisotropic)
+        terms = team.empty((rows, n_surf), np.float32) if plan.resampled else None
         # ReSTIR GI's target terms: the same, with the specular lobe off at glossy primary surfaces
-        gi_terms = team.empty((WIDTH, n_surf), np.float32) if plan.gi or plan.probe else None
+        gi_terms = team.empty((rows, n_surf), np.float32) if plan.gi or plan.probe else None
         if plan.resampled:
             with run.stage("initial"):
                 run.map_chunks(lambda c: direct.initial(ctx, plan, candidates, terms, c), chunks, 1)

@@ -15,7 +15,7 @@ from ..integrators import camera_paths, pathtracer
 from ..integrators.method_choice import choose_indirect_method
 from ..materials.params import luminance_rows
 from ..modes import IndirectMethod, Integrator
-from ..restir.target import WIDTH
+from ..restir.target import width
 from ..sampling import STREAM_PROBE, rng
 
 MEASURE_DECAY = 0.8  # weight of the earlier passes' measurements per pass (a memory of about five passes)
@@ -97,7 +97,8 @@ class IndirectChoice:
         if len(surf):
             out = pathtracer.continue_paths(ctx, surf, r, first_bounce=True,
                                             budget=np.full(len(surf), min(PROBE_BOUNCES, ctx.max_bounces)))
-            _glossy, _res, rest, _rest_g = gi_initial(surf, out.first, np.empty((WIDTH, len(surf)), np.float32))
+            _glossy, _res, rest, _rest_g = gi_initial(surf, out.first, np.empty((width(ctx.anisotropic), len(surf)),
+                                                                                np.float32))
             sums = share_sums(out.indirect, rest)
         self.measure = (None, 1)  # measured now: no periodic probe in this frame's first pass
         return sums

@@ -13,11 +13,17 @@ and the Fresnel terms depend on the candidate. The absolute value makes a light 
 its light) a candidate like any other; the estimate f · Le · W keeps its sign. A metal's Specular Tint (F82 term) is
 left out of p̂: p̂ then overestimates a tinted metal's grazing reflection a little, which costs variance, not bias. The half
 vector is never formed: with unit ωo, ωi, |ωo + ωi|² = 2 + 2 ωo·ωi, cos θ_h = (cos θ_o + cos θ_i)/|ωo + ωi|
-and ωo·h = (1 + ωo·ωi)/|ωo + ωi|. Agrees with bsdf.eval_bsdf to float32 rounding (tested).
+and ωo·h = (1 + ωo·ωi)/|ωo + ωi|. Agrees with bsdf.eval_bsdf to float32 rounding (tested). At anisotropic surfaces
+p̂ is the isotropic lobe of the same α = √(αx αy) (positive wherever the anisotropic one is: unbiased, with the
+variance of a less exact target), while the BSDF pdf, which weighs the BSDF candidates against the light candidates,
+is the anisotropic one the BSDF sampler draws from (``aniso``, for the surfaces of the initial resampling).
 
 Layout: structure of arrays. Terms are a (32, n) float32 block (:data:`LAYOUT` rows), light points a
 (11, ...) block (light_tiles.PackedPoints); the candidate axis broadcasts, so p̂ of m candidates at n
-surfaces is one pass over (m, n) arrays.
+surfaces is one pass over (m, n) arrays. In a scene with anisotropic materials the block has ANISO_WIDTH rows: the
+specular lobes' αx, αy and tangent X (world) follow (:data:`ANISO_LAYOUT`; αx = αy = α and X any tangent where a
+surface is isotropic), and p̂'s D and Smith Λ(ωi) are the anisotropic GGX's (core/materials/anisotropy.py) about
+the shading normal (the BSDF's bent specular normal, where it differs, only in the BSDF itself and in the pdf).
 """
 from __future__ import annotations
 
@@ -25,6 +31,7 @@ import numpy as np
 
 from ..lights.table import spot_factor
 from ..lights.tiles import PackedPoints, light_points
+from ..materials.anisotropy import AnisoWorld
 from ..materials.bsdf import fresnel_exact, half_vector_terms, view_terms
 from ..parallel.pool import in_worker, pool
 from ..sampling import to_world
@@ -36,16 +43,30 @@ LAYOUT = {"p": slice(0, 3), "ng": slice(3, 6), "ns": slice(6, 9), "wo": slice(9,
           "a": slice(15, 18), "b": slice(18, 21), "c": slice(21, 24), "co": 24, "alpha2": 25, "alpha": 26,
           "lam_o": 27, "p_spec": 28, "spec_on": 29, "eta2m1": 30, "f0r": 31}
 WIDTH = 32  # float32 per surface: 128 bytes
+ANISO_LAYOUT = {"ax": 32, "ay": 33, "tx": slice(34, 37)}
+ANISO_WIDTH = 37
+
+
+def width(anisotropic: bool) -> int:
+    """Rows of a block of terms: WIDTH, or ANISO_WIDTH where some material may be anisotropic."""
+    return ANISO_WIDTH if anisotropic else WIDTH
 
 
 class ShadingTerms:
     """Per-surface terms of p̂ as a (32, n) float32 block (:data:`LAYOUT`): each term a contiguous row, the
     terms of other pixels (spatial and temporal neighbours) one column gather away (:meth:`take`)."""
 
-    def __init__(self, packed: np.ndarray, glossy: bool | None = None, dielectric: bool | None = None):
+    def __init__(self, packed: np.ndarray, glossy: bool | None = None, dielectric: bool | None = None,
+                 aniso: AnisoWorld | None = None, stretched: bool | None = None):
         self.packed = packed
+        self.aniso = aniso  # anisotropic surfaces: their exact BSDF pdf (of_surfaces; not kept in the packed rows)
         for name, rows in LAYOUT.items():
             setattr(self, name, packed[rows])
+        self.stretched = False  # some surface's lobe is anisotropic (ANISO_LAYOUT rows)
+        if packed.shape[0] >= ANISO_WIDTH:
+            for name, rows in ANISO_LAYOUT.items():
+                setattr(self, name, packed[rows])
+            self.stretched = bool((self.ax != self.ay).any()) if stretched is None else stretched
         self.glossy = bool((self.spec_on > 0).any()) if glossy is None else glossy
         # whether some surface has a dielectric lobe (its exact Fresnel is evaluated per candidate)
         self.dielectric = (self.glossy and bool((self.c > 0).any())) if dielectric is None else dielectric
@@ -88,15 +109,30 @@ class ShadingTerms:
         packed[LAYOUT["p_spec"]] = prm.p_spec
         packed[LAYOUT["alpha"]] = prm.alpha
         packed[LAYOUT["alpha2"]] = v.alpha2
-        return ShadingTerms(packed, dielectric=v.spec_c is not None and v.glossy)
+        aniso = None
+        if v.aniso is not None:
+            r = v.aniso.rows
+            ns, t, bt = np.take(surf.ns, r, axis=1), np.take(surf.t, r, axis=1), np.take(surf.bt, r, axis=1)
+            aniso = AnisoWorld.of(v.aniso, lambda w: to_world(w, ns, t, bt), np.take(wl, r, axis=1))
+        if packed.shape[0] >= ANISO_WIDTH:
+            packed[ANISO_LAYOUT["ax"]] = prm.alpha
+            packed[ANISO_LAYOUT["ay"]] = prm.alpha
+            packed[ANISO_LAYOUT["tx"]] = surf.t
+            if aniso is not None:
+                packed[ANISO_LAYOUT["ax"], aniso.rows] = aniso.ax
+                packed[ANISO_LAYOUT["ay"], aniso.rows] = aniso.ay
+                packed[ANISO_LAYOUT["tx"].start:ANISO_LAYOUT["tx"].stop, aniso.rows] = aniso.x
+        return ShadingTerms(packed, dielectric=v.spec_c is not None and v.glossy, aniso=aniso,
+                            stretched=aniso is not None and packed.shape[0] >= ANISO_WIDTH)
 
     def take(self, idx) -> "ShadingTerms":
         """Terms of surfaces ``idx`` (index array or slice). Without a glossy surface among them only the
         rows the diffuse target and pdf read are gathered (p, ng, ns, kd, p_spec: 13 of 32)."""
+        aniso = None if self.aniso is None else self.aniso.take(idx, len(self))
         if isinstance(idx, slice):
-            return ShadingTerms(self.packed[:, idx], self.glossy, self.dielectric)
+            return ShadingTerms(self.packed[:, idx], self.glossy, self.dielectric, aniso, self.stretched)
         if self.glossy:
-            return ShadingTerms(np.take(self.packed, idx, axis=1), True, self.dielectric)
+            return ShadingTerms(np.take(self.packed, idx, axis=1), True, self.dielectric, aniso, self.stretched)
         out = np.empty((WIDTH, len(idx)), np.float32)
         np.take(self.packed[0:9], idx, axis=1, out=out[0:9])
         np.take(self.packed[12:15], idx, axis=1, out=out[12:15])
@@ -151,14 +187,17 @@ class ShadingTerms:
             wdw += dz * self.wo[2]
             wdw *= inv                               # ωo·ωi
             cos_h, odh, dist_d = half_vector_terms(wdw, self.co, ci, self.alpha2)
-            c2 = ci * ci
-            np.clip(c2, 1e-12, 1.0, out=c2)
-            tan2 = 1.0 - c2
-            tan2 /= c2
-            tan2 *= self.alpha2
-            tan2 += 1.0
-            np.sqrt(tan2, out=tan2)
-            g = tan2
+            if self.stretched:
+                dist_d, g = self._stretched(dx, dy, dz, inv, ci)
+            else:
+                c2 = ci * ci
+                np.clip(c2, 1e-12, 1.0, out=c2)
+                tan2 = 1.0 - c2
+                tan2 /= c2
+                tan2 *= self.alpha2
+                tan2 += 1.0
+                np.sqrt(tan2, out=tan2)
+                g = tan2
             g *= 0.5
             g += 0.5 + self.lam_o                    # 1 + Λ(ωo) + Λ(ωi)
             s = self.spec_on * dist_d
@@ -189,6 +228,10 @@ class ShadingTerms:
             if want_pdf:
                 pdf_s = dist_d * cos_h
                 pdf_s /= 4.0 * odh
+                if self.aniso is not None:  # the anisotropic surfaces' own sampling pdf
+                    ra = self.aniso.rows
+                    iv = inv[..., ra]
+                    pdf_s[..., ra] = self.aniso.reflection_pdf(dx[..., ra] * iv, dy[..., ra] * iv, dz[..., ra] * iv)
         lum *= ci
         lum *= to_area
         np.abs(lum, out=lum)                         # |f · Le|: a negative light's samples are drawn too
@@ -204,6 +247,29 @@ class ShadingTerms:
         pdf *= to_area
         return p_hat, np.multiply(pdf, ok, out=pdf)
 
+
+    def _stretched(self, dx, dy, dz, inv, ci):
+        """The anisotropic GGX's D(h) and √(1 + (αx² ix² + αy² iy²)/cos² θi) = 1 + 2 Λ(ωi) of directions
+        (dx, dy, dz) · inv at every surface, in the frame (X, n_s x X, n_s) of ANISO_LAYOUT's tangent (isotropic
+        surfaces: αx = αy = α, the isotropic terms)."""
+        tx, ns, wo = self.tx, self.ns, self.wo
+        ty = np.stack([ns[1] * tx[2] - ns[2] * tx[1], ns[2] * tx[0] - ns[0] * tx[2], ns[0] * tx[1] - ns[1] * tx[0]])
+        ix = (dx * tx[0] + dy * tx[1] + dz * tx[2]) * inv
+        iy = (dx * ty[0] + dy * ty[1] + dz * ty[2]) * inv
+        hx = ix + (wo[0] * tx[0] + wo[1] * tx[1] + wo[2] * tx[2])
+        hy = iy + (wo[0] * ty[0] + wo[1] * ty[1] + wo[2] * ty[2])
+        hz = ci + self.co
+        q = hx * hx / (self.ax * self.ax) + hy * hy / (self.ay * self.ay)
+        q /= np.maximum(hx * hx + hy * hy + hz * hz, np.float32(1e-30))   # h unit: (hx/αx)² + (hy/αy)², and
+        h2 = hz * hz / np.maximum(hx * hx + hy * hy + hz * hz, np.float32(1e-30))
+        q += h2                                                              # + hz²
+        d = np.float32(np.pi) * self.ax * self.ay * q * q
+        d = np.divide(np.float32(1.0), np.maximum(d, np.float32(1e-30)), out=d)
+        c2 = np.clip(ci * ci, 1e-12, 1.0)
+        lam = ((self.ax * ix) ** 2 + (self.ay * iy) ** 2) / c2
+        lam += 1.0
+        np.sqrt(lam, out=lam)
+        return d, lam
 
     def _evaluate_diffuse(self, dx, dy, dz, d2, pts: PackedPoints, want_pdf: bool):
         """:meth:`evaluate` for blocks without a glossy surface, without square roots: with unnormalized

@@ -353,6 +353,13 @@ def principled_f0(attrs, params, ior, level):
     return f32(np.clip(r * r * 2 * np.maximum(f32(level), 0), 0, 1))
 
 
+def aniso_aspect(attrs, params, anisotropy):
+    """A GGX lobe's anisotropic aspect from a BSDF's anisotropy (params "glossy": the Glossy BSDF's mapping, else
+    the Principled BSDF's; core/materials/anisotropy.py)."""
+    from ..anisotropy import glossy_aspect, principled_aspect
+    return (glossy_aspect if params.get("glossy") else principled_aspect)(f32(anisotropy))
+
+
 def blackbody(attrs, params, temperature):
     """Blackbody node: the colour of a black body at ``temperature`` kelvin (luminance 1, core/lights/blackbody)."""
     from ...lights.blackbody import blackbody_rgb
@@ -370,7 +377,7 @@ OPERATIONS = {
     "color_to_float": lambda attrs, params, c: luminance(c),
     "vector_to_float": lambda attrs, params, v: f32((f32(v)[0] + f32(v)[1] + f32(v)[2]) / 3),
     "float_to_vector": lambda attrs, params, x: f32(np.stack(np.broadcast_arrays(f32(x), f32(x), f32(x)))),
-    "principled_f0": principled_f0,
+    "principled_f0": principled_f0, "aniso_aspect": aniso_aspect,
     "scale": lambda attrs, params, c, s: f32(f32(c) * f32(s)),
     "multiply": lambda attrs, params, a, b: f32(f32(a) * f32(b)),
     "add": lambda attrs, params, a, b: f32(f32(a) + f32(b)),
