@@ -109,6 +109,24 @@ ANISO_GRID = [[
 ]]
 
 
+# Principled Sheen (one row): Weight 1 at Sheen Roughness 0.5 and 0.2 on blue, a tinted half-weight rough sheen on
+# red, a sheen over a metal, the sheen alone over a black base, a rough sheen on grey.
+SHEEN_GRID = [[
+    ("P", (0.2, 0.4, 0.8), 0.5, {"Sheen Weight": 1.0, "Sheen Roughness": 0.5}),
+    ("P", (0.2, 0.4, 0.8), 0.5, {"Sheen Weight": 1.0, "Sheen Roughness": 0.2}),
+    ("P", (0.8, 0.2, 0.2), 0.4, {"Sheen Weight": 0.5, "Sheen Roughness": 0.8, "Sheen Tint": (1.0, 0.8, 0.6, 1.0)}),
+    ("P", (0.9, 0.6, 0.3), 0.4, {"Metallic": 1.0, "Sheen Weight": 1.0, "Sheen Roughness": 0.5}),
+    ("P", (0.0, 0.0, 0.0), 0.3, {"Sheen Weight": 1.0, "Sheen Roughness": 0.3}),
+    ("P", (0.5, 0.5, 0.5), 0.5, {"Sheen Weight": 1.0, "Sheen Roughness": 1.0}),
+]]
+
+
+def sheen_spheres(size=(144, 24), sheen=True):
+    """material_spheres of :data:`SHEEN_GRID` (every Sheen Weight 0 without ``sheen``)."""
+    grid = SHEEN_GRID if sheen else [[(k, c, r, {**e, "Sheen Weight": 0.0}) for k, c, r, e in SHEEN_GRID[0]]]
+    return material_spheres("AREA", size, grid)
+
+
 def aniso_spheres(size=(144, 24), isotropic=False):
     """material_spheres of :data:`ANISO_GRID`, the last sphere's Tangent from a Tangent node (UV map); with
     ``isotropic`` every Anisotropic / Anisotropy set to 0 (what ignoring anisotropy would render)."""

@@ -115,6 +115,8 @@ class MaterialTable:
     aniso_aspect (m,)   the specular lobes' anisotropic aspect k (αx = α/k, αy = α k; 1: isotropic) from Principled
                         Anisotropic or Glossy Anisotropy (core/materials/anisotropy.py); the node program's
                         "aniso_aspect" replaces it per hit
+    sheen_roughness (m,) > 0: a sheen lobe (Sheen BSDF, a Principled BSDF's Sheen component) of this roughness, whose
+                        base_color is its Color (core/materials/sheen.py); 0: none
     aniso_rotation (m,) the tangent's rotation about the normal, in turns (program field "aniso_rotation"); the
                         tangent is the radial one about the object's Z axis unless the program gives "tangent"
     translucent (m,) bool  a Translucent BSDF: Lambertian transmission, base_color/π toward the side away from the
@@ -177,6 +179,7 @@ class MaterialTable:
     holdout: np.ndarray = None  # (m,) bool: a Holdout shader (camera rays meeting it give alpha 0, black)
     translucent: np.ndarray = None  # (m,) bool: a Translucent BSDF (Lambertian transmission of base_color)
     aniso_aspect: np.ndarray = None
+    sheen_roughness: np.ndarray = None
     aniso_rotation: np.ndarray = None
     program: np.ndarray = None
     programs: list = field(default_factory=list)
@@ -210,7 +213,8 @@ class MaterialTable:
             glass_fresnel=col("glass_fresnel", 1.0), glass_beckmann=col("glass_beckmann", 0.0),
             diffuse_roughness=col("diffuse_roughness", 0.0), holdout=col("holdout", False, bool),
             translucent=col("translucent", False, bool),
-            aniso_aspect=col("aniso_aspect", 1.0), aniso_rotation=col("aniso_rotation", 0.0),
+            aniso_aspect=col("aniso_aspect", 1.0), sheen_roughness=col("sheen_roughness", 0.0),
+            aniso_rotation=col("aniso_rotation", 0.0),
             absorption=col("absorption", (0.0, 0.0, 0.0)),
             **_mix_arrays(rows), **_programs(rows), **_programs(rows, "aov_program"),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

@@ -14,7 +14,7 @@ from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
 from .coat import coat_set
 from .flat_nodes import FlatTree, cycles_output, flat_output
-from .sheen import sheen_row
+from .sheen import sheen_row, sheen_set
 from .limits import clamped_radiance
 from .material_textures import TextureReader
 from .mix_shaders import MixShaderReader
@@ -239,9 +239,10 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         return float(socket.default_value)
 
     def _shader(self, material, node, depth: int, base_only: bool = False) -> dict:
-        """The row of shader ``node``; ``base_only``: a Principled BSDF without its coat (export/coat.py)."""
+        """The row of shader ``node``; ``base_only``: a Principled BSDF without its coat (export/coat.py) and sheen
+        (export/sheen.py)."""
         t = node.type
-        if t == "BSDF_PRINCIPLED" and not base_only and coat_set(node):
+        if t == "BSDF_PRINCIPLED" and not base_only and (coat_set(node) or sheen_set(node)):
             return self._mix_program(material, node, depth)
         if t == "BSDF_PRINCIPLED":
             return self._principled(material, node)
@@ -330,7 +331,7 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         row["multiscatter"] = self._multiscatter(material, node)
         self._anisotropy(material, node, row, g, varying, "Anisotropic", "Anisotropic Rotation")
         self._emission(material, g, inp["Emission Color"], inp["Emission Strength"], row, varying)
-        for name in ("Sheen Weight", "Subsurface Weight"):
+        for name in ("Subsurface Weight",):
             if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
                 self._warn(material, f"Principled '{name}' is not supported and was ignored")
         if "Transmission Weight" in inp:

@@ -8,6 +8,7 @@ import dataclasses
 import numpy as np
 
 from .coat import base_albedo, coat_factors, coat_row, coat_set
+from .sheen import sheen_layer, sheen_set
 from .node_graph import GraphCompiler
 
 # Mix/Add shader levels followed; deeper nests (Blender allows any) are cut off with a warning
@@ -75,7 +76,7 @@ class MixShaderReader:
     def _mix_varies(self, node, seen: set) -> bool:
         """Whether a Mix/Add tree has a factor that varies over the surface other than a plain Image Texture
         (those go to the fixed texture path)."""
-        if coat_set(node):  # a coated Principled BSDF is a coat and a base component (export/coat.py)
+        if coat_set(node) or sheen_set(node):  # a coat / sheen and a base component (export/coat.py, sheen.py)
             return True
         if node.type == "BSDF_PRINCIPLED" and "Alpha" in node.inputs and node.inputs["Alpha"].is_linked:
             return True  # its alpha joins the mix's transparent share per hit
@@ -99,7 +100,8 @@ class MixShaderReader:
         product of the factors along them, Fac clamped to [0, 1] as Cycles) and the weighted emission are outputs
         of the mix row's node program ("mix:<k>" for component k, "emission"); components keep weight 1. A coated
         Principled BSDF (``node`` itself, or a leaf) becomes two components, its coat and its base (export/coat.py),
-        the base's Coat Tint factor the program's "mix_tint:<k>"."""
+        the base's Coat Tint factor the program's "mix_tint:<k>"; one with a sheen gets a sheen component on top
+        (export/sheen.py)."""
         g = self._compiler(material)
         weights: dict = {}
         order: list = []
@@ -136,9 +138,23 @@ class MixShaderReader:
                     share = g.emit("multiply", {}, [w, g.emit("one_minus", {}, [a], ("float",))[0]], ("float",))[0]
                     clear = share if clear is None else g.emit("add", {}, [clear, share], ("float",))[0]
                     w = g.emit("multiply", {}, [w, a], ("float",))[0]
+            sheen = sheen_layer(self, material, g, leaf) if sheen_set(leaf) else None
             coat = coat_factors(g, leaf) if coat_set(leaf) else None
-            row = self._shader(material, leaf, depth + 1, base_only=coat is not None)
+            row = self._shader(material, leaf, depth + 1, base_only=coat is not None or sheen is not None)
             tint = None
+            if sheen is not None:  # the sheen on top of the coat, the base and the emission
+                s_row, s_w, s_layer, s_reflectance = sheen
+                outputs[f"mix_pick:{len(comps)}"] = s_reflectance
+                if coat is None:
+                    outputs[f"mix_pick:{len(comps) + 1}"] = g.constant(max(base_albedo(row), 1e-3), "float")
+                index = self.add_row(dict(s_row, name=f"{material.name} ({len(comps) + 1}, sheen)"))
+                sw = g.emit("multiply", {}, [w, s_w], ("float",))[0]
+                if sw.const is not None:
+                    comps.append((index, sw.constant_value(), -1, 0.0))
+                else:
+                    outputs[f"mix:{len(comps)}"] = sw
+                    comps.append((index, 1.0, -1, 0.0))
+                w = g.emit("multiply", {}, [w, s_layer], ("float",))[0]
             if coat is not None:  # the coat, then the base under it
                 coat_w, layer, tint, reflectance = coat
                 outputs[f"mix_pick:{len(comps)}"] = reflectance

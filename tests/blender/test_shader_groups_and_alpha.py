@@ -248,29 +248,39 @@ def test_ambient_occlusion_passes_its_colour_through(addon):
     assert any("Ambient Occlusion" in w and "unoccluded" in w for w in sc.warnings)
 
 
-def test_sheen_bsdf_is_named_and_reflects_its_average(addon):
-    """A Sheen BSDF (glTF's sheen, velvet) is approximated by a diffuse of its colour times the lobe's mean albedo
-    at its roughness (before: a diffuse of the viewport colour, several times too bright), and named."""
+def test_sheen_bsdf_is_named_and_exported_as_a_sheen_lobe(addon):
+    """A Sheen BSDF (glTF's sheen, velvet; Microfiber) becomes a sheen row: its Color and Roughness for the separable
+    lobe of core/materials/sheen.py (before: a diffuse of the viewport colour, several times too bright; then a
+    diffuse of its mean albedo), and is named as an approximation; an Ashikhmin one stays a diffuse of its colour
+    times the lobe's mean albedo."""
     from restir_engine.export.sheen import SHEEN_ALBEDO, SHEEN_ROUGHNESS
 
-    def build():
-        mat = bpy.data.materials.new("Velvet")
-        enable_nodes(mat)
-        t = mat.node_tree
-        t.nodes.remove(t.nodes["Principled BSDF"])
-        sh = t.nodes.new("ShaderNodeBsdfSheen")
-        sh.inputs["Color"].default_value = (0.9, 0.3, 0.6, 1)
-        sh.inputs["Roughness"].default_value = 0.6
-        t.links.new(sh.outputs[0], t.nodes["Material Output"].inputs["Surface"])
-        return mat
-    _facing_plane(build)
+    def build(name, distribution):
+        def make():
+            mat = bpy.data.materials.new(name)
+            enable_nodes(mat)
+            t = mat.node_tree
+            t.nodes.remove(t.nodes["Principled BSDF"])
+            sh = t.nodes.new("ShaderNodeBsdfSheen")
+            sh.distribution = distribution
+            sh.inputs["Color"].default_value = (0.9, 0.3, 0.6, 1)
+            sh.inputs["Roughness"].default_value = 0.6
+            t.links.new(sh.outputs[0], t.nodes["Material Output"].inputs["Surface"])
+            return mat
+        return make
+    _facing_plane(build("Velvet", "MICROFIBER"))
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     i = sc.materials.names.index("Velvet")
-    albedo = np.interp(0.6, SHEEN_ROUGHNESS, SHEEN_ALBEDO["MICROFIBER"])
-    assert 0.1 < albedo < 0.26
-    np.testing.assert_allclose(sc.materials.base_color[i], np.array([0.9, 0.3, 0.6]) * albedo, rtol=1e-5)
+    np.testing.assert_allclose(sc.materials.base_color[i], [0.9, 0.3, 0.6], rtol=1e-5)
+    assert abs(float(sc.materials.sheen_roughness[i]) - 0.6) < 1e-6
     assert float(sc.materials.metallic[i]) == 0 and float(sc.materials.f0[i]) == 0
     assert any("Sheen BSDF" in w and "approximated" in w for w in sc.warnings)
+    _facing_plane(build("Velvet2", "ASHIKHMIN"))
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    i = sc.materials.names.index("Velvet2")
+    albedo = np.interp(0.6, SHEEN_ROUGHNESS, SHEEN_ALBEDO["ASHIKHMIN"])
+    np.testing.assert_allclose(sc.materials.base_color[i], np.array([0.9, 0.3, 0.6]) * albedo, rtol=1e-5)
+    assert float(sc.materials.sheen_roughness[i]) == 0
 
 
 def test_the_output_cycles_renders_is_used(addon):

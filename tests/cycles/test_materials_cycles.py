@@ -361,3 +361,36 @@ def test_anisotropic_ggx_matches_cycles(addon):
     ours = ours_cells(build, 0, 32, cells, integrator="RESTIR", direct_method="RESTIR", bias_correction="UNBIASED",
                       temporal_reuse=True, spatial_neighbors=5)
     assert_cells_match(ours, ref, names, power=spheres)
+
+
+def test_principled_sheen_matches_cycles_within_its_approximation(addon):
+    """Principled Sheen (tests/bpy_scenes.SHEEN_GRID: Weight 1 at Roughness 0.5 and 0.2, a tinted half-weight rough
+    sheen, a sheen over a metal, the sheen alone over black, a rough sheen on grey) is core/materials/sheen.py's
+    separable lobe of Cycles' measured albedo, layered as Cycles layers it, and named as an approximation. Per
+    sphere against Cycles it must stay within the issue's 3 % (+ 5 SE) and recover at least three quarters of what the
+    sheen changes (|ours - Cycles| below a quarter of |Cycles without sheen - Cycles|, + 5 SE) on every sphere where
+    that change exceeds 3 %. Left out, as before, the spheres read 0.66x to 0.94x Cycles; as a diffuse of the lobe's
+    mean albedo up to 1.33x. ReSTIR DI unbiased agrees with our path tracer per sphere (5 SE + 0.5 %)."""
+    from bpy_scenes import SHEEN_GRID, sheen_spheres
+    size = (144, 24)
+    count = len(SHEEN_GRID[0])
+    cells = by_masks(sphere_masks(size)[:count])
+    ours, ref = both("sheen", lambda: sheen_spheres(size), 0, 128, 64, cells, integrator="PATH")
+    bare = cycles_reference("sheen_left_out", lambda: sheen_spheres(size, sheen=False), 0, 64, cells)
+    mo, mr, mb = ours.mean(axis=0), ref.mean(axis=0), bare.mean(axis=0)
+    se = np.sqrt(ours.var(axis=0, ddof=1) / len(ours) + ref.var(axis=0, ddof=1) / len(ref))
+    effect = np.abs(mb - mr)
+    matters = effect > 0.03 * mr
+    assert matters.sum() >= 4
+    report = "\n".join(f"sphere {k}: ours/Cycles {a / c:.4f} (rel SE {e / c:.4f}), without sheen {b / c:.3f}"
+                        for k, (a, b, c, e) in enumerate(zip(mo, mb, mr, se)))
+    assert (np.abs(mo - mr) < 0.03 * mr + 5 * se).all(), report
+    assert (np.abs(mo - mr) < 0.25 * effect + 5 * se)[matters].all(), report
+    # power: the sheen left out (Cycles' own image without it) fails the first check on the spheres it matters on
+    assert not (np.abs(mb - mr) < 0.03 * mr + 5 * se)[matters].any(), report
+    # ReSTIR DI unbiased (its target the lobe's Lambert bound) converges to our path tracer's image of the same lobe
+    restir = ours_cells(lambda: sheen_spheres(size), 0, 48, cells, integrator="RESTIR", direct_method="RESTIR",
+                        bias_correction="UNBIASED", temporal_reuse=True, spatial_neighbors=5)
+    # (power on the sheens over dielectric bases; over the metal and alone they reach rel SE 0.6 %: the target leaves
+    # out the lobe's R(μi), which makes them noisier)
+    assert_cells_match(restir, ours, [f"sphere {k}" for k in range(count)], power=[0, 1, 2, 5])

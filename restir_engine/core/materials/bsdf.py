@@ -32,6 +32,7 @@ from ..sampling import cosine_hemisphere, dot, orthonormal_basis
 from . import microfacet_tables as tables
 from .anisotropy import AnisoFrame
 from .params import SurfaceParams
+from .sheen import SheenRows
 
 INV_PI = np.float32(1.0 / np.pi)
 def smith_view(alpha2: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -98,6 +99,7 @@ class ViewTerms:
     metal_b: np.ndarray | None = None
     metal_d: np.ndarray | None = None
     aniso: AnisoFrame | None = None  # the anisotropic surfaces (their vo is the anisotropic view term)
+    sheen: SheenRows | None = None   # the sheen surfaces (their kd holds R(μo)/Ē; f takes R(μi) too: sheen.py)
 
     def spec_full(self):
         """spec_a ((3, n) or grey (n,)) and spec_b ((3, n) or None) of every surface, metal columns included."""
@@ -144,6 +146,13 @@ class ViewTerms:
         vo = self.vo.copy()
         vo[rows] = frame.smith_v(np.take(wo, rows, axis=1))
         self.vo = vo
+
+    def with_sheen(self, rows: SheenRows, wo: np.ndarray) -> None:
+        """Make the surfaces ``rows.rows`` sheen lobes (core/materials/sheen.py): kd scaled by R(μo)/Ē."""
+        self.sheen = rows
+        kd = np.array(self.kd, np.float32, copy=True)
+        kd[:, rows.rows] *= rows.view_factor(np.clip(wo[2, rows.rows], 0.0, 1.0))
+        self.kd = kd
 
     @staticmethod
     def of(p: SurfaceParams, wo: np.ndarray, albedo: np.ndarray | None = None,
@@ -338,6 +347,9 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
         ok, g = bump_factor(v, wi)
         valid = valid & (ok > 0)
         kd = kd * g
+    if v.sheen is not None:  # the sheen rows' R(μi)
+        kd = np.array(kd, np.float32, copy=True)
+        kd[:, v.sheen.rows] *= v.sheen.light_factor(wi[2, v.sheen.rows])
     if not v.glossy:
         pdf = np.maximum(ci, np.float32(0.0)) * INV_PI * valid
         return (kd * valid).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)
@@ -457,6 +469,11 @@ def diffuse_f(v: ViewTerms, wi: np.ndarray, rows=None) -> np.ndarray:
     kd = v.kd if rows is None else np.take(v.kd, rows, axis=1)
     co = v.co if rows is None else v.co[rows]
     valid = ((wi[2] > 0) & (co > 0)).astype(np.float32)
+    if v.sheen is not None:  # the sheen rows' R(μi)
+        sub = v.sheen if rows is None else v.sheen.take(rows, len(v.co))
+        if sub is not None:
+            kd = np.array(kd, np.float32, copy=True)
+            kd[:, sub.rows] *= sub.light_factor(wi[2, sub.rows])
     if v.bump_n is not None:
         sub = v if rows is None else ViewTerms(None, None, None, None, None, None, None, None, None, None, None,
                                                bump_n=np.take(v.bump_n, rows, axis=1), bump_a2=v.bump_a2[rows])

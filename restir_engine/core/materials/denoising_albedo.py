@@ -14,6 +14,10 @@ def denoising_albedo(surf) -> np.ndarray:
     e = surf.albedo
     one_e = 1.0 - e
     out = v.kd * np.float32(np.pi)
+    if v.sheen is not None:  # a sheen's kd holds R(μo)/Ē (sheen.py): its albedo is Color R(μo)
+        from .sheen import mean_albedo
+        out = np.array(out, np.float32, copy=True)
+        out[:, v.sheen.rows] *= mean_albedo(v.sheen.roughness)
     if p.has("metal"):
         c = np.clip(1.0 - surf.wo_l[2], 0.0, 1.0)
         out = out + (p.a_m + p.b_m * (c * c * c * c * c)) * (e + p.fm * one_e)

@@ -18,6 +18,7 @@ from .microfacet_tables import lerp_rows, mu_index
 from .mix import hash_uniform, pick_components
 from .nodes import HitAttributes, run_programs
 from .params import SurfaceParams
+from .sheen import SheenRows
 from .textures import apply_texture, gradient, sample
 
 
@@ -62,6 +63,9 @@ class Surface:
         self._view_frame()
         mu = self._specular_normal()
         self._anisotropy(ctx, mat)
+        rough = getattr(ctx.scene.materials, "sheen_roughness", None)
+        rows = None if rough is None or not rough.any() else np.flatnonzero(rough[mat] > 0)
+        self.sheen = SheenRows(rows, rough[mat[rows]].astype(np.float32)) if rows is not None and rows.size else None
         # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal): looked
         # up once per hit when first used (α and η are constant per material: one interpolation in μo)
         self._mu, self._tables = mu, (ctx.material_albedo, ctx.material_layer)
@@ -432,6 +436,8 @@ class Surface:
                 v.with_spec_normal(self.spec_n, self.wo_l)
             if self.aniso is not None:
                 v.with_anisotropy(self.aniso, self.wo_l)
+            if self.sheen is not None:
+                v.with_sheen(self.sheen, self.wo_l)
         return v
 
     def take(self, idx) -> "Surface":
@@ -452,6 +458,7 @@ class Surface:
             setattr(out, name, None if a is None else a[:, idx] if isinstance(idx, slice) else np.take(a, idx, axis=1))
         out.bump_a2 = None if self.bump_a2 is None else self.bump_a2[idx]
         out.aniso = None if self.aniso is None else self.aniso.take(idx, len(self))
+        out.sheen = None if self.sheen is None else self.sheen.take(idx, len(self))
         out.params = self.params.take(idx)
         return out
 

@@ -1,5 +1,5 @@
 """The Principled BSDF's layers as node-program operations: how much of the light reaches the base under a Coat,
-as Cycles weighs it (Blender 4.0+).
+as Cycles weighs it (Blender 4.0+), and the Sheen's albedo toward the viewer.
 
 Cycles puts the Coat on top of the base as a dielectric GGX lobe of weight w (Coat Weight) with the exact
 dielectric Fresnel of the Coat IOR η, and scales everything under it by
@@ -10,6 +10,8 @@ dielectric Fresnel of the Coat IOR η, and scales everything under it by
                                                             transmittance at normal incidence; cos θ_t the angle
                                                             of the view refracted into the coat)
 with θ the angle between the view and the coat normal. Both depend on the view only, not on the light.
+The Sheen (Cycles' microfibre lobe) reflects R(μo, roughness) of uniform light toward a view at μo = cos θo
+(core/materials/sheen.py): :func:`sheen_albedo`, which dims what lies under a Principled BSDF's sheen.
 Floats are (n,) or 0-d, vectors and colours (3, n) or (3, 1).
 """
 from __future__ import annotations
@@ -22,6 +24,14 @@ from ..params import fss_dielectric, multiscatter_fresnel
 from .ops_math import _dot, f32
 
 _F = np.float32
+
+
+def sheen_albedo(attrs, params, roughness, normal):
+    """The Sheen's albedo R(μo, roughness) (n,) toward the viewer, μo about the unit ``normal`` facing the viewer
+    (core/materials/sheen.py)."""
+    from ..sheen import albedo
+    cos = np.clip(_dot(attrs.get("incoming"), f32(normal)), 0, 1)
+    return albedo(f32(roughness), cos)
 
 
 def coat_albedo(roughness, cos, eta):
@@ -55,6 +65,6 @@ def coat_layer(attrs, params, weight, ior, tint, normal, roughness):
     return layer, np.broadcast_to(factor, (3, len(attrs))).astype(np.float32), albedo
 
 
-OPERATIONS = {"coat_layer": coat_layer}
+OPERATIONS = {"coat_layer": coat_layer, "sheen_albedo": sheen_albedo}
 #: reads the view: never folded into constants at export
-READS_HITS = frozenset({"coat_layer"})
+READS_HITS = frozenset({"coat_layer", "sheen_albedo"})
