@@ -109,8 +109,9 @@ ANISO_GRID = [[
 ]]
 
 
-# Principled Sheen (one row): Weight 1 at Sheen Roughness 0.5 and 0.2 on blue, a tinted half-weight rough sheen on
-# red, a sheen over a metal, the sheen alone over a black base, a rough sheen on grey.
+# Principled Sheen (one row): Weight 1 at Sheen Roughness 0.5 and 0.2 on blue, a half-weight rough sheen on red (its
+# Tint a Noise Texture: sheen_spheres), a sheen over a metal, the sheen alone over a black base, a sheen on grey (its
+# Roughness a Noise Texture).
 SHEEN_GRID = [[
     ("P", (0.2, 0.4, 0.8), 0.5, {"Sheen Weight": 1.0, "Sheen Roughness": 0.5}),
     ("P", (0.2, 0.4, 0.8), 0.5, {"Sheen Weight": 1.0, "Sheen Roughness": 0.2}),
@@ -122,9 +123,16 @@ SHEEN_GRID = [[
 
 
 def sheen_spheres(size=(144, 24), sheen=True):
-    """material_spheres of :data:`SHEEN_GRID` (every Sheen Weight 0 without ``sheen``)."""
+    """material_spheres of :data:`SHEEN_GRID` (every Sheen Weight 0 without ``sheen``), the third sphere's Sheen
+    Tint and the last's Sheen Roughness from Noise Textures."""
     grid = SHEEN_GRID if sheen else [[(k, c, r, {**e, "Sheen Weight": 0.0}) for k, c, r, e in SHEEN_GRID[0]]]
-    return material_spheres("AREA", size, grid)
+    scene = material_spheres("AREA", size, grid)
+    for c, socket, output in ((2, "Sheen Tint", "Color"), (5, "Sheen Roughness", "Fac")):
+        tree = bpy.data.materials[f"M0{c}"].node_tree
+        noise = tree.nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Scale"].default_value = 6.0
+        tree.links.new(noise.outputs[output], tree.nodes["Principled BSDF"].inputs[socket])
+    return scene
 
 
 def aniso_spheres(size=(144, 24), isotropic=False):

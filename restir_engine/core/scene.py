@@ -131,7 +131,7 @@ class MaterialTable:
     program     (m,) int32  index into ``programs`` of the material's node program (-1 = none): fields that vary
                         per hit ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness",
                         "emission", "mix:<k>" the weight of Mix component k, "aniso_aspect", "aniso_rotation",
-                        "tangent") evaluated at the hits
+                        "tangent", "sheen_roughness") evaluated at the hits
                         (core/materials/nodes), replacing the row's constants
     programs    list of nodes.program.Program
     textures    list of (h, w, 3) float32 linear images, row 0 at the bottom (Blender's order)

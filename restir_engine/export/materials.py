@@ -331,9 +331,10 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         row["multiscatter"] = self._multiscatter(material, node)
         self._anisotropy(material, node, row, g, varying, "Anisotropic", "Anisotropic Rotation")
         self._emission(material, g, inp["Emission Color"], inp["Emission Strength"], row, varying)
-        for name in ("Subsurface Weight",):
-            if name in inp and (inp[name].is_linked or float(inp[name].default_value) > 0):
-                self._warn(material, f"Principled '{name}' is not supported and was ignored")
+        sss = inp.get("Subsurface Weight")
+        if sss is not None and (sss.is_linked or float(sss.default_value) > 0):
+            self._warn(material, "Principled subsurface scattering is not supported: its share renders as the "
+                       "diffuse lobe of the Base Color")
         if "Transmission Weight" in inp:
             self._principled_transmission(material, inp, row, ior)
             if row.get("transmission", 0.0) > 0 and ("aniso_aspect" in row or "aniso_aspect" in varying):

@@ -23,24 +23,26 @@ def _normal(g, node):
 
 def sheen_row(registry, material, node) -> dict:
     """The row of a Sheen BSDF ``node``: Microfiber as core/materials/sheen.py's separable lobe of its Color and
-    Roughness (a varying Roughness approximated by the socket's value, reported); Ashikhmin as a diffuse of its Color
-    times the lobe's mean albedo (:data:`SHEEN_ALBEDO`). Named in a warning. ``registry``: the MaterialRegistry."""
+    Roughness (either from any graph: the program's "base_color" and "sheen_roughness"); Ashikhmin as a diffuse of its
+    Color times the lobe's mean albedo (:data:`SHEEN_ALBEDO`). Named in a warning. ``registry``: the MaterialRegistry."""
     registry._warn(material, f"'{node.name}' (Sheen BSDF) is approximated by a separable lobe of its measured "
                    "albedo")
     g, varying = registry._compiler(material), {}
-    rough = float(np.clip(registry._float_input(material, node.inputs["Roughness"]), 0, 1))
     row = {"f0": 0.0, "metallic": 0.0}
-    colour = g.value(node.inputs["Color"], "color")
     if getattr(node, "distribution", "MICROFIBER") == "MICROFIBER":
-        row["sheen_roughness"] = max(rough, 1e-3)
+        rough = registry._param(material, g, node.inputs["Roughness"], "float", "sheen_roughness", varying)
+        row["sheen_roughness"] = max(float(np.clip(rough, 0, 1)), 1e-3)
+        row["base_color"] = registry._param(material, g, node.inputs["Color"], "color", "base_color", varying)
     else:
+        rough = float(np.clip(registry._float_input(material, node.inputs["Roughness"]), 0, 1))
         albedo = float(np.interp(rough, SHEEN_ROUGHNESS, SHEEN_ALBEDO["ASHIKHMIN"]))
-        colour = g.emit("scale", {}, [colour, g.constant(albedo, "float")], ("color",))[0]
-    if colour.const is not None:
-        row["base_color"] = colour.constant_value()
-    else:
-        row["base_color"] = (1.0, 1.0, 1.0)
-        varying["base_color"] = colour
+        colour = g.emit("scale", {}, [g.value(node.inputs["Color"], "color"), g.constant(albedo, "float")],
+                        ("color",))[0]
+        if colour.const is not None:
+            row["base_color"] = colour.constant_value()
+        else:
+            row["base_color"] = (1.0, 1.0, 1.0)
+            varying["base_color"] = colour
     registry._normal(material, node, row, g, varying)
     return registry._with_program(row, g, varying)
 
@@ -55,8 +57,7 @@ def sheen_layer(registry, material, g, node):
     """A Principled BSDF's sheen as a Mix component, registers of compiler ``g`` where they vary: (its row: the
     sheen lobe of the Sheen Tint and Roughness, its weight Sheen Weight, the layering factor of what lies under it
     1 - Sheen Weight x max(Tint) x R(μo, Sheen Roughness), the component's reflectance estimate); None where the
-    weight folds to the cut-off or below. A varying Tint or Roughness is approximated by the socket's value in the
-    lobe (reported); the layering reads the Roughness per hit."""
+    weight folds to the cut-off or below. Weight, Roughness and Tint may come from any graph."""
     inp = node.inputs
     weight = g.value(inp["Sheen Weight"], "float")
     if weight.const is not None and weight.constant_value() <= CUTOFF:
@@ -65,15 +66,22 @@ def sheen_layer(registry, material, g, node):
                    "measured albedo")
     rough = g.value(inp["Sheen Roughness"], "float")
     albedo = g.emit("sheen_albedo", {}, [rough, _normal(g, node)], ("float",))[0]
-    tint = tuple(max(float(c), 0.0) for c in registry._color_input(material, inp["Sheen Tint"], None, {},
-                                                                      (1.0, 1.0, 1.0))[:3])
-    r = float(np.clip(registry._float_input(material, inp["Sheen Roughness"]), 0, 1))
-    row = {"f0": 0.0, "metallic": 0.0, "base_color": tint, "sheen_roughness": max(r, 1e-3)}
     rg, rvarying = registry._compiler(material), {}
+    row = {"f0": 0.0, "metallic": 0.0}
+    r = registry._param(material, rg, inp["Sheen Roughness"], "float", "sheen_roughness", rvarying)
+    row["sheen_roughness"] = max(float(np.clip(r, 0, 1)), 1e-3)
+    row["base_color"] = registry._param(material, rg, inp["Sheen Tint"], "color", "base_color", rvarying)
     registry._normal(material, node, row, rg, rvarying)  # the sheen follows the Principled BSDF's Normal
     row = registry._with_program(row, rg, rvarying)
-    dim = g.emit("multiply", {}, [g.emit("multiply", {}, [weight, albedo], ("float",))[0],
-                                  g.constant(max(tint), "float")], ("float",))[0]
+    tint = g.value(inp["Sheen Tint"], "color")
+    if tint.const is not None:
+        brightest = g.constant(max(max(float(c), 0.0) for c in tint.constant_value()[:3]), "float")
+    else:
+        rgb = g.emit("separate", {"mode": "RGB"}, [tint], ("float", "float", "float"))
+        brightest = g.emit("math", {"op": "MAXIMUM"}, [rgb[0], g.emit("math", {"op": "MAXIMUM"}, [rgb[1], rgb[2],
+                           g.constant(0.0, "float")], ("float",))[0], g.constant(0.0, "float")], ("float",))[0]
+    dim = g.emit("multiply", {}, [g.emit("multiply", {}, [weight, albedo], ("float",))[0], brightest],
+                 ("float",))[0]
     layer = g.emit("one_minus", {}, [g.emit("saturate", {}, [dim], ("float",))[0]], ("float",))[0]
     reflectance = g.emit("math", {"op": "MAXIMUM"}, [dim, g.constant(1e-3, "float"), g.constant(0.0, "float")],
                          ("float",))[0]

@@ -157,3 +157,30 @@ def test_anisotropy_exports_cycles_aspect_rotation_and_tangent(addon):
     prog = m.programs[m.program[i]]
     assert prog.has("aniso_aspect") and prog.has("tangent")
     assert [w for w in sc.warnings if "Wired" in w and "transmission is rendered isotropic" in w]
+
+
+def test_principled_sheen_becomes_a_sheen_component_over_the_base(addon):
+    """A Principled BSDF with Sheen becomes a Mix of a sheen row (its Tint, its Roughness as sheen_roughness) and the
+    base, named as an approximation; a Sheen Roughness from a graph becomes the sheen row's program field; a Sheen
+    Weight of 0 leaves the material a plain Principled row."""
+    def wire(tree, bsdf):
+        _set(bsdf, "Sheen Weight", 0.7)
+        _set(bsdf, "Sheen Tint", (1.0, 0.5, 0.25, 1.0))
+        noise = _node(tree, "ShaderNodeTexNoise")
+        tree.links.new(noise.outputs["Fac"], bsdf.inputs["Sheen Roughness"])
+    sc, _ = _principled_plane(wire)
+    m = sc.materials
+    i = m.names.index("Wired")
+    comps = m.mix_comp[m.mix_first[i]:m.mix_first[i] + m.mix_count[i]]
+    sheen_rows = [int(c) for c in comps if m.sheen_roughness[c] > 0]
+    assert len(comps) == 2 and len(sheen_rows) == 1
+    k = sheen_rows[0]
+    np.testing.assert_allclose(m.base_color[k], (1.0, 0.5, 0.25), atol=1e-6)
+    assert m.programs[m.program[k]].has("sheen_roughness")
+    assert [w for w in sc.warnings if "Wired" in w and "Sheen" in w and "approximated" in w]
+
+    def off(tree, bsdf):
+        _set(bsdf, "Sheen Weight", 0.0)
+    sc, _ = _principled_plane(off)
+    i = sc.materials.names.index("Wired")
+    assert sc.materials.mix_first[i] == -1 and not [w for w in sc.warnings if "Sheen" in w]

@@ -1,5 +1,6 @@
-"""The Principled BSDF as Cycles builds it (Blender 4.x/5.x), without sheen and transmission (a Coat is a Mix of a
-coat and a base row: export/coat.py); vectorized. Anisotropic hits replace the specular lobes' D and Smith terms
+"""The Principled BSDF as Cycles builds it (Blender 4.x/5.x), without transmission (a Coat or a Sheen is a Mix of a
+coat or sheen row and a base row: export/coat.py, export/sheen.py; a sheen row's diffuse lobe is sheen.py's lobe);
+vectorized. Anisotropic hits replace the specular lobes' D and Smith terms
 with anisotropic GGX (anisotropy.py) at the same α = √(αx αy), so the lobes' weights and compensation stay these.
 
 All directions are (3, n) rows (x, y, z) in the local shading frame (z = shading normal), unit length,

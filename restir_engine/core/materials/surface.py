@@ -25,8 +25,9 @@ from .textures import apply_texture, gradient, sample
 #: the BSDF fields a material's node program may compute (scene.MaterialTable.program)
 PARAM_FIELDS = ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness")
 #: the anisotropy fields it may compute: the aspect (anisotropy.py), its rotation (turns) and the tangent (world,
-#: (3, k))
+#: (3, k)); and a sheen row's roughness (sheen.py)
 ANISO_FIELDS = ("aniso_aspect", "aniso_rotation", "tangent")
+SHEEN_FIELDS = ("sheen_roughness",)
 
 
 class Surface:
@@ -63,9 +64,7 @@ class Surface:
         self._view_frame()
         mu = self._specular_normal()
         self._anisotropy(ctx, mat)
-        rough = getattr(ctx.scene.materials, "sheen_roughness", None)
-        rows = None if rough is None or not rough.any() else np.flatnonzero(rough[mat] > 0)
-        self.sheen = SheenRows(rows, rough[mat[rows]].astype(np.float32)) if rows is not None and rows.size else None
+        self._sheen(ctx, mat)
         # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal): looked
         # up once per hit when first used (α and η are constant per material: one interpolation in μo)
         self._mu, self._tables = mu, (ctx.material_albedo, ctx.material_layer)
@@ -202,8 +201,8 @@ class Surface:
         varying = []
         for rows, out in run_programs(mats, mat, lambda r: self._attributes(
                 ctx, r, cols(self.wo, r), normal=cols(self.ns, r), true_normal=cols(self.ng, r)),
-                PARAM_FIELDS + ANISO_FIELDS):
-            self._given_anisotropy(rows, out, len(mat))
+                PARAM_FIELDS + ANISO_FIELDS + SHEEN_FIELDS):
+            self._given_fields(rows, out, len(mat))
             if not any(f in out for f in PARAM_FIELDS):
                 continue
             tm = mat[rows]
@@ -219,10 +218,10 @@ class Surface:
                 varying.append(rows)
         return np.concatenate(varying) if varying else None
 
-    def _given_anisotropy(self, rows, out: dict, n: int) -> None:
-        """Keep the anisotropy fields a node program computed at hits ``rows`` (``_aniso_given``: field -> (hits
-        given (n,) bool, values (n,) or (3, n)))."""
-        for name in ANISO_FIELDS:
+    def _given_fields(self, rows, out: dict, n: int) -> None:
+        """Keep the anisotropy and sheen fields a node program computed at hits ``rows`` (``_aniso_given``: field ->
+        (hits given (n,) bool, values (n,) or (3, n)))."""
+        for name in ANISO_FIELDS + SHEEN_FIELDS:
             if name not in out:
                 continue
             if self._aniso_given is None:
@@ -272,6 +271,22 @@ class Surface:
             n_l = np.zeros((3, rows.size), np.float32)
             n_l[2] = 1.0
         self.aniso = AnisoFrame.of(rows, self.params.alpha[rows], a[rows], t_l.astype(np.float32), n_l)
+
+    def _sheen(self, ctx, mat) -> None:
+        """The sheen rows among the hits (``sheen``: sheen.SheenRows, or None): their material's sheen roughness, or
+        its node program's."""
+        self.sheen = None
+        rough = getattr(ctx.scene.materials, "sheen_roughness", None)
+        if rough is None or not rough.any():
+            return
+        rows = np.flatnonzero(rough[mat] > 0)
+        if rows.size == 0:
+            return
+        r = rough[mat[rows]].astype(np.float32)
+        given = (self._aniso_given or {}).get("sheen_roughness")
+        if given is not None:
+            r = np.where(given[0][rows], np.clip(given[1][rows], 0.0, 1.0), r).astype(np.float32)
+        self.sheen = SheenRows(rows, r)
 
     def _per_hit_tables(self, rows) -> None:
         """The GGX albedo and the layer factor at hits ``rows`` from their own α and F0 (the per-material rows
