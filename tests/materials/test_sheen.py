@@ -74,3 +74,62 @@ def test_mean_albedo_is_the_tables_cosine_weighted_mean():
         y = 2 * sheen.albedo(r, mu) * mu
         want = float(((y[1:] + y[:-1]) * 0.5 * np.diff(mu)).sum())
         assert abs(float(sheen.mean_albedo(r)) - want) < 2e-3 * want + 1e-5
+
+
+@pytest.mark.parametrize("glossy", [False, True], ids=["diffuse block", "with a glossy surface"])
+def test_restir_target_is_the_sheen_lobe(glossy):
+    """ShadingTerms (with the extension rows a scene with sheen gets) evaluates p̂ = |luminance(f Le)| G with the
+    sheen's R(μi): the same as the BSDF model (shading_value) at sheen surfaces, in a block of diffuse surfaces and
+    in one with a glossy surface too; without the rows (the isotropic block) it differs there."""
+    from restir_engine.core.lights import tiles as light_tiles
+    from restir_engine.core.restir.di import shading_value
+    from restir_engine.core.restir.target import ANISO_WIDTH, WIDTH, ShadingTerms
+    from restir_engine.core.sampling import orthonormal_basis, to_local
+
+    g = np.random.default_rng(5)
+    n = 2000
+
+    class Surf:
+        pass
+    s = Surf()
+    ng = g.normal(size=(3, n))
+    s.ng = (ng / np.linalg.norm(ng, axis=0)).astype(np.float32)
+    s.ns = s.ng.copy()
+    s.p = g.uniform(-1, 1, (3, n)).astype(np.float32)
+    s.t, s.bt = orthonormal_basis(s.ns)
+    wo = s.ng + 0.7 * g.normal(size=(3, n)).astype(np.float32)
+    wo_l = to_local((wo / np.linalg.norm(wo, axis=0)).astype(np.float32), s.ns, s.t, s.bt)
+    wo_l[2] = np.maximum(wo_l[2], 0.05)
+    s.wo_l = (wo_l / np.linalg.norm(wo_l, axis=0)).astype(np.float32)
+    metal = np.zeros(n, np.float32)
+    if glossy:
+        metal[::7] = 1.0
+    s.params = SurfaceParams.from_material(g.uniform(0.1, 0.9, (n, 3)).astype(np.float32), metal,
+                                           np.full(n, 0.4, np.float32), np.zeros(n, np.float32))
+    rows = np.flatnonzero(metal == 0)[::2]
+    s.view = bsdf.ViewTerms.of(s.params, s.wo_l)
+    s.view.with_sheen(SheenRows(rows, g.uniform(0.2, 1.0, rows.size).astype(np.float32)), s.wo_l)
+    pos = g.uniform(-2, 2, (3, n)).astype(np.float32)
+    nl = g.normal(size=(3, n))
+    pts = light_tiles.LightPoints(np.zeros(n, np.int32), np.zeros(n, np.float32), np.zeros(n, np.float32), pos,
+                                  (nl / np.linalg.norm(nl, axis=0)).astype(np.float32), np.ones((3, n), np.float32),
+                                  np.ones(n, np.float32), np.ones(n, bool), np.full(n, -1, np.int32))
+    d = pos - s.p
+    dist = np.linalg.norm(d, axis=0)
+    wi = (d / dist).astype(np.float32)
+    cos_l = -(wi * pts.normal).sum(axis=0)
+    ref, _f, _g, _pdf = shading_value(s, wi, pts.le, dist.astype(np.float32), cos_l.astype(np.float32))
+    live = np.intersect1d(rows, np.flatnonzero(ref > 0))
+    assert live.size > 100
+    for width in (ANISO_WIDTH, WIDTH):
+        terms = ShadingTerms.of_surfaces(s, np.empty((width, n), np.float32))
+        assert terms.glossy == glossy and terms.sheeny == (width == ANISO_WIDTH)
+        p_hat, _ = terms.evaluate(light_tiles.PackedPoints.of(pts.packed()), want_pdf=False)
+        if width == ANISO_WIDTH:
+            np.testing.assert_allclose(p_hat[live], ref[live], rtol=2e-3, atol=1e-6 * ref.max())
+            again, _ = ShadingTerms(terms.packed).take(live).evaluate(
+                light_tiles.PackedPoints.of(pts.packed()[:, live]), want_pdf=False)
+            np.testing.assert_allclose(again, ref[live], rtol=2e-3, atol=1e-6 * ref.max())
+        else:
+            assert (p_hat[live] >= ref[live] * (1 - 2e-3)).all()  # the Lambert bound
+            assert np.abs(p_hat[live] / ref[live] - 1).max() > 0.2

@@ -41,6 +41,7 @@ class TraceContext:
     has_glass: bool = False    # some material has a smooth glass closure (core/materials/glass.py)
     has_programs: bool = False  # some material has a node program (core/materials/nodes)
     anisotropic: bool = False  # some material may have an anisotropic GGX lobe (core/materials/anisotropy.py)
+    sheen: bool = False  # some material is a sheen lobe (core/materials/sheen.py)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -151,6 +152,8 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         and bool((scene.materials.transmission > 0).any()),
                         has_programs=bool(getattr(scene.materials, "programs", None)),
                         anisotropic=may_be_anisotropic(scene.materials), world=world,
+                        sheen=getattr(scene.materials, "sheen_roughness", None) is not None
+                        and bool((scene.materials.sheen_roughness > 0).any()),
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)
 

@@ -396,7 +396,7 @@ class FrameRenderer:
                 candidates = direct.with_light_tiles(ctx, plan, chunks, st.light_sampler, team)
             self.used_tiles = True
         # the frame's target terms, one (width, surfaces) block the chunks write into (reuse gathers from it)
-        rows = width(ctx.anisotropic)
+        rows = width(ctx.anisotropic, ctx.sheen)
         terms = team.empty((rows, n_surf), np.float32) if plan.resampled else None
         # ReSTIR GI's target terms: the same, with the specular lobe off at glossy primary surfaces
         gi_terms = team.empty((rows, n_surf), np.float32) if plan.gi or plan.probe else None

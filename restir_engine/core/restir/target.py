@@ -20,10 +20,12 @@ is the anisotropic one the BSDF sampler draws from (``aniso``, for the surfaces 
 
 Layout: structure of arrays. Terms are a (32, n) float32 block (:data:`LAYOUT` rows), light points a
 (11, ...) block (light_tiles.PackedPoints); the candidate axis broadcasts, so p̂ of m candidates at n
-surfaces is one pass over (m, n) arrays. In a scene with anisotropic materials the block has ANISO_WIDTH rows: the
-specular lobes' αx, αy and tangent X (world) follow (:data:`ANISO_LAYOUT`; αx = αy = α and X any tangent where a
-surface is isotropic), and p̂'s D and Smith Λ(ωi) are the anisotropic GGX's (core/materials/anisotropy.py) about
-the shading normal (the BSDF's bent specular normal, where it differs, only in the BSDF itself and in the pdf).
+surfaces is one pass over (m, n) arrays. In a scene with anisotropic or sheen materials the block has ANISO_WIDTH
+rows: the specular lobes' αx, αy and tangent X (world) follow (:data:`ANISO_LAYOUT`; αx = αy = α and X any tangent
+where a surface is isotropic), and p̂'s D and Smith Λ(ωi) are the anisotropic GGX's (core/materials/anisotropy.py)
+about the shading normal (the BSDF's bent specular normal, where it differs, only in the BSDF itself and in the pdf);
+then a sheen surface's roughness (:data:`SHEEN_ROW`), whose diffuse term takes its light factor R(μi)
+(core/materials/sheen.py), so p̂ is the sheen lobe's own.
 """
 from __future__ import annotations
 
@@ -33,6 +35,7 @@ from ..lights.table import spot_factor
 from ..lights.tiles import PackedPoints, light_points
 from ..materials.anisotropy import AnisoWorld
 from ..materials.bsdf import fresnel_exact, half_vector_terms, view_terms
+from ..materials.sheen import albedo
 from ..parallel.pool import in_worker, pool
 from ..sampling import to_world
 
@@ -44,12 +47,13 @@ LAYOUT = {"p": slice(0, 3), "ng": slice(3, 6), "ns": slice(6, 9), "wo": slice(9,
           "lam_o": 27, "p_spec": 28, "spec_on": 29, "eta2m1": 30, "f0r": 31}
 WIDTH = 32  # float32 per surface: 128 bytes
 ANISO_LAYOUT = {"ax": 32, "ay": 33, "tx": slice(34, 37)}
-ANISO_WIDTH = 37
+SHEEN_ROW = 37  # a sheen surface's roughness (0: not a sheen lobe)
+ANISO_WIDTH = 38  # the block's rows with the extension (anisotropy and sheen)
 
 
-def width(anisotropic: bool) -> int:
-    """Rows of a block of terms: WIDTH, or ANISO_WIDTH where some material may be anisotropic."""
-    return ANISO_WIDTH if anisotropic else WIDTH
+def width(anisotropic: bool, sheen: bool = False) -> int:
+    """Rows of a block of terms: WIDTH, or ANISO_WIDTH where some material may be anisotropic or a sheen."""
+    return ANISO_WIDTH if anisotropic or sheen else WIDTH
 
 
 class ShadingTerms:
@@ -57,16 +61,19 @@ class ShadingTerms:
     terms of other pixels (spatial and temporal neighbours) one column gather away (:meth:`take`)."""
 
     def __init__(self, packed: np.ndarray, glossy: bool | None = None, dielectric: bool | None = None,
-                 aniso: AnisoWorld | None = None, stretched: bool | None = None):
+                 aniso: AnisoWorld | None = None, stretched: bool | None = None, sheeny: bool | None = None):
         self.packed = packed
         self.aniso = aniso  # anisotropic surfaces: their exact BSDF pdf (of_surfaces; not kept in the packed rows)
         for name, rows in LAYOUT.items():
             setattr(self, name, packed[rows])
         self.stretched = False  # some surface's lobe is anisotropic (ANISO_LAYOUT rows)
+        self.sheeny = False     # some surface is a sheen lobe (SHEEN_ROW)
         if packed.shape[0] >= ANISO_WIDTH:
             for name, rows in ANISO_LAYOUT.items():
                 setattr(self, name, packed[rows])
             self.stretched = bool((self.ax != self.ay).any()) if stretched is None else stretched
+            self.sheen_r = packed[SHEEN_ROW]
+            self.sheeny = bool((self.sheen_r > 0).any()) if sheeny is None else sheeny
         self.glossy = bool((self.spec_on > 0).any()) if glossy is None else glossy
         # whether some surface has a dielectric lobe (its exact Fresnel is evaluated per candidate)
         self.dielectric = (self.glossy and bool((self.c > 0).any())) if dielectric is None else dielectric
@@ -122,17 +129,22 @@ class ShadingTerms:
                 packed[ANISO_LAYOUT["ax"], aniso.rows] = aniso.ax
                 packed[ANISO_LAYOUT["ay"], aniso.rows] = aniso.ay
                 packed[ANISO_LAYOUT["tx"].start:ANISO_LAYOUT["tx"].stop, aniso.rows] = aniso.x
+            packed[SHEEN_ROW] = 0.0
+            if v.sheen is not None:
+                packed[SHEEN_ROW, v.sheen.rows] = np.maximum(v.sheen.roughness, np.float32(1e-3))
+        ext = packed.shape[0] >= ANISO_WIDTH
         return ShadingTerms(packed, dielectric=v.spec_c is not None and v.glossy, aniso=aniso,
-                            stretched=aniso is not None and packed.shape[0] >= ANISO_WIDTH)
+                            stretched=aniso is not None and ext, sheeny=v.sheen is not None and ext)
 
     def take(self, idx) -> "ShadingTerms":
         """Terms of surfaces ``idx`` (index array or slice). Without a glossy surface among them only the
         rows the diffuse target and pdf read are gathered (p, ng, ns, kd, p_spec: 13 of 32)."""
         aniso = None if self.aniso is None else self.aniso.take(idx, len(self))
         if isinstance(idx, slice):
-            return ShadingTerms(self.packed[:, idx], self.glossy, self.dielectric, aniso, self.stretched)
-        if self.glossy:
-            return ShadingTerms(np.take(self.packed, idx, axis=1), True, self.dielectric, aniso, self.stretched)
+            return ShadingTerms(self.packed[:, idx], self.glossy, self.dielectric, aniso, self.stretched, self.sheeny)
+        if self.glossy or self.sheeny:
+            return ShadingTerms(np.take(self.packed, idx, axis=1), self.glossy, self.dielectric, aniso, self.stretched,
+                                self.sheeny)
         out = np.empty((WIDTH, len(idx)), np.float32)
         np.take(self.packed[0:9], idx, axis=1, out=out[0:9])
         np.take(self.packed[12:15], idx, axis=1, out=out[12:15])
@@ -180,6 +192,8 @@ class ShadingTerms:
         lum = le[0] * self.kd[0]
         lum += le[1] * self.kd[1]
         lum += le[2] * self.kd[2]
+        if self.sheeny:
+            lum *= self._sheen_factor(ci)
         pdf_s = None
         if self.glossy:
             wdw = dx * self.wo[0]
@@ -248,6 +262,11 @@ class ShadingTerms:
         return p_hat, np.multiply(pdf, ok, out=pdf)
 
 
+    def _sheen_factor(self, ci):
+        """The diffuse term's factor at every surface: R(μi = ci, roughness) at sheen surfaces, 1 elsewhere."""
+        r = np.broadcast_to(self.sheen_r, np.shape(ci))
+        return np.where(r > 0, albedo(np.maximum(r, np.float32(1e-3)), np.clip(ci, 0.0, 1.0)), np.float32(1.0))
+
     def _stretched(self, dx, dy, dz, inv, ci):
         """The anisotropic GGX's D(h) and √(1 + (αx² ix² + αy² iy²)/cos² θi) = 1 + 2 Λ(ωi) of directions
         (dx, dy, dz) · inv at every surface, in the frame (X, n_s x X, n_s) of ANISO_LAYOUT's tangent (isotropic
@@ -278,6 +297,7 @@ class ShadingTerms:
         dn = dx * ns[0]
         dn += dy * ns[1]
         dn += dz * ns[2]
+        sheen_f = self._sheen_factor(dn / np.sqrt(np.maximum(d2, np.float32(1e-30)))) if self.sheeny else None
         ln = dx * nl[0]
         ln += dy * nl[1]
         ln += dz * nl[2]
@@ -300,6 +320,8 @@ class ShadingTerms:
         p_hat = le[0] * kd[0]
         p_hat += le[1] * kd[1]
         p_hat += le[2] * kd[2]
+        if sheen_f is not None:
+            p_hat *= sheen_f
         np.abs(p_hat, out=p_hat)                     # |f · Le| (negative lights)
         p_hat *= geo
         if not want_pdf:
