@@ -97,8 +97,8 @@ class IndirectChoice:
         if len(surf):
             out = pathtracer.continue_paths(ctx, surf, r, first_bounce=True,
                                             budget=np.full(len(surf), min(PROBE_BOUNCES, ctx.max_bounces)))
-            _glossy, _res, rest, _rest_g = gi_initial(surf, out.first, np.empty((width(ctx.anisotropic, ctx.sheen), len(surf)),
-                                                                                np.float32))
+            block = np.empty((width(ctx.anisotropic, ctx.sheen), len(surf)), np.float32)
+            _glossy, _res, rest, _rest_g = gi_initial(surf, out.first, block)
             sums = share_sums(out.indirect, rest)
         self.measure = (None, 1)  # measured now: no periodic probe in this frame's first pass
         return sums
