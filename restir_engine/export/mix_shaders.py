@@ -148,24 +148,14 @@ class MixShaderReader:
                 if coat is None:
                     outputs[f"mix_pick:{len(comps) + 1}"] = g.constant(max(base_albedo(row), 1e-3), "float")
                 index = self.add_row(dict(s_row, name=f"{material.name} ({len(comps) + 1}, sheen)"))
-                sw = g.emit("multiply", {}, [w, s_w], ("float",))[0]
-                if sw.const is not None:
-                    comps.append((index, sw.constant_value(), -1, 0.0))
-                else:
-                    outputs[f"mix:{len(comps)}"] = sw
-                    comps.append((index, 1.0, -1, 0.0))
+                _add_component(comps, outputs, index, g.emit("multiply", {}, [w, s_w], ("float",))[0])
                 w = g.emit("multiply", {}, [w, s_layer], ("float",))[0]
             if coat is not None:  # the coat, then the base under it
                 coat_w, layer, tint, reflectance = coat
                 outputs[f"mix_pick:{len(comps)}"] = reflectance
                 outputs[f"mix_pick:{len(comps) + 1}"] = g.constant(max(base_albedo(row), 1e-3), "float")
                 index = self.add_row(dict(coat_row(self, material, leaf), name=f"{material.name} ({len(comps) + 1}, coat)"))
-                cw = g.emit("multiply", {}, [w, coat_w], ("float",))[0]
-                if cw.const is not None:
-                    comps.append((index, cw.constant_value(), -1, 0.0))
-                else:
-                    outputs[f"mix:{len(comps)}"] = cw
-                    comps.append((index, 1.0, -1, 0.0))
+                _add_component(comps, outputs, index, g.emit("multiply", {}, [w, coat_w], ("float",))[0])
                 w = g.emit("multiply", {}, [w, layer], ("float",))[0]
             if row.get("transparent"):  # opacity 1 - w; summed over transparent leaves
                 clear = w if clear is None else g.emit("add", {}, [clear, w], ("float",))[0]
@@ -185,11 +175,7 @@ class MixShaderReader:
                                                                          if k != "emission"})
                 if tint is not None:
                     outputs[f"mix_tint:{len(comps)}"] = tint
-                if w.const is not None:
-                    comps.append((self.add_row(comp), w.constant_value(), -1, 0.0))
-                else:
-                    outputs[f"mix:{len(comps)}"] = w
-                    comps.append((self.add_row(comp), 1.0, -1, 0.0))
+                _add_component(comps, outputs, self.add_row(comp), w)
         if clear is not None:
             _cut_out_share(g, clear, out, outputs, comps)
         if emission is not None:
@@ -254,6 +240,16 @@ class MixShaderReader:
                     key = (leaf.name, ltx, lsg)
                     merged[key] = (leaf, merged[key][1] + lw if key in merged else lw, ltx, lsg)
         return list(merged.values())
+
+
+def _add_component(comps: list, outputs: dict, index: int, weight) -> None:
+    """Append row ``index`` to the mix's components with ``weight`` (a register): its constant, or weight 1 and the
+    program's "mix:<k>" output where it varies."""
+    if weight.const is not None:
+        comps.append((index, weight.constant_value(), -1, 0.0))
+    else:
+        outputs[f"mix:{len(comps)}"] = weight
+        comps.append((index, 1.0, -1, 0.0))
 
 
 def _cut_out_share(g: GraphCompiler, clear, out: dict, outputs: dict, comps: list) -> None:

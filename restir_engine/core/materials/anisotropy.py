@@ -32,6 +32,16 @@ GLOSSY_MAX = 0.99  # Cycles clamps the Glossy BSDF's anisotropy to [-0.99, 0.99]
 _PI = np.float32(np.pi)
 
 
+def renumbered(rows: np.ndarray, idx, n: int):
+    """Rows ``rows`` (k,) of ``n`` surfaces seen through ``idx`` (index array or slice): (their positions in the
+    taken surfaces, their positions in ``rows``), or None when ``idx`` takes none of them."""
+    pos = np.full(n, -1, np.intp)
+    pos[rows] = np.arange(len(rows))
+    sub = pos[idx]
+    keep = np.flatnonzero(sub >= 0)
+    return None if keep.size == 0 else (keep, sub[keep])
+
+
 def principled_aspect(anisotropy) -> np.ndarray:
     """The Principled BSDF's aspect √(1 - 0.9 a) of Anisotropic a (1 where a ≤ 0)."""
     a = np.clip(np.asarray(anisotropy, np.float32), 0.0, 1.0)
@@ -73,13 +83,10 @@ class AnisoFrame:
     def take(self, idx, n: int) -> "AnisoFrame | None":
         """The frame of surfaces ``idx`` (index array or slice into the ``n`` surfaces), renumbered; None when none
         of them is anisotropic."""
-        pos = np.full(n, -1, np.intp)
-        pos[self.rows] = np.arange(len(self.rows))
-        sub = pos[idx]
-        keep = np.flatnonzero(sub >= 0)
-        if keep.size == 0:
+        got = renumbered(self.rows, idx, n)
+        if got is None:
             return None
-        s = sub[keep]
+        keep, s = got
         return AnisoFrame(keep, self.ax[s], self.ay[s], self.x[:, s], self.y[:, s], self.n[:, s])
 
     def lobe(self, w: np.ndarray):
@@ -170,13 +177,10 @@ class AnisoWorld:
 
     def take(self, idx, n: int) -> "AnisoWorld | None":
         """The rows of surfaces ``idx`` (index array or slice into the ``n`` surfaces), renumbered; None if none."""
-        pos = np.full(n, -1, np.intp)
-        pos[self.rows] = np.arange(len(self.rows))
-        sub = pos[idx]
-        keep = np.flatnonzero(sub >= 0)
-        if keep.size == 0:
+        got = renumbered(self.rows, idx, n)
+        if got is None:
             return None
-        s = sub[keep]
+        keep, s = got
         return AnisoWorld(keep, self.ax[s], self.ay[s], self.x[:, s], self.y[:, s], self.n[:, s], self.wo[:, s])
 
     def reflection_pdf(self, wx, wy, wz) -> np.ndarray:

@@ -329,12 +329,10 @@ def half_vector_terms(wdw: np.ndarray, co, ci, alpha2):
     return cos_h, odh, d
 
 
-def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
-    """f (3, n) and pdf (n,) (solid angle) of unit directions wi (3, n) at surfaces with view terms ``v``. The half
-    vector h = (wo + wi)/|wo + wi| enters only through |wo + wi|² = t = 2 + 2 wo·wi: cos θ_h = (cos θ_o +
-    cos θ_i)/√t and wo·h = √t/2, so the specular pdf D cos θ_h/(4 wo·h) is D (cos θ_o + cos θ_i)/(2t)."""
-    co = v.co
-    ci = wi[2]
+def _diffuse_term(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
+    """(The diffuse lobe's f (3, n) toward unit directions wi: Lambert, Oren–Nayar, the bump-map correction and
+    the sheen rows' R(μi); validity (n,) bool: both directions above the shading normal and the unmapped one)."""
+    co, ci = v.co, wi[2]
     valid = (co > 0) & (ci > 0)
     kd = v.kd
     if v.on_b is not None:  # Oren–Nayar relative to Lambert (on_a, on_b, on_ms carry the factor π)
@@ -351,6 +349,16 @@ def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
     if v.sheen is not None:  # the sheen rows' R(μi)
         kd = np.array(kd, np.float32, copy=True)
         kd[:, v.sheen.rows] *= v.sheen.light_factor(wi[2, v.sheen.rows])
+    return kd, valid
+
+
+def eval_view(v: ViewTerms, wo: np.ndarray, wi: np.ndarray):
+    """f (3, n) and pdf (n,) (solid angle) of unit directions wi (3, n) at surfaces with view terms ``v``. The half
+    vector h = (wo + wi)/|wo + wi| enters only through |wo + wi|² = t = 2 + 2 wo·wi: cos θ_h = (cos θ_o +
+    cos θ_i)/√t and wo·h = √t/2, so the specular pdf D cos θ_h/(4 wo·h) is D (cos θ_o + cos θ_i)/(2t)."""
+    co = v.co
+    ci = wi[2]
+    kd, valid = _diffuse_term(v, wo, wi)
     if not v.glossy:
         pdf = np.maximum(ci, np.float32(0.0)) * INV_PI * valid
         return (kd * valid).astype(np.float32, copy=False), pdf.astype(np.float32, copy=False)

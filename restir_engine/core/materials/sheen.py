@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .anisotropy import renumbered
+
 _TABLE = None
 
 
@@ -65,11 +67,8 @@ class SheenRows:
 
     def take(self, idx, n: int) -> "SheenRows | None":
         """The rows of surfaces ``idx`` (index array or slice into the ``n`` surfaces), renumbered; None if none."""
-        pos = np.full(n, -1, np.intp)
-        pos[self.rows] = np.arange(len(self.rows))
-        sub = pos[idx]
-        keep = np.flatnonzero(sub >= 0)
-        return None if keep.size == 0 else SheenRows(keep, self.roughness[sub[keep]])
+        got = renumbered(self.rows, idx, n)
+        return None if got is None else SheenRows(got[0], self.roughness[got[1]])
 
     def view_factor(self, mu_o: np.ndarray) -> np.ndarray:
         """R(μo)/Ē (k,): what the Lambert lobe's kd of these rows is scaled by toward their views."""

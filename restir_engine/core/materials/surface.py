@@ -11,14 +11,13 @@ import numpy as np
 from ..geometry.camera import pixel_footprint
 from ..sampling import barycentric, cols, dot, norm, orthonormal_basis
 from . import microfacet_tables
-from .anisotropy import AnisoFrame
 from .bsdf import ViewTerms
 from .glass import GLASS_SALT
 from .microfacet_tables import lerp_rows, mu_index
 from .mix import hash_uniform, pick_components
 from .nodes import HitAttributes, run_programs
+from .lobe_fields import anisotropy_frame, keep_given, sheen_rows
 from .params import SurfaceParams
-from .sheen import SheenRows
 from .textures import apply_texture, gradient, sample
 
 
@@ -219,74 +218,16 @@ class Surface:
         return np.concatenate(varying) if varying else None
 
     def _given_fields(self, rows, out: dict, n: int) -> None:
-        """Keep the anisotropy and sheen fields a node program computed at hits ``rows`` (``_aniso_given``: field ->
-        (hits given (n,) bool, values (n,) or (3, n)))."""
-        for name in ANISO_FIELDS + SHEEN_FIELDS:
-            if name not in out:
-                continue
-            if self._aniso_given is None:
-                self._aniso_given = {}
-            given, values = self._aniso_given.get(name) or (np.zeros(n, bool), np.ones((3, n) if name == "tangent"
-                                                                                     else n, np.float32))
-            given[rows] = True
-            values[..., rows] = np.broadcast_to(out[name], values[..., rows].shape)
-            self._aniso_given[name] = (given, values)
+        """Keep the anisotropy and sheen fields a node program computed at hits ``rows`` (lobe_fields.keep_given)."""
+        self._aniso_given = keep_given(self._aniso_given, rows, out, n, ANISO_FIELDS + SHEEN_FIELDS)
 
     def _anisotropy(self, ctx, mat) -> None:
-        """The anisotropic hits' GGX frame (``aniso``: anisotropy.AnisoFrame, or None where no hit is): the
-        material's aspect and Rotation (or its node program's), the tangent from the program
-        (a Tangent input) or the radial tangent about the object's Z axis (Cycles' default), turned about the
-        shading normal by Rotation · 2π, in the local frame about the specular lobes' normal."""
-        self.aniso = None
-        mats, given = ctx.scene.materials, self._aniso_given or {}
-        table = getattr(mats, "aniso_aspect", None)
-        if table is None and "aniso_aspect" not in given:
-            return
-        a = np.ones(len(mat), np.float32) if table is None else table[mat].astype(np.float32)
-        if "aniso_aspect" in given:
-            a = np.where(given["aniso_aspect"][0], given["aniso_aspect"][1], a)
-        rows = np.flatnonzero((np.abs(a - np.float32(1.0)) > np.float32(1e-6)) & (self.params.spec_on > 0))
-        if rows.size == 0:
-            return
-        rot_table = getattr(mats, "aniso_rotation", None)
-        rot = np.zeros(rows.size, np.float32) if rot_table is None else rot_table[mat[rows]].astype(np.float32)
-        if "aniso_rotation" in given:
-            rot = np.where(given["aniso_rotation"][0][rows], given["aniso_rotation"][1][rows], rot)
-        tangent = np.empty((3, rows.size), np.float32)
-        own = np.zeros(rows.size, bool) if "tangent" not in given else given["tangent"][0][rows]
-        if own.any():
-            tangent[:, own] = given["tangent"][1][:, rows[own]]
-        if not own.all():
-            r = rows[~own]
-            attrs = self._attributes(ctx, r, cols(self.wo, r), normal=cols(self.ns, r), true_normal=cols(self.ng, r))
-            tangent[:, ~own] = attrs.get("tangent")
-        n = cols(self.ns, rows)
-        theta = np.float32(2.0 * np.pi) * rot
-        tangent = tangent * np.cos(theta) + np.cross(n.T, tangent.T).T * np.sin(theta) + \
-            n * (dot(n, tangent) * (1.0 - np.cos(theta)))
-        t_l = np.stack([dot(tangent, cols(self.t, rows)), dot(tangent, cols(self.bt, rows)), dot(tangent, n)])
-        if self.spec_n is not None:
-            n_l = cols(self.spec_n, rows)
-        else:
-            n_l = np.zeros((3, rows.size), np.float32)
-            n_l[2] = 1.0
-        self.aniso = AnisoFrame.of(rows, self.params.alpha[rows], a[rows], t_l.astype(np.float32), n_l)
+        """``aniso``: the anisotropic hits' GGX frame, or None (lobe_fields.anisotropy_frame)."""
+        self.aniso = anisotropy_frame(self, ctx, mat, self._aniso_given or {})
 
     def _sheen(self, ctx, mat) -> None:
-        """The sheen rows among the hits (``sheen``: sheen.SheenRows, or None): their material's sheen roughness, or
-        its node program's."""
-        self.sheen = None
-        rough = getattr(ctx.scene.materials, "sheen_roughness", None)
-        if rough is None or not rough.any():
-            return
-        rows = np.flatnonzero(rough[mat] > 0)
-        if rows.size == 0:
-            return
-        r = rough[mat[rows]].astype(np.float32)
-        given = (self._aniso_given or {}).get("sheen_roughness")
-        if given is not None:
-            r = np.where(given[0][rows], np.clip(given[1][rows], 0.0, 1.0), r).astype(np.float32)
-        self.sheen = SheenRows(rows, r)
+        """``sheen``: the sheen rows among the hits, or None (lobe_fields.sheen_rows)."""
+        self.sheen = sheen_rows(ctx, mat, self._aniso_given or {})
 
     def _per_hit_tables(self, rows) -> None:
         """The GGX albedo and the layer factor at hits ``rows`` from their own α and F0 (the per-material rows

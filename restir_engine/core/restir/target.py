@@ -204,14 +204,7 @@ class ShadingTerms:
             if self.stretched:
                 dist_d, g = self._stretched(dx, dy, dz, inv, ci)
             else:
-                c2 = ci * ci
-                np.clip(c2, 1e-12, 1.0, out=c2)
-                tan2 = 1.0 - c2
-                tan2 /= c2
-                tan2 *= self.alpha2
-                tan2 += 1.0
-                np.sqrt(tan2, out=tan2)
-                g = tan2
+                g = self._smith_light(ci)
             g *= 0.5
             g += 0.5 + self.lam_o                    # 1 + Λ(ωo) + Λ(ωi)
             s = self.spec_on * dist_d
@@ -240,12 +233,7 @@ class ShadingTerms:
             spec *= s
             lum += spec
             if want_pdf:
-                pdf_s = dist_d * cos_h
-                pdf_s /= 4.0 * odh
-                if self.aniso is not None:  # the anisotropic surfaces' own sampling pdf
-                    ra = self.aniso.rows
-                    iv = inv[..., ra]
-                    pdf_s[..., ra] = self.aniso.reflection_pdf(dx[..., ra] * iv, dy[..., ra] * iv, dz[..., ra] * iv)
+                pdf_s = self._reflection_pdf(dist_d, cos_h, odh, dx, dy, dz, inv)
         lum *= ci
         lum *= to_area
         np.abs(lum, out=lum)                         # |f · Le|: a negative light's samples are drawn too
@@ -261,6 +249,28 @@ class ShadingTerms:
         pdf *= to_area
         return p_hat, np.multiply(pdf, ok, out=pdf)
 
+
+    def _smith_light(self, ci):
+        """√(1 + α² tan² θi) = 1 + 2 Λ(ωi) of the isotropic GGX at cos θi = ``ci``."""
+        c2 = ci * ci
+        np.clip(c2, 1e-12, 1.0, out=c2)
+        tan2 = 1.0 - c2
+        tan2 /= c2
+        tan2 *= self.alpha2
+        tan2 += 1.0
+        np.sqrt(tan2, out=tan2)
+        return tan2
+
+    def _reflection_pdf(self, dist_d, cos_h, odh, dx, dy, dz, inv):
+        """The specular lobes' sampling pdf D cos θh/(4 ωo·h) (solid angle), the anisotropic surfaces' own where
+        there are some (their sampler's: AnisoWorld) toward directions (dx, dy, dz) · inv."""
+        pdf_s = dist_d * cos_h
+        pdf_s /= 4.0 * odh
+        if self.aniso is not None:
+            ra = self.aniso.rows
+            iv = inv[..., ra]
+            pdf_s[..., ra] = self.aniso.reflection_pdf(dx[..., ra] * iv, dy[..., ra] * iv, dz[..., ra] * iv)
+        return pdf_s
 
     def _sheen_factor(self, ci):
         """The diffuse term's factor at every surface: R(μi = ci, roughness) at sheen surfaces, 1 elsewhere."""
