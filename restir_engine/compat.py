@@ -3,12 +3,15 @@
 Each function names what changed and in which version; callers never test ``bpy.app.version`` themselves.
 - 5.0: materials and worlds always use their node tree (``use_nodes`` is gone).
 - 5.0: image output settings gained ``media_type`` (image / multilayer EXR / video) beside ``file_format``.
+- 5.2: the Principled BSDF's Random Walk subsurface takes Radius x Scale as the mean free path (van de Hulst's
+  albedo mapping; default Scale 0.005); the earlier walk (radius / 4π) became Random Walk (Legacy).
 """
 from __future__ import annotations
 
 import bpy
 
 NODES_ALWAYS = bpy.app.version >= (5, 0, 0)
+RANDOM_WALK_MFP = bpy.app.version >= (5, 2, 0)
 
 
 def uses_nodes(idblock) -> bool:

@@ -135,6 +135,40 @@ def sheen_spheres(size=(144, 24), sheen=True):
     return scene
 
 
+# Subsurface scattering (Principled Random Walk unless named): (base, roughness, Subsurface Weight, Radius, Scale,
+# extra inputs, method). Scales are per Blender series: 5.2's Random Walk takes Radius x Scale as the mean free path,
+# 5.0's divides it by 4π (subsurface_spheres picks the series' column), so both see light bleed through the 0.4 spheres
+SSS_GRID = [
+    ((0.8, 0.5, 0.3), 0.5, 1.0, (1.0, 0.2, 0.1), (1.5, 0.15), {}, "RANDOM_WALK"),
+    ((0.9, 0.9, 0.9), 0.3, 1.0, (1.0, 1.0, 1.0), (3.0, 0.3), {}, "RANDOM_WALK"),
+    ((0.2, 0.6, 0.8), 0.4, 0.5, (0.5, 1.0, 1.0), (2.0, 0.2), {}, "RANDOM_WALK"),
+    ((0.8, 0.6, 0.5), 0.5, 1.0, (1.0, 0.4, 0.2), (3.0, 3.0), {}, "RANDOM_WALK_SKIN"),
+    ((0.7, 0.7, 0.3), 0.5, 1.0, (1.0, 1.0, 1.0), (2.0, 0.2), {"Subsurface Anisotropy": 0.5}, "RANDOM_WALK"),
+    ((0.6, 0.3, 0.6), 0.2, 1.0, (1.0, 0.5, 1.0), (2.0, 0.2), {}, "RANDOM_WALK"),
+]
+
+
+def subsurface_spheres(size=(144, 24), sss=True):
+    """material_spheres of :data:`SSS_GRID` (every Subsurface Weight 0 without ``sss``: what rendering the share as
+    the diffuse lobe gives), the last sphere's Subsurface Weight from a Noise Texture."""
+    mfp = bpy.app.version >= (5, 2, 0)
+    grid = [[("P", c, r, {"Subsurface Weight": w if sss else 0.0, "Subsurface Radius": rad,
+                          "Subsurface Scale": sc[1] if mfp else sc[0], **extra})
+             for c, r, w, rad, sc, extra, _method in SSS_GRID]]
+    scene = material_spheres("AREA", size, grid)
+    for k, (*_rest, method) in enumerate(SSS_GRID):
+        node = bpy.data.materials[f"M0{k}"].node_tree.nodes["Principled BSDF"]
+        node.subsurface_method = method
+        if method == "RANDOM_WALK_SKIN":  # (the socket is found by name only while the method shows it)
+            node.inputs["Subsurface IOR"].default_value = 1.3
+    if sss:
+        tree = bpy.data.materials[f"M0{len(SSS_GRID) - 1}"].node_tree
+        noise = tree.nodes.new("ShaderNodeTexNoise")
+        noise.inputs["Scale"].default_value = 4.0
+        tree.links.new(noise.outputs["Fac"], tree.nodes["Principled BSDF"].inputs["Subsurface Weight"])
+    return scene
+
+
 def aniso_spheres(size=(144, 24), isotropic=False):
     """material_spheres of :data:`ANISO_GRID`, the last sphere's Tangent from a Tangent node (UV map); with
     ``isotropic`` every Anisotropic / Anisotropy set to 0 (what ignoring anisotropy would render)."""

@@ -119,6 +119,13 @@ class MaterialTable:
                         base_color is its Color (core/materials/sheen.py); 0: none
     aniso_rotation (m,) the tangent's rotation about the normal, in turns (program field "aniso_rotation"); the
                         tangent is the radial one about the object's Z axis unless the program gives "tangent"
+    subsurface (m,)     Principled Subsurface Weight (0..1; program field "subsurface"): that share of the diffuse
+                        lobe scatters beneath the surface (core/integrators/subsurface.py)
+    sss_radius (m, 3)   its mean free path per channel in scene units (Subsurface Radius x Scale, before the
+                        method's own scaling)
+    sss_method (m,) int32  the random walk's coefficients and entry (subsurface.WALK_*: 0 none)
+    sss_ior (m,)        the entry's index of refraction (the Principled IOR; Random Walk (Skin): Subsurface IOR)
+    sss_anisotropy (m,) the Henyey–Greenstein g of the medium's phase function (Subsurface Anisotropy, clamped)
     translucent (m,) bool  a Translucent BSDF: Lambertian transmission, base_color/π toward the side away from the
                         viewer and nothing back toward it (Surface turns such hits' frame away from the viewer)
     alpha       (m,)    opacity of an alpha cut-out (1 = opaque; Principled Alpha, Mix with a Transparent BSDF)
@@ -131,7 +138,7 @@ class MaterialTable:
     program     (m,) int32  index into ``programs`` of the material's node program (-1 = none): fields that vary
                         per hit ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness",
                         "emission", "mix:<k>" the weight of Mix component k, "aniso_aspect", "aniso_rotation",
-                        "tangent", "sheen_roughness") evaluated at the hits
+                        "tangent", "sheen_roughness", "subsurface") evaluated at the hits
                         (core/materials/nodes), replacing the row's constants
     programs    list of nodes.program.Program
     textures    list of (h, w, 3) float32 linear images, row 0 at the bottom (Blender's order)
@@ -181,6 +188,11 @@ class MaterialTable:
     aniso_aspect: np.ndarray = None
     sheen_roughness: np.ndarray = None
     aniso_rotation: np.ndarray = None
+    subsurface: np.ndarray = None
+    sss_radius: np.ndarray = None
+    sss_method: np.ndarray = None
+    sss_ior: np.ndarray = None
+    sss_anisotropy: np.ndarray = None
     program: np.ndarray = None
     programs: list = field(default_factory=list)
     aov_program: np.ndarray = None  # (m,) index into aov_programs (the material's AOV Output nodes) or -1
@@ -215,6 +227,9 @@ class MaterialTable:
             translucent=col("translucent", False, bool),
             aniso_aspect=col("aniso_aspect", 1.0), sheen_roughness=col("sheen_roughness", 0.0),
             aniso_rotation=col("aniso_rotation", 0.0),
+            subsurface=col("subsurface", 0.0), sss_radius=col("sss_radius", (0.0, 0.0, 0.0)),
+            sss_method=col("sss_method", 0, np.int32), sss_ior=col("sss_ior", 1.5),
+            sss_anisotropy=col("sss_anisotropy", 0.0),
             absorption=col("absorption", (0.0, 0.0, 0.0)),
             **_mix_arrays(rows), **_programs(rows), **_programs(rows, "aov_program"),
             textures=list(textures or []), names=[r.get("name", f"material{i}") for i, r in enumerate(rows)])

@@ -14,6 +14,7 @@ from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
 from .coat import coat_set
 from .flat_nodes import FlatTree, cycles_output, flat_output
+from .subsurface import principled_subsurface
 from .sheen import sheen_row, sheen_set
 from .limits import clamped_radiance
 from .material_textures import TextureReader
@@ -331,10 +332,7 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         row["multiscatter"] = self._multiscatter(material, node)
         self._anisotropy(material, node, row, g, varying, "Anisotropic", "Anisotropic Rotation")
         self._emission(material, g, inp["Emission Color"], inp["Emission Strength"], row, varying)
-        sss = inp.get("Subsurface Weight")
-        if sss is not None and (sss.is_linked or float(sss.default_value) > 0):
-            self._warn(material, "Principled subsurface scattering is not supported: its share renders as the "
-                       "diffuse lobe of the Base Color")
+        principled_subsurface(self, material, node, row, g, varying, ior)
         if "Transmission Weight" in inp:
             self._principled_transmission(material, inp, row, ior)
             if row.get("transmission", 0.0) > 0 and ("aniso_aspect" in row or "aniso_aspect" in varying):

@@ -159,6 +159,47 @@ def test_anisotropy_exports_cycles_aspect_rotation_and_tangent(addon):
     assert [w for w in sc.warnings if "Wired" in w and "transmission is rendered isotropic" in w]
 
 
+def test_principled_subsurface_exports_the_walks_medium(addon):
+    """Subsurface Weight, Radius x Scale, the method (Random Walk: van de Hulst's walk on Blender 5.2, Chiang's
+    before; Skin with its Subsurface IOR) and Anisotropy become the row's fields without a warning; a Noise Texture
+    on the weight becomes the program's "subsurface"; Christensen-Burley is named (rendered as a random walk)."""
+    from restir_engine.core.integrators import subsurface
+
+    def constant(tree, bsdf):
+        _set(bsdf, "Subsurface Weight", 0.8)
+        _set(bsdf, "Subsurface Radius", (1.0, 0.5, 0.25))
+        _set(bsdf, "Subsurface Scale", 0.2)
+        _set(bsdf, "Subsurface Anisotropy", 0.3)
+        _set(bsdf, "IOR", 1.45)
+    sc, _ = _principled_plane(constant)
+    m, i = sc.materials, sc.materials.names.index("Wired")
+    assert abs(float(m.subsurface[i]) - 0.8) < 1e-6 and m.program[i] == -1
+    np.testing.assert_allclose(m.sss_radius[i], (0.2, 0.1, 0.05), rtol=1e-6)
+    walk = subsurface.WALK_VAN_DE_HULST if bpy.app.version >= (5, 2, 0) else subsurface.WALK_CHIANG
+    assert m.sss_method[i] == walk and abs(float(m.sss_ior[i]) - 1.45) < 1e-6
+    assert abs(float(m.sss_anisotropy[i]) - 0.3) < 1e-6
+    assert not [w for w in sc.warnings if "Wired" in w]
+
+    def skin(tree, bsdf):
+        _set(bsdf, "Subsurface Weight", 1.0)
+        bsdf.subsurface_method = "RANDOM_WALK_SKIN"
+        _set(bsdf, "Subsurface IOR", 1.3)
+        noise = _node(tree, "ShaderNodeTexNoise")
+        tree.links.new(noise.outputs["Fac"], bsdf.inputs["Subsurface Weight"])
+    sc, _ = _principled_plane(skin)
+    m, i = sc.materials, sc.materials.names.index("Wired")
+    assert m.sss_method[i] == subsurface.WALK_SKIN and abs(float(m.sss_ior[i]) - 1.3) < 1e-6
+    assert m.programs[m.program[i]].has("subsurface")
+
+    def burley(tree, bsdf):
+        _set(bsdf, "Subsurface Weight", 1.0)
+        bsdf.subsurface_method = "BURLEY"
+    sc, _ = _principled_plane(burley)
+    m, i = sc.materials, sc.materials.names.index("Wired")
+    assert m.sss_method[i] == subsurface.WALK_CHIANG
+    assert [w for w in sc.warnings if "Wired" in w and "Christensen-Burley" in w]
+
+
 def test_principled_sheen_becomes_a_sheen_component_over_the_base(addon):
     """A Principled BSDF with Sheen becomes a Mix of a sheen row (its Tint, its Roughness as sheen_roughness) and the
     base, named as an approximation; a Sheen Roughness from a graph becomes the sheen row's program field; a Sheen

@@ -223,7 +223,7 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
     alive[idx] = False  # still on glass when the bounce budget ran out
     keep = np.flatnonzero(alive)
     hits.rows = hits.rows[keep]
-    hits.surf = Surface(ctx, prim[keep], b1[keep], b2[keep], o[:, keep], d[:, keep], t[keep])
+    hits.surf = Surface(ctx, prim[keep], b1[keep], b2[keep], o[:, keep], d[:, keep], t[keep], walks=True)
     return SpecularChains(thr[:, keep], depth[keep])
 
 

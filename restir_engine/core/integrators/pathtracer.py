@@ -32,6 +32,7 @@ from ..materials.params import SurfaceParams
 from ..materials.surface import Surface
 from ..materials import volume
 from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
+from .subsurface import subsurface_light
 from .trace_context import TraceContext
 
 
@@ -220,7 +221,8 @@ def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
 def needs_continuation(ctx: TraceContext, direct_resampled: bool, world_resampled: bool = False) -> bool:
     """Whether :func:`continue_paths` has anything to add: bounces, or the first BSDF ray's emitter hits (when
     the direct light is not resampled) or the world it escapes to."""
-    return ctx.max_bounces > 0 or not direct_resampled or ctx.world.sampled and not world_resampled
+    return ctx.max_bounces > 0 or not direct_resampled or ctx.world.sampled and not world_resampled \
+        or ctx.has_subsurface
 
 
 @dataclass
@@ -252,13 +254,26 @@ class PathResult:
     """What :func:`continue_paths` found for primary surfaces (n): ``direct`` (3, n) the first BSDF ray's emitter
     hits (MIS-weighted) and the world it escapes to; ``indirect`` (3, n) bounces 1..max_bounces; ``first`` the
     :class:`FirstBounce` when asked for (indirect is then its throughput · lo), else None. Radiance, scene-linear.
-    With light groups ``direct_g`` and ``indirect_g`` (G, 3, n): the same by the group of their lights."""
+    With light groups ``direct_g`` and ``indirect_g`` (G, 3, n): the same by the group of their lights.
+    ``walked`` (subsurface.SubsurfaceLight or None): what the surfaces' subsurface walks brought, already in direct
+    and indirect (its indirect part is not in ``first``: a stage that replaces the indirect light by the first
+    bounces' adds it again)."""
 
     direct: np.ndarray
     indirect: np.ndarray
     first: FirstBounce | None = None
     direct_g: np.ndarray | None = None
     indirect_g: np.ndarray | None = None
+    walked: object = None
+
+    def add_walked_indirect(self, indirect: np.ndarray, indirect_g: np.ndarray | None) -> None:
+        """Add the subsurface walks' indirect light (and by light group) to ``indirect`` (3, n) in place."""
+        w = self.walked
+        if w is None:
+            return
+        indirect[:, w.rows] += w.indirect
+        if indirect_g is not None and w.indirect_g is not None:
+            indirect_g[:, :, w.rows] += w.indirect_g
 
 
 def _lamps_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, add) -> None:
@@ -399,6 +414,11 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     direct = np.zeros((3, n), np.float32)
     indirect = np.zeros((3, n), np.float32)
     direct_g, indirect_g = light_groups.zeros(ctx.groups, n), light_groups.zeros(ctx.groups, n)
+    walked = subsurface_light(ctx, s, rng, continue_paths, budget) if ctx.has_subsurface else None
+    if walked is not None:
+        direct[:, walked.rows] += walked.direct
+        if direct_g is not None:
+            direct_g[:, :, walked.rows] += walked.direct_g
     idx = np.arange(n)
     throughput = np.ones((3, n), np.float32)
     world_on = ctx.world.sampled or bool((ctx.world.mean > 0).any())
@@ -479,13 +499,15 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
                 budget = budget[idx]
             idx = np.arange(len(idx))
             throughput = np.ones((3, len(idx)), np.float32)
-    if not first_bounce:
-        return PathResult(direct, indirect, None, direct_g, indirect_g)
-    if first is None:
-        first = _no_first_bounce(ctx)
-    else:
-        _through_first(first, indirect, indirect_g)
-    return PathResult(direct, indirect, first, direct_g, indirect_g)
+    out = PathResult(direct, indirect, None, direct_g, indirect_g, walked)
+    if first_bounce:
+        if first is None:
+            first = _no_first_bounce(ctx)
+        else:
+            _through_first(first, indirect, indirect_g)
+        out.first = first
+    out.add_walked_indirect(indirect, indirect_g)
+    return out
 
 
 def _through_first(first: FirstBounce, indirect, indirect_g) -> None:

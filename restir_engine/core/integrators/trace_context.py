@@ -42,6 +42,7 @@ class TraceContext:
     has_programs: bool = False  # some material has a node program (core/materials/nodes)
     anisotropic: bool = False  # some material may have an anisotropic GGX lobe (core/materials/anisotropy.py)
     sheen: bool = False  # some material is a sheen lobe (core/materials/sheen.py)
+    has_subsurface: bool = False  # some material has a subsurface share (integrators/subsurface.py)
     geom_flat: np.ndarray = None        # (n,) bool: the triangle's three corner normals are equal (no interpolation)
     geom_ng_rows: np.ndarray = None     # (3, n) geom_ng as rows
     geom_normal_rows: np.ndarray = None  # (9, n) corner shading normals as rows (corner 0 x, y, z, corner 1 ...)
@@ -154,8 +155,25 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         anisotropic=may_be_anisotropic(scene.materials), world=world,
                         sheen=getattr(scene.materials, "sheen_roughness", None) is not None
                         and bool((scene.materials.sheen_roughness > 0).any()),
+                        has_subsurface=may_have_subsurface(scene.materials),
                         geom_flat=derived.flat, geom_ng_rows=geom_ng_rows, geom_normal_rows=derived.normal_rows,
                         lamp_ng_rows=np.ascontiguousarray(lamp_ng.T), geom_derived=derived)
+
+
+def may_have_subsurface(mats) -> bool:
+    """Whether some material walks beneath its surface: a random-walk method with a Subsurface Weight above 0 (or
+    one its node program computes)."""
+    method = getattr(mats, "sss_method", None)
+    if method is None or not (method > 0).any():
+        return False
+    w = mats.subsurface
+    if bool(((w > 0) & (method > 0)).any()):
+        return True
+    prog = getattr(mats, "program", None)
+    if prog is None:
+        return False
+    progs = getattr(mats, "programs", None) or ()
+    return any(p >= 0 and progs[p].has("subsurface") for p in prog[method > 0])
 
 
 def may_be_anisotropic(mats) -> bool:

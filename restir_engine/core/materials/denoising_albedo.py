@@ -18,6 +18,11 @@ def denoising_albedo(surf) -> np.ndarray:
         from .sheen import mean_albedo
         out = np.array(out, np.float32, copy=True)
         out[:, v.sheen.rows] *= mean_albedo(v.sheen.roughness)
+    if p.has_subsurface():  # camera hits keep the subsurface share as its own lobe: its weight is its albedo
+        from .subsurface_lobe import lobe_weight
+        rows = np.flatnonzero(p.sss.max(axis=0) > 0)
+        out = np.array(out, np.float32, copy=True)
+        out[:, rows] += lobe_weight(surf, rows)
     if p.has("metal"):
         c = np.clip(1.0 - surf.wo_l[2], 0.0, 1.0)
         out = out + (p.a_m + p.b_m * (c * c * c * c * c)) * (e + p.fm * one_e)

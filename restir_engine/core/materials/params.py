@@ -35,10 +35,11 @@ def multiscatter_fresnel(fss: np.ndarray, e_avg: np.ndarray) -> np.ndarray:
 PARAM_ROWS = {"diffuse": slice(0, 3), "a_m": slice(3, 6), "b_m": slice(6, 9), "d_m": slice(9, 12),
               "fm": slice(12, 15), "a_d": slice(15, 18), "c_d": slice(18, 21), "fd": slice(21, 24),
               "msd": slice(24, 27), "diel_f0": slice(27, 30), "alpha": 30, "eta2m1": 31, "f0r": 32, "p_spec": 33,
-              "spec_on": 34, "metal": 35, "diel": 36, "on_a": 37, "on_b": 38, "on_ems": slice(39, 42)}
-PARAM_WIDTH = 42
+              "spec_on": 34, "metal": 35, "diel": 36, "on_a": 37, "on_b": 38, "on_ems": slice(39, 42), "sss": slice(42, 45),
+              "sss_albedo": slice(45, 48)}
+PARAM_WIDTH = 48
 #: The rows that scale with a lobe's weight (Mix/Add components: core/materials/mix.py)
-WEIGHT_ROWS = (slice(0, 12), slice(15, 21))
+WEIGHT_ROWS = (slice(0, 12), slice(15, 21), slice(42, 45))
 
 
 class SurfaceParams:
@@ -55,7 +56,11 @@ class SurfaceParams:
       alpha, eta2m1 = η² - 1, f0r = f0 (untinted), p_spec (probability of sampling a specular lobe), spec_on (1
       where a specular lobe exists), metal, diel (1 where that lobe exists)
       on_a, on_b, on_ems (3)  the diffuse lobe's energy-preserving Oren–Nayar (Cycles 4.3+; Lambert: 1/π, 0, 0):
-                     f_d = diffuse · layer · (a + b t + Ems (1 - E(cos θo)) (1 - E(cos θi))), see :func:`oren_nayar_E`."""
+                     f_d = diffuse · layer · (a + b t + Ems (1 - E(cos θo)) (1 - E(cos θi))), see :func:`oren_nayar_E`
+      sss (3)        the subsurface share of the diffuse lobe, min(base, 1) (1 - metallic) · Subsurface Weight,
+                     layered like the diffuse lobe (core/integrators/subsurface.py walks it at camera hits; elsewhere
+                     it is folded back into ``diffuse``: :meth:`fold_subsurface`)
+      sss_albedo (3) min(base, 1): the colour the walk's medium is fitted to (not scaled by Mix weights)."""
 
     __slots__ = ("_block", "lobes", "_table", "_idx", "_rows", "_mu_rows")
 
@@ -174,6 +179,16 @@ class SurfaceParams:
         self.block[:, idx] = other.block
         self.lobes = self.lobes | other.lobes
 
+    def has_subsurface(self) -> bool:
+        """Whether some entry has a subsurface share (its ``sss`` row not zero)."""
+        return bool(self.sss.any())
+
+    def fold_subsurface(self) -> None:
+        """Render the subsurface share as part of the diffuse lobe (in place): diffuse += sss, sss = 0."""
+        b = self.block
+        b[PARAM_ROWS["diffuse"]] += b[PARAM_ROWS["sss"]]
+        b[PARAM_ROWS["sss"]] = 0.0
+
     def scale(self, factor: np.ndarray) -> None:
         """Scale every lobe by ``factor`` (n,) in place (Fresnel and layering terms are ratios: unchanged)."""
         for rows in WEIGHT_ROWS:
@@ -190,11 +205,11 @@ class SurfaceParams:
 
     @staticmethod
     def from_material(base, metallic, roughness, f0_d, spec_tint=None, metal_f90=None, multiscatter=None,
-                      diffuse_roughness=None):
+                      diffuse_roughness=None, subsurface=None):
         """From base colours (m, 3) (scene-linear RGB, as the material table stores them), metallic, roughness,
         the dielectric f0 (m,) (IOR and Specular IOR Level applied; 0 = no dielectric lobe), and optionally the
-        Specular Tint (m, 3) (white), metal_f90 (m,) (1), multiscatter (m,) (1) and the diffuse roughness (m,) (0:
-        Lambert)."""
+        Specular Tint (m, 3) (white), metal_f90 (m,) (1), multiscatter (m,) (1), the diffuse roughness (m,) (0:
+        Lambert) and the Subsurface Weight (m,) (0)."""
         m = len(metallic)
         base = np.maximum(np.asarray(base, np.float32), 0).T
         met = np.clip(np.asarray(metallic, np.float32), 0, 1)
@@ -221,7 +236,10 @@ class SurfaceParams:
         metal = (met > 0) & ((metal_f0.max(axis=0) > 0) | (f90 > 0))
         out = SurfaceParams(np.zeros((PARAM_WIDTH, m), np.float32), frozenset())  # its lobes: scanned once filled
         b = out.block
-        b[PARAM_ROWS["diffuse"]] = base * (1 - met)
+        sss = np.zeros(m, np.float32) if subsurface is None else np.clip(np.asarray(subsurface, np.float32), 0, 1)
+        b[PARAM_ROWS["diffuse"]] = base * ((1 - met) * (1 - sss))
+        b[PARAM_ROWS["sss"]] = np.minimum(base, 1.0) * ((1 - met) * sss)
+        b[PARAM_ROWS["sss_albedo"]] = np.minimum(base, 1.0)
         b[PARAM_ROWS["a_m"]] = met * metal_f0
         b[PARAM_ROWS["b_m"]] = met * (1 - metal_f0) * f90
         b[PARAM_ROWS["d_m"]] = met * metal_b
@@ -236,7 +254,7 @@ class SurfaceParams:
         b[PARAM_ROWS["eta2m1"]] = eta * eta - 1
         b[PARAM_ROWS["f0r"]] = f0r
         ws = luminance_rows(metal_f0 + (1 - metal_f0) * (0.05 * f90)) * met + luminance_rows(diel_f0) * diel_w
-        wd = luminance_rows(base * (1 - met)) * (1 - f0r)
+        wd = luminance_rows(base * (1 - met)) * (1 - f0r)  # (the subsurface share included: folded or walked)
         tot = ws + wd
         p = np.where(tot > 0, ws / np.maximum(tot, 1e-12), 0.0)
         both = (ws > 0) & (wd > 0)
@@ -265,5 +283,11 @@ class SurfaceParams:
         dr = getattr(mats, "diffuse_roughness", None)
         return SurfaceParams.from_material(mats.base_color[sel] if base is None else base, mats.metallic[sel],
                                            mats.roughness[sel], mats.f0[sel], mats.specular_tint[sel],
-                                           mats.metal_f90[sel], mats.multiscatter[sel],
-                                           None if dr is None else dr[sel])
+                                                   mats.metal_f90[sel], mats.multiscatter[sel],
+                                           None if dr is None else dr[sel], subsurface_of(mats, sel))
+
+
+def subsurface_of(mats, sel) -> np.ndarray | None:
+    """The Subsurface Weight (k,) of materials ``sel`` of a scene.MaterialTable (None where it has none)."""
+    w = getattr(mats, "subsurface", None)
+    return None if w is None else w[sel]

@@ -17,12 +17,12 @@ from .microfacet_tables import lerp_rows, mu_index
 from .mix import hash_uniform, pick_components
 from .nodes import HitAttributes, run_programs
 from .lobe_fields import anisotropy_frame, keep_given, sheen_rows
-from .params import SurfaceParams
+from .params import SurfaceParams, subsurface_of
 from .textures import apply_texture, gradient, sample
 
 
 #: the BSDF fields a material's node program may compute (scene.MaterialTable.program)
-PARAM_FIELDS = ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness")
+PARAM_FIELDS = ("base_color", "metallic", "roughness", "f0", "specular_tint", "diffuse_roughness", "subsurface")
 #: the anisotropy fields it may compute: the aspect (anisotropy.py), its rotation (turns) and the tangent (world,
 #: (3, k)); and a sheen row's roughness (sheen.py)
 ANISO_FIELDS = ("aniso_aspect", "aniso_rotation", "tangent")
@@ -34,7 +34,12 @@ class Surface:
     away from it at Translucent BSDF hits, :meth:`facing_normals`), wo, the tangent frame (t, bt), wo_l, material
     index and BSDF params (textures applied)."""
 
-    def __init__(self, ctx, prim, u, v, o, d, t, camera: bool = False):
+    def __init__(self, ctx, prim, u, v, o, d, t, camera: bool = False, lambert: bool = False,
+                 walks: bool | None = None):
+        """``camera``: hits of camera rays. ``walks`` (default: ``camera``): a subsurface share stays its own lobe
+        (``params.sss``, walked by integrators/subsurface.py) at these hits, the first the camera's paths shade; at
+        others it is part of the diffuse lobe. ``lambert``: every hit is a white Lambertian surface whatever its
+        material (a subsurface walk's exit, as Cycles shades it)."""
         geom = ctx.scene.geometry
         self.camera = camera  # hits of camera rays (Light Path > Is Camera Ray in node programs)
         self._t = t
@@ -56,14 +61,23 @@ class Surface:
         self.wo = -d
         self.bsdf_mat = mat  # the material whose BSDF the hit uses
         self._material_params(ctx, mat, scale, tint)
-        self._glass(ctx, mat, scale, tint, s_ng)
-        away = self._translucent(ctx, mat)
+        if lambert:
+            self.params = SurfaceParams.from_material(np.ones((len(mat), 3), np.float32), np.zeros(len(mat)),
+                                                      np.ones(len(mat)), np.zeros(len(mat)))
+            self._varying = None
+        elif not (camera if walks is None else walks) and getattr(ctx, "has_subsurface", False) \
+                and self.params.has_subsurface():
+            self.params.fold_subsurface()
+        self._glass(ctx, mat, scale, tint, s_ng, lambert)
+        away = None if lambert else self._translucent(ctx, mat)
         self.t, self.bt = orthonormal_basis(self.ns)
         self._bump_shadowing(mapped, smooth_n, s_ng if away is None else s_ng * away)
         self._view_frame()
         mu = self._specular_normal()
         self._anisotropy(ctx, mat)
         self._sheen(ctx, mat)
+        if lambert:
+            self.aniso = self.sheen = None
         # GGX albedo and the dielectric layer's Fresnel factor toward the viewer (about the specular normal): looked
         # up once per hit when first used (α and η are constant per material: one interpolation in μo)
         self._mu, self._tables = mu, (ctx.material_albedo, ctx.material_layer)
@@ -212,7 +226,7 @@ class Surface:
             self.params.assign(rows, SurfaceParams.from_material(
                 base, out.get("metallic", mats.metallic[tm]), out.get("roughness", mats.roughness[tm]),
                 out.get("f0", mats.f0[tm]), out["specular_tint"].T if "specular_tint" in out else mats.specular_tint[tm],
-                mats.metal_f90[tm], mats.multiscatter[tm], dr))
+                mats.metal_f90[tm], mats.multiscatter[tm], dr, out.get("subsurface", subsurface_of(mats, tm))))
             if "roughness" in out or "f0" in out:
                 varying.append(rows)
         return np.concatenate(varying) if varying else None
@@ -239,12 +253,12 @@ class Surface:
         layer[rows] = microfacet_tables.layer_s(p.alpha, mu, p.f0r)
         self._albedo, self._layer = albedo, layer
 
-    def _glass(self, ctx, mat, scale, tint, s_ng) -> None:
+    def _glass(self, ctx, mat, scale, tint, s_ng, lambert: bool = False) -> None:
         """Smooth glass (core/materials/glass.py): picked per point with the material's transmission share; black
         for every evaluation, sampled as a delta closure by pathtracer.sample_rays."""
         self.glass = self.glass_front = self.glass_ior = self.glass_reflect = self.glass_refract = None
         self.glass_alpha = self.glass_ms = self.glass_fresnel = self.glass_beckmann = None
-        if not ctx.has_glass:
+        if not ctx.has_glass or lambert:
             return
         mats, prim, u, v = ctx.scene.materials, self.prim, self.b1, self.b2
         cand = np.flatnonzero(mats.transmission[mat] > 0)

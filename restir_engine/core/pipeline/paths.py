@@ -53,6 +53,7 @@ def paths(ctx, plan: PassPlan, terms, gi_terms, make_gi, c: Chunk) -> None:
         c.glossy, c.gi_res, c.indirect, rest_g = make_gi(c.hits.surf, out.first, block, filled=plan.resampled)
         if rest_g is not None:
             c.indirect_g = rest_g
+        out.add_walked_indirect(c.indirect, c.indirect_g)  # the subsurface walks' light is not GI's to carry
         c.gi_share = share_sums(c.path_indirect, c.indirect)
 
 
