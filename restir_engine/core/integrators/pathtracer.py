@@ -32,7 +32,7 @@ from ..materials.params import SurfaceParams
 from ..materials.surface import Surface
 from ..materials import volume
 from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
-from .subsurface import subsurface_light
+from .subsurface import subsurface_light, vertex_walks, with_exit_rays
 from .trace_context import TraceContext
 
 
@@ -188,6 +188,8 @@ class BsdfRay:
     d: np.ndarray
     hits: object = None
     delta: np.ndarray | None = None  # (k,) bool: a delta sample (smooth glass): f is its weight, pdf DELTA_PDF
+    walked: np.ndarray | None = None    # (k,) bool: a ray from a subsurface walk's exit (subsurface.with_exit_rays)
+    origin_n: np.ndarray | None = None  # (3, k): the normals at the rays' origins where not all are the rows'
 
 
 def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
@@ -393,6 +395,26 @@ def _vertex_light(ctx: TraceContext, s: Surface, rng, target, idx, throughput, f
         target[:, idx] += next_event(ctx, s, rng, throughput, taps=(Tap(target_g, idx),) if g else ())
 
 
+def _exit_light(ctx: TraceContext, walks, rng, target, idx, throughput, first, dthr, at_x2: bool,
+                target_g=None) -> None:
+    """Next-event estimation at the exits of a vertex's subsurface walks (subsurface.VertexWalks), weighed by the
+    walks, into ``target`` and, past a first bounce, wholly into ``first.lo_d`` (a walk is x2's diffuse light)."""
+    ex = walks.exits
+    if ex is None:
+        return
+    rows = walks.rows[ex.at]
+    col = idx[rows]
+    thr = ex.weight if at_x2 else cols(throughput, rows) * ex.weight
+    d_thr = None if first is None else ex.weight if at_x2 else None if dthr is None else cols(dthr, rows) * ex.weight
+    taps = ()
+    if target_g is not None:
+        taps = (Tap(target_g, col, thr),) + (() if d_thr is None else (Tap(first.lo_d_g, col, d_thr),))
+    ne = next_event(ctx, ex.surf, rng, None, taps=taps)
+    target[:, col] += ne * thr
+    if d_thr is not None:
+        first.lo_d[:, col] += ne * d_thr
+
+
 def _no_first_bounce(ctx: TraceContext) -> FirstBounce:
     """A FirstBounce of no rays (no path reached a second vertex)."""
     z3 = np.zeros((3, 0), np.float32)
@@ -433,6 +455,11 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         # --- BSDF sampling (its emission hit still belongs to this bounce's direct light) -------
         ray = first_ray if bounce == 0 and first_ray is not None else \
             sample_rays(s, rng.random((3, len(idx)), dtype=np.float32))
+        walks = vertex_walks(ctx, s, rng) if bounce > 0 and ctx.has_subsurface else None
+        if walks is not None:  # the vertices that chose their subsurface lobe: lit at the exits, rays from there
+            _exit_light(ctx, walks, rng, target, idx, throughput, first, dthr, bounce == 1 and first is not None,
+                        target_g)
+            ray = with_exit_rays(ray, s, walks, rng.random((2, len(walks.rows)), dtype=np.float32))
         rows, wi_l, f, pdf, o, d, hits = ray.rows, ray.wi_l, ray.f, ray.pdf, ray.o, ray.d, ray.hits
         thr = cols(throughput, rows) * f
         scale = wi_l[2] / np.maximum(pdf, np.float32(1e-30))
@@ -441,6 +468,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         thr *= scale
         if bounce == 1 and first is not None:  # x2's diffuse lobe alone (throughput 1 before it)
             dthr = diffuse_f(s.view, wi_l, rows) * scale
+            if ray.walked is not None:  # (a walk counts as x2's diffuse light)
+                dthr[:, ray.walked] = cols(f, np.flatnonzero(ray.walked)) * scale[ray.walked]
         elif dthr is not None:
             dthr = cols(dthr, rows) * f * scale
         ok = vfinite(thr)
@@ -453,8 +482,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         keep = np.flatnonzero(ok)
         if keep.size == 0:
             break
-        if ctx.world.sampled:
-            origin_n = cols(s.ns, rows[keep])  # the receivers' normals, for a constant world's light-sample pdf
+        if ctx.world.sampled:  # the receivers' normals, for a constant world's light-sample pdf
+            origin_n = cols(s.ns, rows[keep]) if ray.origin_n is None else cols(ray.origin_n, keep)
         idx, throughput, prev_pdf = idx[rows[keep]], cols(thr, keep), pdf[keep]
         if dthr is not None:
             dthr = cols(dthr, keep)
@@ -489,7 +518,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         idx, throughput = idx[hsel], cols(throughput, hsel)
         if dthr is not None:
             dthr = cols(dthr, hsel)
-        s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], cols(o, hsel), cols(d, hsel), hits.t[hsel])
+        s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], cols(o, hsel), cols(d, hsel), hits.t[hsel], walks=True)
         if bounce == 0 and first_bounce:
             # from here on the path estimates the radiance leaving x2: throughput 1, accumulated per first hit
             first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.facing_normals()[0], s.params,

@@ -1,12 +1,12 @@
 """Subsurface scattering of the Principled BSDF by random walks, as Cycles renders its Random Walk methods.
 
-At a camera hit whose material has a Subsurface Weight, the subsurface share of the diffuse lobe (SurfaceParams
-``sss``, layered like the diffuse lobe) is estimated by one walk per hit, beside the surface's BSDF (whose diffuse
-lobe then leaves that share out): the path refracts into the mesh, walks through a homogeneous medium until it
-crosses the mesh's surface again (leaving it: a walk that meets the surface from outside, having slipped through
-it by rounding, is lost), and leaves there through a white Lambertian lobe (the exit's own material is not
-evaluated), where it takes next-event estimation and continues as a path. At every other hit the share is part of
-the diffuse lobe (Surface folds it back), which is what a walk converges to where the mean free path is short.
+Where a material has a Subsurface Weight, the subsurface share of the diffuse lobe (SurfaceParams ``sss``, layered
+like the diffuse lobe; the BSDF's diffuse lobe leaves it out) is estimated by walks: at the camera's first hits one
+walk per hit beside the BSDF (:func:`subsurface_light`), at the paths' later vertices a walk in place of the BSDF
+sample, picked with the lobe's share of the albedo (:func:`vertex_walks`). A walk refracts into the mesh, goes
+through a homogeneous medium until it crosses the mesh's surface again (leaving it: a walk that meets the surface
+from outside, having slipped through it by rounding, is lost), and leaves there through a white Lambertian lobe
+(the exit's own material is not evaluated), where it takes next-event estimation and continues as a path.
 
 The medium (per colour channel, scene units): extinction σt and single-scattering albedo α fitted so that a
 half-space of it reflects the Base Color (clamped to 1), from the mean free path ``radius`` (Subsurface Radius x
@@ -319,6 +319,50 @@ def walk(ctx, p: np.ndarray, ng: np.ndarray, d: np.ndarray, obj: np.ndarray, med
     return Exits(rows, prim, hu, hv, cols(pos, rows), cols(direction, rows), cols(weight, rows))
 
 
+def walkable_rows(ctx, surf) -> np.ndarray:
+    """The surfaces (indices) that keep a subsurface share of a walked method."""
+    if not getattr(ctx, "has_subsurface", False) or not surf.params.has_subsurface():
+        return np.zeros(0, np.int64)
+    rows = np.flatnonzero(vmax(surf.params.sss) > 0)
+    return rows[ctx.scene.materials.sss_method[surf.bsdf_mat[rows]] > 0]
+
+
+@dataclass
+class WalkExits:
+    """Walks from surfaces that left their mesh: ``at`` (k,) the walks' indices among the surfaces walked, ``surf``
+    the exits (a white Lambertian Surface, k) and ``weight`` (3, k) each walk's weight, the lobe's weight included."""
+
+    at: np.ndarray
+    surf: Surface
+    weight: np.ndarray
+
+
+def walk_from(ctx, surf, rows: np.ndarray, lobe_w: np.ndarray, rng: np.random.Generator) -> WalkExits | None:
+    """One walk from each surface ``rows`` of ``surf`` whose lobe weighs ``lobe_w`` (3, k): entry, walk, exit
+    (:class:`WalkExits`, or None where none left its mesh)."""
+    mats = ctx.scene.materials
+    mat = surf.bsdf_mat[rows]
+    method = mats.sss_method[mat]
+    params = surf.params.take(rows)
+    ior = mats.sss_ior[mat]
+    med = medium(lobe_w, params.sss_albedo, mats.sss_radius[mat].T, mats.sss_anisotropy[mat], method, ior)
+    u = rng.random((2, rows.size), dtype=np.float32)
+    d, ok = entry_directions(cols(surf.wo, rows), cols(surf.ns, rows), cols(surf.ng, rows), params.alpha, ior,
+                             method == WALK_SKIN, u)
+    inst = ctx.scene.geometry.instance
+    obj = np.zeros(rows.size, np.int64) if inst is None else inst[surf.prim[rows]].astype(np.int64)
+    start = np.flatnonzero(ok)
+    if start.size == 0:
+        return None
+    sub = Medium(cols(med.sigma_t, start), cols(med.alpha, start), med.g[start], cols(med.weight, start))
+    ex = walk(ctx, cols(surf.p, rows[start]), cols(surf.ng, rows[start]), cols(d, start), obj[start], sub, rng)
+    if ex.rows.size == 0:
+        return None
+    o = ex.p + ex.d * np.float32(1e-3)  # the exit seen from outside, as Cycles shades it
+    s = Surface(ctx, ex.prim, ex.u, ex.v, o, -ex.d, np.full(ex.rows.size, 1e-3, np.float32), lambert=True)
+    return WalkExits(start[ex.rows], s, ex.weight)
+
+
 @dataclass
 class SubsurfaceLight:
     """Light the walks from surfaces ``rows`` (k,) bring back: ``direct`` (3, k) at their exits (next-event
@@ -333,45 +377,91 @@ class SubsurfaceLight:
 
 
 def subsurface_light(ctx, surf, rng: np.random.Generator, continue_paths, budget=None) -> SubsurfaceLight | None:
-    """One walk per surface of ``surf`` (camera hits) with a subsurface share, and the light its exit gathers
-    (next_event + ``continue_paths``, pathtracer's). None where no surface has one."""
+    """One walk per surface of ``surf`` (the camera's first hits) with a subsurface share, beside their BSDF, and
+    the light its exit gathers (next_event + ``continue_paths``, pathtracer's). None where no surface has one."""
     from .pathtracer import next_event
-    if not getattr(ctx, "has_subsurface", False) or not surf.params.has_subsurface():
-        return None
-    rows = np.flatnonzero(vmax(surf.params.sss) > 0)
-    mats = ctx.scene.materials
-    mat = surf.bsdf_mat[rows]
-    method = mats.sss_method[mat]
-    rows, mat, method = rows[method > 0], mat[method > 0], method[method > 0]
+    rows = walkable_rows(ctx, surf)
     if rows.size == 0:
         return None
-    params = surf.params.take(rows)
-    ior = mats.sss_ior[mat]
-    med = medium(lobe_weight(surf, rows), params.sss_albedo, mats.sss_radius[mat].T, mats.sss_anisotropy[mat],
-                 method, ior)
-    u = rng.random((2, rows.size), dtype=np.float32)
-    d, ok = entry_directions(cols(surf.wo, rows), cols(surf.ns, rows), cols(surf.ng, rows),
-                             params.alpha, ior, method == WALK_SKIN, u)
-    inst = ctx.scene.geometry.instance
-    obj = np.zeros(rows.size, np.int64) if inst is None else inst[surf.prim[rows]].astype(np.int64)
-    start = np.flatnonzero(ok)
     k = rows.size
     direct, indirect = np.zeros((3, k), np.float32), np.zeros((3, k), np.float32)
     direct_g, indirect_g = light_groups.zeros(ctx.groups, k), light_groups.zeros(ctx.groups, k)
-    if start.size:
-        sub = Medium(cols(med.sigma_t, start), cols(med.alpha, start), med.g[start], cols(med.weight, start))
-        ex = walk(ctx, cols(surf.p, rows[start]), cols(surf.ng, rows[start]), cols(d, start), obj[start], sub, rng)
-        if ex.rows.size:
-            at = start[ex.rows]
-            o = ex.p + ex.d * np.float32(1e-3)  # the exit seen from outside, as Cycles shades it
-            s = Surface(ctx, ex.prim, ex.u, ex.v, o, -ex.d, np.full(ex.rows.size, 1e-3, np.float32), lambert=True)
-            g = ctx.groups is not None
-            ne = next_event(ctx, s, rng, ex.weight, taps=(Tap(direct_g, at),) if g else ())
-            direct[:, at] += ne
-            out = continue_paths(ctx, s, rng, budget=None if budget is None else budget[rows[start][ex.rows]])
-            direct[:, at] += out.direct * ex.weight
-            indirect[:, at] += out.indirect * ex.weight
-            if g:
-                direct_g[:, :, at] += out.direct_g * ex.weight
-                indirect_g[:, :, at] += out.indirect_g * ex.weight
+    ex = walk_from(ctx, surf, rows, lobe_weight(surf, rows), rng)
+    if ex is not None:
+        at, w = ex.at, ex.weight
+        g = ctx.groups is not None
+        direct[:, at] += next_event(ctx, ex.surf, rng, w, taps=(Tap(direct_g, at),) if g else ())
+        out = continue_paths(ctx, ex.surf, rng, budget=None if budget is None else budget[rows[at]])
+        direct[:, at] += out.direct * w
+        indirect[:, at] += out.indirect * w
+        if g:
+            direct_g[:, :, at] += out.direct_g * w
+            indirect_g[:, :, at] += out.indirect_g * w
     return SubsurfaceLight(rows, direct, indirect, direct_g, indirect_g)
+
+
+@dataclass
+class VertexWalks:
+    """At a path vertex after the first (n surfaces): the surfaces that chose their subsurface lobe ``walking``
+    ((n,) bool), the factor ``bsdf_scale`` (n,) of the others' BSDF samples (1/(1 - P(walk))), and the walks that
+    left their mesh (:class:`WalkExits`, ``exits.at`` indexing ``rows``, the walking surfaces), their weight divided
+    by P(walk)."""
+
+    walking: np.ndarray
+    bsdf_scale: np.ndarray
+    rows: np.ndarray
+    exits: WalkExits | None
+
+
+def vertex_walks(ctx, surf, rng: np.random.Generator) -> VertexWalks | None:
+    """Pick, at each surface with a subsurface share, its subsurface lobe or its BSDF, with probability P(walk) =
+    the lobe's share of the surface's albedo toward the viewer (0.05..0.95 where the BSDF reflects too), and walk
+    the chosen (as Cycles picks a closure). None where no surface has a share."""
+    from ..materials.denoising_albedo import denoising_albedo
+    from ..materials.params import luminance_rows
+    cand = walkable_rows(ctx, surf)
+    if cand.size == 0:
+        return None
+    lw = lobe_weight(surf, cand)
+    a = luminance_rows(lw)
+    b = np.maximum(luminance_rows(denoising_albedo(surf.take(cand))) - a, 0.0)
+    p = np.where(a + b > 0, a / np.maximum(a + b, 1e-12), 0.0)
+    p = np.where(b > 0, np.clip(p, 0.05, 0.95), p).astype(np.float32)
+    go = rng.random(cand.size, dtype=np.float32) < p
+    n = len(surf)
+    walking = np.zeros(n, bool)
+    walking[cand[go]] = True
+    scale = np.ones(n, np.float32)
+    scale[cand[~go]] = 1.0 / (1.0 - p[~go])
+    rows = cand[go]
+    exits = walk_from(ctx, surf, rows, lw[:, go] / p[go], rng) if rows.size else None
+    return VertexWalks(walking, scale, rows, exits)
+
+
+def with_exit_rays(ray, surf, walks: VertexWalks, u: np.ndarray):
+    """The BSDF rays ``ray`` (pathtracer.BsdfRay from ``surf``) without the walking surfaces' (the others' weighed by
+    1/(1 - P(walk))), and one cosine-sampled ray from each walk's exit, weighed by the walk (its ``walked`` rows
+    True, ``origin_n`` the exits' normals). ``u`` (2, len(walks.rows)) uniforms."""
+    from .pathtracer import BsdfRay
+    keep = np.flatnonzero(~walks.walking[ray.rows])
+    rows = ray.rows[keep]
+    f = cols(ray.f, keep) * walks.bsdf_scale[rows]
+    parts = [(rows, cols(ray.wi_l, keep), f, ray.pdf[keep], cols(ray.o, keep), cols(ray.d, keep),
+              np.zeros(keep.size, bool) if ray.delta is None else ray.delta[keep], np.zeros(keep.size, bool),
+              cols(surf.ns, rows))]
+    ex = walks.exits
+    if ex is not None:
+        s = ex.surf
+        wi_l = cosine_hemisphere(u[0, ex.at], u[1, ex.at])
+        wi = wi_l[0] * s.t + wi_l[1] * s.bt + wi_l[2] * s.ns
+        wi = (wi / np.maximum(norm(wi), 1e-12)).astype(np.float32)
+        up = np.flatnonzero(dot(wi, s.ng) > 0)
+        pdf = (wi_l[2, up] / np.float32(np.pi)).astype(np.float32)
+        d = cols(wi, up)
+        parts.append((walks.rows[ex.at[up]], cols(wi_l, up), cols(ex.weight, up) / np.float32(np.pi), pdf,
+                      offset_origin(cols(s.p, up), cols(s.ng, up), d), d, np.zeros(up.size, bool),
+                      np.ones(up.size, bool), cols(s.ns, up)))
+    cat = [np.concatenate([p[i] for p in parts], axis=-1) for i in range(9)]
+    out = BsdfRay(cat[0], cat[1], cat[2], cat[3], cat[4], cat[5], delta=cat[6] if ray.delta is not None else None)
+    out.walked, out.origin_n = cat[7], cat[8]
+    return out
