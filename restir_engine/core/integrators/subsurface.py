@@ -255,68 +255,69 @@ def _same_object_hits(ctx, o, d, tmax, obj):
     return prim, t, u, v
 
 
+def _uniform_directions(u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
+    """Directions (3, k) uniform over the sphere (the isotropic phase function)."""
+    z = 1.0 - 2.0 * u1
+    r = np.sqrt(np.maximum(0.0, 1.0 - z * z))
+    phi = np.float32(2.0 * np.pi) * u2
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z]).astype(np.float32)
+
+
 def walk(ctx, p: np.ndarray, ng: np.ndarray, d: np.ndarray, obj: np.ndarray, med: Medium,
          rng: np.random.Generator) -> Exits:
     """Random walks from entry points ``p`` (3, k) (geometric normals ``ng`` facing out) along entry directions
-    ``d`` (3, k) through the media ``med`` of objects ``obj`` (k,), until each crosses its object's surface."""
+    ``d`` (3, k) through the media ``med`` of objects ``obj`` (k,), until each crosses its object's surface. The
+    walks' state is kept compacted to the walks still going."""
     k = p.shape[1]
-    sigma_s = med.sigma_t * med.alpha
-    sigma_s_star = sigma_s * (1.0 - med.g)
-    sigma_t_star = med.sigma_t - sigma_s + sigma_s_star
-    pos = offset_origin(p, ng, d)
-    weight = med.weight.copy()
-    direction = d.copy()
-    alive = np.arange(k)
+    ss_ = med.sigma_t * med.alpha
+    state = {"id": np.arange(k), "pos": offset_origin(p, ng, d), "dir": d.copy(), "w": med.weight.copy(),
+             "st": med.sigma_t, "ss": ss_, "st2": med.sigma_t - ss_ * med.g, "ss2": ss_ * (1.0 - med.g),
+             "alpha": med.alpha, "g": med.g, "obj": obj}
+    isotropic = not bool(np.any(np.abs(med.g) >= 1e-3))
     out = []
     for step in range(MAX_STEPS):
-        if alive.size == 0:
+        m = state["id"].size
+        if m == 0:
             break
-        m = alive.size
         u = rng.random((4, m), dtype=np.float32)
         late = step > SIMILARITY_AFTER
-        st = cols(sigma_t_star if late else med.sigma_t, alive)
-        ss = cols(sigma_s_star if late else sigma_s, alive)
+        st, ss = (state["st2"], state["ss2"]) if late else (state["st"], state["ss"])
         if step > 0:
-            g = np.zeros(m, np.float32) if late else med.g[alive]
-            direction[:, alive] = _phase_directions(cols(direction, alive), g, u[2], u[3])
-        w = cols(weight, alive)
-        cp = np.abs(w) * cols(med.alpha, alive)
+            state["dir"] = _uniform_directions(u[2], u[3]) if isotropic or late else \
+                _phase_directions(state["dir"], state["g"], u[2], u[3])
+        w, dr, o = state["w"], state["dir"], state["pos"]
+        cp = np.abs(w) * state["alpha"]
         tot = cp.sum(axis=0)
         cp = np.where(tot > 0, cp / np.where(tot > 0, tot, 1.0), np.float32(1.0 / 3.0)).astype(np.float32)
-        cdf = np.cumsum(cp, axis=0)
-        ch = (u[0][None, :] >= cdf[:2]).sum(axis=0)
+        ch = (u[0] >= cp[0]).astype(np.intp) + (u[0] >= cp[0] + cp[1])
         sig = st[ch, np.arange(m)]
         dist = (-np.log1p(-np.minimum(u[1], np.float32(1 - 1e-7))) / np.maximum(sig, 1e-30)).astype(np.float32)
-        dr = cols(direction, alive)
-        o = cols(pos, alive)
-        prim, th, hu, hv = _same_object_hits(ctx, o, dr, dist, obj[alive])
+        prim, th, hu, hv = _same_object_hits(ctx, o, dr, dist, state["obj"])
         hit = (prim >= 0) & (th < dist)
         # a crossing into the mesh (the walk slipped out through a surface it started on, by rounding) ends it
         lost = hit & (dot(cols(ctx.geom_ng_rows, np.maximum(prim, 0)), dr) < 0)
         hit &= ~lost
         dist = np.where(hit, th, dist).astype(np.float32)
-        pos[:, alive] = o + dr * dist
+        state["pos"] = o + dr * dist
         tr = np.exp(-st * dist)
         pdf = (cp * np.where(hit, tr, st * tr)).sum(axis=0)
         w = w * np.where(hit, tr, ss * tr) / np.maximum(pdf, 1e-30)
-        weight[:, alive] = w
+        state["w"] = w
         done = np.flatnonzero(hit)
         if done.size:
-            r = alive[done]
-            out.append((r, prim[done], hu[done], hv[done]))
-        keep = ~hit & ~lost & (vmax(w) >= WEIGHT_FLOOR) & np.isfinite(w).all(axis=0)
-        alive = alive[keep]
+            out.append((state["id"][done], prim[done], hu[done], hv[done], cols(state["pos"], done), cols(dr, done),
+                        cols(w, done)))
+        keep = np.flatnonzero(~hit & ~lost & (vmax(w) >= WEIGHT_FLOOR) & np.isfinite(w).all(axis=0))
+        if keep.size < m:
+            state = {key: (a[keep] if a.ndim == 1 else np.take(a, keep, axis=1)) for key, a in state.items()}
     if not out:
         z = np.zeros(0, np.int64)
-        return Exits(z, z, np.zeros(0, np.float32), np.zeros(0, np.float32), np.zeros((3, 0), np.float32),
-                     np.zeros((3, 0), np.float32), np.zeros((3, 0), np.float32))
-    rows = np.concatenate([r for r, *_ in out])
-    prim = np.concatenate([x for _, x, _, _ in out])
-    hu = np.concatenate([x for _, _, x, _ in out])
-    hv = np.concatenate([x for *_, x in out])
-    order = np.argsort(rows, kind="stable")
-    rows, prim, hu, hv = rows[order], prim[order], hu[order], hv[order]
-    return Exits(rows, prim, hu, hv, cols(pos, rows), cols(direction, rows), cols(weight, rows))
+        e3 = np.zeros((3, 0), np.float32)
+        return Exits(z, z, np.zeros(0, np.float32), np.zeros(0, np.float32), e3, e3.copy(), e3.copy())
+    cat = [np.concatenate([part[i] for part in out], axis=-1) for i in range(7)]
+    order = np.argsort(cat[0], kind="stable")
+    cat = [c[..., order] for c in cat]
+    return Exits(*cat)
 
 
 def walkable_rows(ctx, surf) -> np.ndarray:
