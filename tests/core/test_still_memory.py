@@ -60,3 +60,21 @@ def test_film_sums_are_float32():
     f = film.Film(8, 4, gi=True, denoise_data=True, adaptive=True)
     assert {a.dtype for a in f.acc.values()} == {np.dtype(np.float32)}
     f.release()
+
+
+def test_estimate_counts_the_target_terms_extension_rows():
+    """A scene with an anisotropic lobe widens every target-term block by its six extension rows (restir/target.py):
+    four float32 blocks per pixel (DI and GI, this frame's and the history's) under ReSTIR DI + GI, none under the
+    path tracer."""
+    from restir_engine.core.pipeline import memory
+    from restir_engine.core.restir import target
+    scene = regression_room()
+    st = RenderSettings(integrator="RESTIR", direct_method="RESTIR", indirect_method="RESTIR_GI")
+    plain = memory.frame_estimate(scene, st)
+    scene.materials.aniso_aspect = scene.materials.aniso_aspect.copy()
+    scene.materials.aniso_aspect[0] = 0.5
+    rows = target.width(True) - target.WIDTH
+    wide = memory.frame_estimate(scene, st)
+    assert wide.low - plain.low == rows * 4 * 4 * plain.pixels
+    assert memory.frame_estimate(scene, RenderSettings(integrator="PATH")).low == \
+        memory.frame_estimate(regression_room(), RenderSettings(integrator="PATH")).low

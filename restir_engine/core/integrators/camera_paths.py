@@ -14,7 +14,8 @@ from ..lights.table import emitted_radiance
 from ..materials import volume
 from ..materials.surface import Surface
 from ..sampling import cols, finite
-from .pathtracer import _lamp_emission, lamp_hits, sample_rays
+from .pathtracer import sample_rays
+from .ray_emission import _lamp_emission, lamp_hits
 from .trace_context import TraceContext
 
 

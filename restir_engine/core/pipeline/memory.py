@@ -11,7 +11,9 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
+from ..integrators.trace_context import may_be_anisotropic
 from ..modes import DirectMethod, IndirectMethod, Integrator
+from ..restir import target
 from . import methods
 
 BASE = 370  # camera paths, film (float32 sums), passes: the path tracer, or light sampling with path-traced indirect
@@ -53,12 +55,31 @@ def frame_estimate(scene, settings, keeps_history: bool = True) -> MemoryEstimat
     groups = getattr(scene, "light_groups", None)
     if groups is not None:  # per light group: a float32 RGB film sum and float32 RGB estimates of the pass's stages
         low, high = low + len(groups) * 24, high + len(groups) * 48
+    extra = target_extension_bytes(scene, settings)
+    if extra:  # anisotropic or sheen lobes widen the target terms of the reservoirs
+        low, high = low + extra[0], high + extra[1]
     catchers = getattr(getattr(scene.geometry, "objects", None), "shadow_catcher", None)
     if getattr(settings, "shadow_catcher_pass", False) or (catchers is not None and catchers.any()):
         low, high = low + 40, high + 76  # shadow catchers: 10 float32 film sums, 3 float32 RGB estimates
     scene_bytes = scene_size(scene)
     return MemoryEstimate(FIXED + scene_bytes + low * pixels, FIXED + scene_bytes + high * pixels, pixels,
                           scene_bytes)
+
+
+def target_extension_bytes(scene, st) -> tuple[int, int] | None:
+    """(low, high) bytes per pixel the target terms' extension rows (restir/target.py: anisotropy, sheen) add in a
+    scene that has such lobes: float32 rows of this frame's and the history's DI terms, and GI's where it may run;
+    None where none is needed."""
+    mats = scene.materials
+    sheen = getattr(mats, "sheen_roughness", None)
+    rows = target.width(may_be_anisotropic(mats), sheen is not None and bool((sheen > 0).any())) - target.WIDTH
+    if rows <= 0 or st.integrator != Integrator.RESTIR:
+        return None
+    low, high = per_pixel_range(st)
+    base = BASE + (DENOISE_DATA if st.denoise_data else 0)
+    copies_low = (low > base) * 2 + (low - base > DIRECT_REUSE) * 2
+    copies_high = (high > base) * 2 + (high - base > DIRECT_REUSE) * 2
+    return rows * 4 * copies_low, rows * 4 * copies_high
 
 
 def per_pixel_range(st, keeps_history: bool = True) -> tuple[int, int]:

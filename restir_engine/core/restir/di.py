@@ -31,7 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.accel import shadow_rays
-from ..integrators.pathtracer import lamp_hits, sample_rays
+from ..integrators.pathtracer import sample_rays
+from ..integrators.ray_emission import lamp_hits
 from ..lights import groups as light_groups
 from ..lights.tiles import PackedPoints, TileSettings, light_points, sample_points
 from ..materials.bsdf import eval_view, view_terms
