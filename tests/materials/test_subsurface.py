@@ -142,3 +142,27 @@ def test_entry_refracts_by_snells_law():
     d, ok = subsurface.entry_directions(wo1, nm, nm, np.full(m, 0.25, np.float32), np.full(m, 1.3, np.float32),
                                         np.ones(m, bool), u)
     assert ok.mean() > 0.9 and (d[2][ok] < 0).all()
+
+
+def test_a_channel_of_zero_radius_is_diffuse():
+    """As Cycles: where a channel's Radius x Scale is below 1e-8 the walked share of that channel is the diffuse
+    lobe's (a camera hit keeps the other channels' share for its walk)."""
+    from restir_engine.core.materials.surface import Surface
+    scene = _box_scene()
+    mats = scene.materials
+    mats.subsurface = np.float32([1.0])
+    mats.sss_radius = np.float32([[1.0, 0.5, 0.0]])
+    mats.sss_method = np.int32([WALK_VAN_DE_HULST])
+    ctx = build_context(scene, 0)
+    assert ctx.has_subsurface
+    n = 4
+    o = np.tile(np.float32([[0], [0], [1]]), (1, n))
+    d = np.tile(np.float32([[0], [0], [-1]]), (1, n))
+    hit = ctx.geom_accel.intersect(o, d)
+    s = Surface(ctx, hit.prim, hit.u, hit.v, o, d, hit.t, camera=True)
+    base = np.float32([0.8, 0.5, 0.2])
+    np.testing.assert_allclose(s.params.sss[:, 0], [0.8, 0.5, 0.0], atol=1e-6)
+    np.testing.assert_allclose(s.params.diffuse[:, 0], [0.0, 0.0, 0.2], atol=1e-6)
+    folded = Surface(ctx, hit.prim, hit.u, hit.v, o, d, hit.t)  # not a camera hit: all of it diffuse
+    np.testing.assert_allclose(folded.params.diffuse[:, 0], base, atol=1e-6)
+    assert not folded.params.sss.any()

@@ -183,11 +183,17 @@ class SurfaceParams:
         """Whether some entry has a subsurface share (its ``sss`` row not zero)."""
         return bool(self.sss.any())
 
-    def fold_subsurface(self) -> None:
-        """Render the subsurface share as part of the diffuse lobe (in place): diffuse += sss, sss = 0."""
+    def fold_subsurface(self, where: np.ndarray | None = None) -> None:
+        """Render the subsurface share as part of the diffuse lobe (in place): diffuse += sss, sss = 0; only at the
+        entries and channels ``where`` ((3, n) bool) when given."""
         b = self.block
-        b[PARAM_ROWS["diffuse"]] += b[PARAM_ROWS["sss"]]
-        b[PARAM_ROWS["sss"]] = 0.0
+        d, s = b[PARAM_ROWS["diffuse"]], b[PARAM_ROWS["sss"]]
+        if where is None:
+            d += s
+            s[:] = 0.0
+        else:
+            d[where] += s[where]
+            s[where] = 0.0
 
     def scale(self, factor: np.ndarray) -> None:
         """Scale every lobe by ``factor`` (n,) in place (Fresnel and layering terms are ratios: unchanged)."""

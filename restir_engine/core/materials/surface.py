@@ -65,9 +65,12 @@ class Surface:
             self.params = SurfaceParams.from_material(np.ones((len(mat), 3), np.float32), np.zeros(len(mat)),
                                                       np.ones(len(mat)), np.zeros(len(mat)))
             self._varying = None
-        elif not (camera if walks is None else walks) and getattr(ctx, "has_subsurface", False) \
-                and self.params.has_subsurface():
-            self.params.fold_subsurface()
+        elif getattr(ctx, "has_subsurface", False) and self.params.has_subsurface():
+            if not (camera if walks is None else walks):
+                self.params.fold_subsurface()
+            else:  # as Cycles: a channel whose radius is below 1e-8 (or a material not walked) is diffuse
+                mats = ctx.scene.materials
+                self.params.fold_subsurface((mats.sss_radius[mat].T < 1e-8) | (mats.sss_method[mat] == 0))
         self._glass(ctx, mat, scale, tint, s_ng, lambert)
         away = None if lambert else self._translucent(ctx, mat)
         self.t, self.bt = orthonormal_basis(self.ns)
