@@ -27,6 +27,7 @@ from ..geometry.accel import offset_origin, shadow_rays
 from ..lights import groups as light_groups
 from ..lights.groups import Tap, tap_add
 from ..materials.bsdf import diffuse_f, eval_view, sample_bsdf
+from ..materials import glass as glass_mod
 from ..materials.glass import DELTA_PDF, sample_glass
 from ..materials.params import SurfaceParams
 from ..materials.surface import Surface
@@ -35,6 +36,19 @@ from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vma
 from .ray_emission import _emission_on_rays, power_heuristic
 from .subsurface import subsurface_light, vertex_walks, with_exit_rays
 from .trace_context import TraceContext
+
+
+def _light_terms(s: Surface, wi_l: np.ndarray, wi: np.ndarray):
+    """f (3, n) and the BSDF sampling pdf (n,) of surfaces ``s`` toward light directions ``wi`` (world; ``wi_l``
+    local), and where a light sample may count ((n,) bool: above the geometric surface, or on either side of rough
+    glass, whose lobe (glass.eval_rough) covers both)."""
+    f, pdf_b = eval_view(s.view, s.wo_l, wi_l)
+    side = dot(wi, s.ng) > 0
+    rough = glass_mod.rough_rows(s)
+    if rough.size:
+        f[:, rough], pdf_b[rough] = glass_mod.eval_rough(s, rough, np.take(wi, rough, axis=1))
+        side[rough] = True
+    return f, pdf_b, side
 
 
 def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughput=None, diffuse: bool = False,
@@ -55,13 +69,13 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         return (out, out.copy()) if diffuse else out
     ls = ctx.lights.sample(s.p, rng.random((4, n), dtype=np.float32))
     wi_l = to_local(ls.wi, s.ns, s.t, s.bt)
-    f, pdf_b = eval_view(s.view, s.wo_l, wi_l)
+    f, pdf_b, side = _light_terms(s, wi_l, ls.wi)
     w = np.where(ls.delta, np.float32(1.0), power_heuristic(ls.pdf, pdf_b))
     contrib = f * ls.le
     contrib *= np.abs(wi_l[2]) * w / np.maximum(ls.pdf, np.float32(1e-30))
     if throughput is not None:
         contrib *= throughput
-    live = np.flatnonzero((dot(ls.wi, s.ng) > 0) & (ls.pdf > 0) & (vmax(np.abs(contrib)) > 0))
+    live = np.flatnonzero(side & (ls.pdf > 0) & (vmax(np.abs(contrib)) > 0))
     lv = live
     if live.size:
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), cols(ls.pos, live), cols(ls.wi, live),
@@ -95,14 +109,14 @@ def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, through
     u = rng.random((2, n), dtype=np.float32)
     wi, pdf, le = ctx.world.sample(u[0], u[1], (s.ns, s.t, s.bt))
     wi_l = to_local(wi, s.ns, s.t, s.bt)
-    f, pdf_b = eval_view(s.view, s.wo_l, wi_l)
+    f, pdf_b, side = _light_terms(s, wi_l, wi)
     w = power_heuristic(pdf, pdf_b)
     scale = np.abs(wi_l[2]) * w / np.maximum(pdf, np.float32(1e-30))
     contrib = f * le * scale
     if throughput is not None:
         contrib *= throughput
     out = np.zeros((3, n), np.float32)
-    live = np.flatnonzero((dot(wi, s.ng) > 0) & (pdf > 0) & (vmax(np.abs(contrib)) > 0))
+    live = np.flatnonzero(side & (pdf > 0) & (vmax(np.abs(contrib)) > 0))
     if live.size:
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), np.zeros((3, live.size), np.float32),
                                   cols(wi, live), np.full(live.size, np.inf, np.float32))
@@ -156,9 +170,12 @@ def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
                                          None if s.glass_beckmann is None else s.glass_beckmann[g])
         wi[:, g] = wg
         wi_l[:, g] = 0.0
-        wi_l[2, g] = 1.0  # unused for delta rows (their throughput is the weight)
+        wi_l[2, g] = 1.0  # unused for glass rows (their throughput is the weight)
         f[:, g] = weight
         pdf[g] = DELTA_PDF
+        rough = glass_mod.rough_rows(s)
+        if rough.size:  # rough glass is light-sampled too: its rays' emission takes MIS weights by their pdf
+            pdf[rough] = glass_mod.eval_rough(s, rough, np.take(wi, rough, axis=1))[1]
         ok[g] = valid
         delta = s.glass
     rows = np.flatnonzero(ok)

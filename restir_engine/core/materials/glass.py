@@ -13,11 +13,13 @@ shading normal, then reflection or refraction about h with probability F(ωo·h)
 where 1/E is Cycles' energy compensation of its multiscatter glass (E: the interface's directional albedo,
 microfacet_tables GLASS_OUT / GLASS_IN), for reflection and refraction alike.
 
-Glass is sampled, never evaluated for light samples (next-event estimation, ReSTIR targets): a glass hit's BSDF
-parameters are black for those, and light through or off glass arrives by the path's next vertices (its emission
-seen along a glass ray takes MIS weight 1, ``DELTA_PDF``). Unbiased for rough glass too, but small lights seen
-through rough glass converge slower than in Cycles, which light-samples them. Shadow rays are blocked by glass, as
-in Cycles (caustics come from BSDF paths only).
+Smooth glass is sampled only (a delta closure: its BSDF parameters are black for light samples, and the emission
+its rays meet takes MIS weight 1, ``DELTA_PDF``). Rough glass is also evaluated for the path tracer's next-event
+estimation (:func:`eval_rough`: f and the pdf with which :func:`sample_glass` draws a direction, on both sides of
+the surface), and the emission its sampled rays meet is MIS-weighted by that pdf, as Cycles light-samples it. The
+camera's glass chains (integrators/camera_paths.py) sample it only (their emission weight 1) and ReSTIR's targets
+never see glass (their surfaces lie past the chains). Shadow rays are blocked by glass, as in Cycles (caustics come
+from BSDF paths only).
 """
 from __future__ import annotations
 
@@ -114,3 +116,77 @@ def sample_glass(wo: np.ndarray, n: np.ndarray, ng: np.ndarray, front: np.ndarra
         weight[:, rough] *= w.astype(np.float32)
         valid[rough] &= (np.where(reflect[rough], ci > 0, ci < 0)) & (c[rough] > 0) & (m > 0)
     return wi, weight, valid
+
+
+def _ggx_d(alpha: np.ndarray, cos_h: np.ndarray) -> np.ndarray:
+    """GGX D(h) at cos θh (1/sr)."""
+    a2 = alpha * alpha
+    t = cos_h * cos_h * (a2 - 1.0) + 1.0
+    return a2 / (np.float32(np.pi) * t * t)
+
+
+def _beckmann_d(alpha: np.ndarray, cos_h: np.ndarray) -> np.ndarray:
+    """Beckmann D(h) at cos θh (1/sr)."""
+    c2 = np.maximum(cos_h * cos_h, 1e-12)
+    return np.exp(-(1.0 - c2) / (c2 * alpha * alpha)) / (np.float32(np.pi) * alpha * alpha * c2 * c2)
+
+
+def eval_glass(wo: np.ndarray, wi: np.ndarray, n: np.ndarray, ng: np.ndarray, front: np.ndarray, ior: np.ndarray,
+               reflect_tint: np.ndarray, refract_tint: np.ndarray, alpha: np.ndarray, multiscatter: np.ndarray,
+               fresnel_on: np.ndarray, beckmann: np.ndarray):
+    """The rough glass of :func:`sample_glass` evaluated for light directions: f (3, k) (the BSDF, per steradian;
+    the caller takes |cos θi|) and the solid-angle pdf (k,) with which :func:`sample_glass` draws ``wi`` (3, k),
+    for k rough glass hits (arguments as there; ``alpha`` above ROUGH_ALPHA_MIN). f |cos θi| / pdf is the sample's
+    weight there, so light samples and BSDF samples estimate the same lobe: reflection
+    tint F D G / (4 cos θo E), refraction tint (1 - F) D G η² (ωo·h) |ωi·h| / (cos θo (ωo·h + η ωi·h)² E)
+    (η = η_t / η_i; without Fresnel (the Refraction BSDF) no reflection and no 1 - F)."""
+    eta = np.where(front, ior, 1.0 / ior).astype(np.float32)
+    co = np.clip(dot(wo, n), 0.0, 1.0)
+    ci = dot(wi, n)
+    reflect = ci > 0
+    hr = wo + wi
+    ht = -(wo + eta * wi)
+    h = np.where(reflect, hr, ht)
+    h = h / np.maximum(np.sqrt(dot(h, h)), 1e-12)
+    h = h * np.where(dot(h, n) < 0, np.float32(-1.0), np.float32(1.0))
+    oh, ih, cos_h = dot(wo, h), dot(wi, h), dot(h, n)
+    side = dot(wi, ng)
+    valid = (co > 0) & (oh > 0) & (cos_h > 0) & np.where(reflect, (ih > 0) & (side > 0), (ih < 0) & (side < 0))
+    d = np.where(beckmann, _beckmann_d(alpha, cos_h), _ggx_d(alpha, cos_h))
+    lam_o = np.where(beckmann, beckmann_lambda(alpha, co), smith_lambda(alpha, co))
+    lam_i = np.where(beckmann, beckmann_lambda(alpha, np.abs(ci)), smith_lambda(alpha, np.abs(ci)))
+    g = 1.0 / (1.0 + lam_o + lam_i)
+    c = np.clip(oh, 0.0, 1.0)
+    sin2_t = (1.0 - c * c) / (eta * eta)
+    tir = sin2_t >= 1.0
+    fr = np.where(tir, 1.0, fresnel_exact(c, np.where(tir, 0.0, eta * eta - 1.0).astype(np.float32)))
+    p_r = np.where(fresnel_on, fr, 0.0)
+    p_t = np.where(fresnel_on, 1.0 - fr, np.where(tir, 0.0, 1.0))
+    e = np.where(multiscatter, glass_albedo_at(alpha, co, eta), np.float32(1.0))
+    den_t = oh + eta * ih
+    jac_t = eta * eta * np.abs(ih) / np.maximum(den_t * den_t, 1e-12)
+    pdf = np.where(reflect, p_r * d * cos_h / np.maximum(4.0 * oh, 1e-12), p_t * d * cos_h * jac_t)
+    # f |cos θi| = weight x pdf, weight = tint G (ωo·h) / (cos θo cos θh E)
+    w = g * c / np.maximum(co * cos_h * e, 1e-12)
+    f_cos = w * pdf
+    tint = np.where(reflect, reflect_tint, refract_tint)
+    f = tint * (f_cos / np.maximum(np.abs(ci), 1e-6))
+    ok = valid & np.isfinite(pdf) & (pdf > 0)
+    return np.where(ok, f, 0.0).astype(np.float32), np.where(ok, pdf, 0.0).astype(np.float32)
+
+
+def rough_rows(surf) -> np.ndarray:
+    """The hits of ``surf`` (a Surface) on rough glass (indices), which light samples can reach."""
+    if surf.glass is None:
+        return np.zeros(0, np.intp)
+    return np.flatnonzero(surf.glass & (surf.glass_alpha > ROUGH_ALPHA_MIN))
+
+
+def eval_rough(surf, rows: np.ndarray, wi: np.ndarray):
+    """:func:`eval_glass` at the rough glass hits ``rows`` of ``surf`` for world directions ``wi`` (3, k)."""
+    def take(a):
+        return np.take(a, rows, axis=-1)
+    beck = surf.glass_beckmann[rows] if surf.glass_beckmann is not None else np.zeros(rows.size, bool)
+    return eval_glass(take(surf.wo), wi, take(surf.ns), take(surf.ng), surf.glass_front[rows], surf.glass_ior[rows],
+                      take(surf.glass_reflect), take(surf.glass_refract), surf.glass_alpha[rows],
+                      surf.glass_ms[rows], surf.glass_fresnel[rows], beck)
