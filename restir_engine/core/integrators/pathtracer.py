@@ -345,25 +345,9 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             _exit_light(ctx, walks, rng, target, idx, throughput, first, dthr, bounce == 1 and first is not None,
                         target_g)
             ray = with_exit_rays(ray, s, walks, rng.random((2, len(walks.rows)), dtype=np.float32))
-        rows, wi_l, f, pdf, o, d, hits = ray.rows, ray.wi_l, ray.f, ray.pdf, ray.o, ray.d, ray.hits
-        thr = cols(throughput, rows) * f
-        scale = wi_l[2] / np.maximum(pdf, np.float32(1e-30))
-        if ray.delta is not None:
-            scale = np.where(ray.delta, np.float32(1.0), scale).astype(np.float32)
-        thr *= scale
-        if bounce == 1 and first is not None:  # x2's diffuse lobe alone (throughput 1 before it)
-            dthr = diffuse_f(s.view, wi_l, rows) * scale
-            if ray.walked is not None:  # (a walk counts as x2's diffuse light)
-                dthr[:, ray.walked] = cols(f, np.flatnonzero(ray.walked)) * scale[ray.walked]
-        elif dthr is not None:
-            dthr = cols(dthr, rows) * f * scale
-        ok = vfinite(thr)
-        if bounce + 1 >= ctx.rr_start:
-            q = np.clip(vmax(thr), 0.05, 1.0)
-            ok &= rng.random(len(rows), dtype=np.float32) < q
-            thr /= q
-            if dthr is not None:
-                dthr /= q
+        rows, pdf, o, d, hits = ray.rows, ray.pdf, ray.o, ray.d, ray.hits
+        thr, dthr, ok = _ray_throughput(ray, s, throughput, dthr, bounce == 1 and first is not None,
+                                        bounce + 1 >= ctx.rr_start, rng)
         keep = np.flatnonzero(ok)
         if keep.size == 0:
             break
@@ -422,6 +406,32 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         out.first = first
     out.add_walked_indirect(indirect, indirect_g)
     return out
+
+
+def _ray_throughput(ray: BsdfRay, s: Surface, throughput, dthr, at_x2: bool, roulette: bool, rng):
+    """The paths' throughput (3, k) along the BSDF rays ``ray`` from surfaces ``s``, the throughput through x2's
+    diffuse lobe (``at_x2``: this ray leaves x2; after it ``dthr`` carried on; None without a first bounce), and
+    which rays go on ((k,) bool: finite, and past Russian roulette where ``roulette``)."""
+    rows, wi_l, f = ray.rows, ray.wi_l, ray.f
+    thr = cols(throughput, rows) * f
+    scale = wi_l[2] / np.maximum(ray.pdf, np.float32(1e-30))
+    if ray.delta is not None:
+        scale = np.where(ray.delta, np.float32(1.0), scale).astype(np.float32)
+    thr *= scale
+    if at_x2:  # x2's diffuse lobe alone (throughput 1 before it)
+        dthr = diffuse_f(s.view, wi_l, rows) * scale
+        if ray.walked is not None:  # (a walk counts as x2's diffuse light)
+            dthr[:, ray.walked] = cols(f, np.flatnonzero(ray.walked)) * scale[ray.walked]
+    elif dthr is not None:
+        dthr = cols(dthr, rows) * f * scale
+    ok = vfinite(thr)
+    if roulette:
+        q = np.clip(vmax(thr), 0.05, 1.0)
+        ok &= rng.random(len(rows), dtype=np.float32) < q
+        thr /= q
+        if dthr is not None:
+            dthr /= q
+    return thr, dthr, ok
 
 
 def _through_first(first: FirstBounce, indirect, indirect_g) -> None:
