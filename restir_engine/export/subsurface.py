@@ -49,6 +49,8 @@ def principled_subsurface(registry, material, node, row: dict, g, varying: dict,
 
 def _constant(registry, material, g, socket, kind: str):
     """A socket's value (its graph folded); one that varies over the surface is its unlinked value (reported)."""
+    if kind == "float":
+        return registry._float_input(material, socket)
     reg = g.value(socket, kind)
     if reg.const is not None:
         v = reg.constant_value()
@@ -56,4 +58,4 @@ def _constant(registry, material, g, socket, kind: str):
         registry._warn(material, f"'{socket.name}' of '{socket.node.name}' varies over the surface; approximated "
                        "by the socket's value")
         v = socket.default_value
-    return tuple(v) if kind == "vector" else float(v)
+    return tuple(v)

@@ -280,18 +280,7 @@ def _anisotropic_sheen_room(width, height):
 def test_anisotropic_and_sheen_frames_render_the_same_in_processes():
     """ReSTIR DI + GI (unbiased) over two frames with history on anisotropic and sheen materials: finite, and 2
     processes render what one renders, bit for bit."""
-    settings = SETTINGS["di-gi-unbiased"]
-    images = []
-    for n in (1, 2):
-        scene = _anisotropic_sheen_room(*SIZE)
-        first = render_frame(scene, settings, processes=n)
-        second = render_frame(scene, dataclasses.replace(settings, frame=2), history=first.history, processes=n)
-        images.append((first.passes["Combined"], second.passes["Combined"]))
-    for frame in (0, 1):
-        assert np.isfinite(images[0][frame]).all()
-        assert np.array_equal(images[0][frame], images[1][frame])
-    plain = render_frame(regression_room(*SIZE), settings, processes=1).passes["Combined"]
-    assert not np.array_equal(plain, images[0][0])  # the materials changed the image
+    _two_frames_agree_in_processes(lambda: _anisotropic_sheen_room(*SIZE))
 
 
 def test_subsurface_frames_render_the_same_in_processes():
@@ -299,14 +288,24 @@ def test_subsurface_frames_render_the_same_in_processes():
     (core/integrators/subsurface.py: one walk per camera hit, on the chunk's own random stream): finite, and 2
     processes render what one renders, bit for bit."""
     from restir_engine.core.integrators.subsurface import WALK_VAN_DE_HULST
-    settings = SETTINGS["di-gi-unbiased"]
-    images = []
-    for n in (1, 2):
+
+    def build():
         scene = regression_room(*SIZE)
         mats = scene.materials
         mats.subsurface = np.float32([0, 1, 0, 0, 0, 0])
         mats.sss_radius = np.tile(np.float32([0.3, 0.1, 0.05]), (6, 1))
         mats.sss_method = np.full(6, WALK_VAN_DE_HULST, np.int32)
+        return scene
+    _two_frames_agree_in_processes(build)
+
+
+def _two_frames_agree_in_processes(build):
+    """ReSTIR DI + GI (unbiased), two frames with history of ``build()`` in 1 and in 2 processes: finite, equal bit
+    for bit, and unlike the plain regression room's first frame (the scene's materials changed the image)."""
+    settings = SETTINGS["di-gi-unbiased"]
+    images = []
+    for n in (1, 2):
+        scene = build()
         first = render_frame(scene, settings, processes=n)
         second = render_frame(scene, dataclasses.replace(settings, frame=2), history=first.history, processes=n)
         images.append((first.passes["Combined"], second.passes["Combined"]))
@@ -314,4 +313,4 @@ def test_subsurface_frames_render_the_same_in_processes():
         assert np.isfinite(images[0][frame]).all()
         assert np.array_equal(images[0][frame], images[1][frame])
     plain = render_frame(regression_room(*SIZE), settings, processes=1).passes["Combined"]
-    assert not np.array_equal(plain, images[0][0])  # the walks changed the image
+    assert not np.array_equal(plain, images[0][0])

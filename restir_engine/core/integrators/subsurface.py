@@ -322,7 +322,7 @@ def walk(ctx, p: np.ndarray, ng: np.ndarray, d: np.ndarray, obj: np.ndarray, med
 
 def walkable_rows(ctx, surf) -> np.ndarray:
     """The surfaces (indices) that keep a subsurface share of a walked method."""
-    if not getattr(ctx, "has_subsurface", False) or not surf.params.has_subsurface():
+    if not ctx.has_subsurface or not surf.params.has_subsurface():
         return np.zeros(0, np.int64)
     rows = np.flatnonzero(vmax(surf.params.sss) > 0)
     return rows[ctx.scene.materials.sss_method[surf.bsdf_mat[rows]] > 0]

@@ -65,7 +65,7 @@ class Surface:
             self.params = SurfaceParams.from_material(np.ones((len(mat), 3), np.float32), np.zeros(len(mat)),
                                                       np.ones(len(mat)), np.zeros(len(mat)))
             self._varying = None
-        elif getattr(ctx, "has_subsurface", False) and self.params.has_subsurface():
+        elif ctx.has_subsurface and self.params.has_subsurface():
             if not (camera if walks is None else walks):
                 self.params.fold_subsurface()
             else:  # as Cycles: a channel whose radius is below 1e-8 (or a material not walked) is diffuse

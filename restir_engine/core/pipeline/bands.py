@@ -109,7 +109,7 @@ def plan(scene, settings, free: int | None, keeps_history: bool = True) -> tuple
     ``keeps_history`` holds its first pass's G-buffer and reservoirs in each band's working set."""
     _x0, _y0, w, h = scene.camera.window
     budget = memory.band_budget(free)
-    _low, high = memory.per_pixel_range(settings, keeps_history)
+    _low, high = memory.per_pixel_range(settings, keeps_history, memory.target_extension_rows(scene))
     m = margin_rows(settings, scene.camera)
     if high * w * h <= budget:
         return 1, m

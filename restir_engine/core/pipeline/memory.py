@@ -51,13 +51,10 @@ def frame_estimate(scene, settings, keeps_history: bool = True) -> MemoryEstimat
     temporal history for the next where ``keeps_history``."""
     _x0, _y0, w, h = scene.camera.window
     pixels = int(w) * int(h)
-    low, high = per_pixel_range(settings, keeps_history)
+    low, high = per_pixel_range(settings, keeps_history, target_extension_rows(scene))
     groups = getattr(scene, "light_groups", None)
     if groups is not None:  # per light group: a float32 RGB film sum and float32 RGB estimates of the pass's stages
         low, high = low + len(groups) * 24, high + len(groups) * 48
-    extra = target_extension_bytes(scene, settings)
-    if extra:  # anisotropic or sheen lobes widen the target terms of the reservoirs
-        low, high = low + extra[0], high + extra[1]
     catchers = getattr(getattr(scene.geometry, "objects", None), "shadow_catcher", None)
     if getattr(settings, "shadow_catcher_pass", False) or (catchers is not None and catchers.any()):
         low, high = low + 40, high + 76  # shadow catchers: 10 float32 film sums, 3 float32 RGB estimates
@@ -66,37 +63,31 @@ def frame_estimate(scene, settings, keeps_history: bool = True) -> MemoryEstimat
                           scene_bytes)
 
 
-def target_extension_bytes(scene, st) -> tuple[int, int] | None:
-    """(low, high) bytes per pixel the target terms' extension rows (restir/target.py: anisotropy, sheen) add in a
-    scene that has such lobes: float32 rows of this frame's and the history's DI terms, and GI's where it may run;
-    None where none is needed."""
+def target_extension_rows(scene) -> int:
+    """The float32 rows per surface that anisotropic or sheen lobes add to every block of target terms
+    (restir/target.py's extension), 0 where the scene has neither."""
     mats = scene.materials
     sheen = getattr(mats, "sheen_roughness", None)
-    rows = target.width(may_be_anisotropic(mats), sheen is not None and bool((sheen > 0).any())) - target.WIDTH
-    if rows <= 0 or st.integrator != Integrator.RESTIR:
-        return None
-    low, high = per_pixel_range(st)
-    base = BASE + (DENOISE_DATA if st.denoise_data else 0)
-    copies_low = (low > base) * 2 + (low - base > DIRECT_REUSE) * 2
-    copies_high = (high > base) * 2 + (high - base > DIRECT_REUSE) * 2
-    return rows * 4 * copies_low, rows * 4 * copies_high
+    return target.width(may_be_anisotropic(mats), sheen is not None and bool((sheen > 0).any())) - target.WIDTH
 
 
-def per_pixel_range(st, keeps_history: bool = True) -> tuple[int, int]:
+def per_pixel_range(st, keeps_history: bool = True, extension_rows: int = 0) -> tuple[int, int]:
     """(low, high) bytes per pixel for settings ``st``; a frame that keeps no history (a still) holds no second
-    G-buffer and reservoirs while it renders."""
+    G-buffer and reservoirs while it renders. ``extension_rows``: float32 rows the target terms' blocks (DI's and
+    GI's, this frame's and the history's) carry beyond target.WIDTH (:func:`target_extension_rows`)."""
+    terms = extension_rows * 4 * (2 if keeps_history else 1)
     low = high = BASE + (DENOISE_DATA if st.denoise_data else 0)
     if st.integrator != Integrator.RESTIR:
         return low, high
     direct = st.direct_method
-    di = DIRECT_REUSE - (0 if keeps_history else HISTORY)
+    di = DIRECT_REUSE - (0 if keeps_history else HISTORY) + terms
     if direct in (DirectMethod.RESTIR, DirectMethod.RIS) or st.reservoir_passes:
         low += di
         high += di
     elif direct == DirectMethod.AUTO:
         high += di
     if methods.gi_possible(st):
-        gi = GI - (0 if keeps_history else GI_HISTORY)
+        gi = GI - (0 if keeps_history else GI_HISTORY) + terms
         if st.indirect_method == IndirectMethod.RESTIR_GI or st.gi_reservoir_passes:
             low += gi
             high += gi
@@ -118,7 +109,7 @@ def banded_estimate(scene, settings, bands: int, margin: int, keeps_history: boo
     _x0, _y0, w, h = scene.camera.window
     pixels = int(w) * int(h)
     band_pixels = int(w) * min(int(h), -(-int(h) // bands) + 2 * margin)
-    low, high = per_pixel_range(settings, keeps_history)
+    low, high = per_pixel_range(settings, keeps_history, target_extension_rows(scene))
     hist = history_per_pixel(settings, keeps_history)
     scene_bytes = scene_size(scene)
     whole = FIXED + scene_bytes + (FRAME_WIDE + hist) * pixels
