@@ -4,7 +4,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from restir_engine.core.materials.surface import bump_map
+from restir_engine.core.materials.image_normals import bump_map
 from restir_engine.core.materials.textures import NearestImage, gradient
 
 
