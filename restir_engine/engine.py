@@ -81,7 +81,8 @@ def apply_threads(scene) -> None:
     """Blender's Render Properties > Performance > Threads (``render.threads_mode``, ``render.threads``): Auto uses
     every logical core, Fixed that many; and our Processes (``scene.restir.processes``): the worker processes F12
     and animation frames render in (0 = Auto: one per core from 2 cores up, at most one per chunk of pixels), each
-    with its share of the threads. The viewport renders in Blender's process with every thread."""
+    with its share of the threads. The Rendered viewport chooses its processes the same way for the view's size
+    (viewport.py), on a team of its own."""
     from .core.parallel.pool import set_thread_count
     from .core.parallel.processes import set_process_count
     render = scene.render

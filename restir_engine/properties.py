@@ -180,10 +180,11 @@ SCENE_FIELDS = (
         name="Viewport Denoise", description="Denoise the Rendered viewport's Combined image each time its samples "
         "refine (off by default, as in Cycles)", default=False)),
     Field("processes", IntProperty, None, dict(
-        name="Processes", description="Worker processes that render F12 and animation frames together, each "
-        "with its share of the threads (Python runs one thread at a time per process, so processes use many "
-        "cores where threads cannot). 0 = Auto: one per thread from 2 threads up (at most one per chunk of "
-        "pixels: small frames render in Blender's own process). "
+        name="Processes", description="Worker processes that render F12, animation frames and the Rendered "
+        "viewport together, each with its share of the threads (Python runs one thread at a time per process, so "
+        "processes use many cores where threads cannot). 0 = Auto: one per thread from 2 threads up (at most one "
+        "per chunk of pixels: small frames and views render in Blender's own process; the viewport's header shows "
+        "its count). "
         "The image is the same for any number", default=0, min=0, soft_max=64, max=1024)),
     Field("samples", IntProperty, int, dict(
         name="Samples", description="Iterations averaged per frame", default=16, min=1,

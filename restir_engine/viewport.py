@@ -12,7 +12,10 @@ The session is driven from Blender's thread by three calls that never wait for t
   accumulates samples there (refinement passes, interrupted at once by a view change, a scene edit or a stop);
 - carries temporal history across views: each view's first pass reprojects the reservoirs (ReSTIR DI and GI) of
   the last view that finished one, through the previous view's camera (any resolution), with the disocclusion
-  tests of the final render; a new view is a new "frame" for the random streams.
+  tests of the final render; a new view is a new "frame" for the random streams;
+- renders on worker processes of its own (core.parallel.processes.borrow) where F12 would for the view's size
+  (the Processes and Threads settings, at most one per chunk of the full-resolution view, as many as fit in
+  memory), else in Blender's process with every thread: the same views give the same images either way.
 
 Images handed to the UI are (h, w, 4) float32 in scene-linear (Combined and the light passes) or display
 values (the false-colour and data passes, see :func:`pass_image`).
@@ -26,6 +29,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .core.parallel import processes as procs
+from .core.parallel.pool import thread_count
+from .core.pipeline.frame_render import team_size
+from .core.pipeline.shared_view import SharedViewRenderer
 from .core.renderer import FrameRenderer, RenderSettings
 from .core.scene import Camera, Motion
 
@@ -127,7 +134,7 @@ def pass_image(renderer: FrameRenderer, name: str) -> tuple[np.ndarray, dict]:
     """The viewport pass ``name`` (a VIEWPORT_PASSES key) of the renderer's running mean as (h, w, 4) float32
     and facts about its mapping (for the header); a pass the renderer does not have (Reservoir M when the
     direct light is not resampled) is black, with the reason."""
-    _x0, _y0, w, h = renderer.ctx.scene.camera.window
+    _x0, _y0, w, h = renderer.camera.window
     out = np.zeros((h, w, 4), np.float32)
     out[..., 3] = 1.0
     info: dict = {}
@@ -139,7 +146,7 @@ def pass_image(renderer: FrameRenderer, name: str) -> tuple[np.ndarray, dict]:
         return out, info
     if name in ("RES_M", "RES_UCW", "GI_M", "GI_UCW"):
         key = {"RES_M": "res_m", "RES_UCW": "res_w", "GI_M": "gi_m", "GI_UCW": "gi_w"}[name]
-        if not renderer.has_pass_data(key) or (name.startswith("RES") and renderer.candidates is None):
+        if not renderer.has_pass_data(key) or (name.startswith("RES") and not renderer.resamples_direct):
             info["missing"] = "no reservoirs: " + ("ReSTIR GI is off" if name.startswith("GI")
                                                    else f"the direct light uses {renderer.method}")
             return out, info
@@ -179,6 +186,7 @@ class ViewportStats:
     mean_m: float | None = None     # mean ReSTIR DI confidence over the pixels with a surface (None: no DI reservoirs)
     gi_mean_m: float | None = None  # the same for ReSTIR GI
     navigation_passes: int = 0    # passes rendered right after a view change
+    processes: int = 1            # processes rendering the passes (1: Blender's own)
     extra: dict = field(default_factory=dict)  # the shown pass's mapping facts (pass_image): range, missing
 
     def text(self) -> str:
@@ -186,6 +194,8 @@ class ViewportStats:
         if self.divider > 1:
             s += f" (1/{self.divider})"
         s += f" | {1000 * self.pass_seconds:.0f} ms/pass"
+        if self.processes > 1:
+            s += f" | {self.processes} processes"
         if self.mean_m is not None:
             s += f" | mean M {self.mean_m:.1f}"
         if self.gi_mean_m is not None:
@@ -195,21 +205,28 @@ class ViewportStats:
             s += f" | range {lo:.3g} to {hi:.3g}"
         if "missing" in self.extra:
             s += f" | {self.extra['missing']}"
+        if "note" in self.extra:
+            s += f" | {self.extra['note']}"
         return s
 
 
 class ViewportSession:
-    """One viewport engine instance's worker: owns the FrameRenderer and renders what the UI asked for last."""
+    """One viewport engine instance's worker: owns the renderer (a FrameRenderer, or a SharedViewRenderer on worker
+    processes) and renders what the UI asked for last. ``processes``: worker processes to render on (None: as F12
+    would choose, core.pipeline.frame_render.team_size; 1: Blender's process)."""
 
     def __init__(self, redraw, budget: float = DEFAULT_BUDGET, max_samples: int = MAX_VIEWPORT_SAMPLES,
-                 clock=time.perf_counter):
+                 clock=time.perf_counter, processes: int | None = None):
         self.redraw = redraw
         self.budget = float(budget)
         self.max_samples = int(max_samples)
         self.time_limit = 0.0  # seconds a still view refines (0 = until max_samples)
         self._refine_t0 = None  # when the current still view's refinement began (clock)
         self.clock = clock
-        self.renderer: FrameRenderer | None = None
+        self.renderer: FrameRenderer | SharedViewRenderer | None = None
+        self.processes = processes
+        self._team = None            # the worker processes borrowed for this session (None: this process renders)
+        self.note = ""               # why fewer processes render than asked for (shown in the header)
         self.stats = ViewportStats()
         self.pass_name = "COMBINED"
         self._cv = threading.Condition()
@@ -236,6 +253,7 @@ class ViewportSession:
         """Render ``scene`` from now on (the view is kept; history is carried over where the lights map)."""
         with self._cv:
             self._scene = (scene, settings)
+            self.last_error = None  # a new scene starts the worker again
             self._interrupt = True
             self._closed = False
             self._cv.notify_all()
@@ -281,6 +299,8 @@ class ViewportSession:
         t = self._thread
         if t is not None and t is not threading.current_thread():
             t.join(timeout)
+        if t is None or not t.is_alive():  # else the worker gives its processes back as it ends
+            self._return_team()
         self._thread = None
 
     @property
@@ -314,7 +334,21 @@ class ViewportSession:
             import traceback
             traceback.print_exc()
             self.last_error = f"{type(exc).__name__}: {exc}"
+            if isinstance(self.renderer, SharedViewRenderer):  # its workers are gone (or went on failing)
+                self.renderer = None
             self.redraw()
+        finally:
+            if self._closed:
+                self._return_team()
+
+    def _return_team(self) -> None:
+        """Give the borrowed worker processes back (kept idle for the next session)."""
+        team, self._team = self._team, None
+        if isinstance(self.renderer, SharedViewRenderer):
+            self.renderer.release()
+            self.renderer = None
+        if team is not None:
+            procs.give_back(team)
 
     def _loop(self) -> None:
         while True:
@@ -348,26 +382,51 @@ class ViewportSession:
 
     def _adopt_scene(self, scene, settings: RenderSettings) -> None:
         old = self.renderer
-        hist = old.latest_history() if old is not None else None
-        cam = scene.camera if self._view is None else scaled_camera(self._view[0], self._divider)
-        scene.camera = cam
+        full = scene.camera if self._view is None else self._view[0]
+        scene.camera = full
         scene.light_groups = None  # the viewport shows Combined alone: no estimate split by light group
-        self.renderer = FrameRenderer(scene, dataclasses.replace(settings, frame=self._frame))
-        if hist is not None and settings.temporal_reuse:
-            self.renderer.adopt_history(hist)
+        team = self._team_for(scene, settings)
+        scene.camera = scene.camera if self._view is None else scaled_camera(full, self._divider)
+        settings = dataclasses.replace(settings, frame=self._frame)
+        if team is not None:
+            # the workers' last renderer hands its history over where this session's renderer was theirs
+            carry = isinstance(old, SharedViewRenderer) and old.team is team
+            _x0, _y0, w, h = full.window
+            self.renderer = SharedViewRenderer(team, scene, settings, w * h, carry=carry)
+        else:
+            hist = old.latest_history() if isinstance(old, FrameRenderer) else None
+            self.renderer = FrameRenderer(scene, settings)
+            if hist is not None and settings.temporal_reuse:
+                self.renderer.adopt_history(hist)
         if old is not None:
             old.release()
         self._key = None  # the next pass is a navigation pass: an edit's first image comes as fast as a move's
+
+    def _team_for(self, scene, settings: RenderSettings):
+        """The worker processes to render ``scene`` (its camera: the full-resolution view) on, or None for this
+        process: the session's team where its shape still fits, else a newly borrowed one."""
+        n, self.note = team_size(scene, settings, self.processes)
+        threads = max(1, thread_count() // n)
+        team = self._team
+        if team is not None and (n <= 1 or team.size != n or team.threads != threads or team.closed):
+            self._return_team()
+            team = None
+        if n > 1 and team is None:
+            try:
+                team = self._team = procs.borrow(n, threads)
+            except procs.WorkerStartFailed as exc:
+                self.note = f"render worker processes could not start ({exc}): rendering in Blender's process"
+        return team
 
     def _move(self, camera: Camera, key) -> None:
         """Point the renderer at the view (at the current divider); the scene's motion holds the previous view
         (for the Motion pass: objects do not move between views)."""
         r = self.renderer
-        prev = r.ctx.scene.camera
+        prev = r.camera
         cam = scaled_camera(camera, self._divider)
         self._frame += 1
         r.move_camera(cam, self._frame)
-        mats = r.ctx.scene.export_stats.get("instance_matrices") if hasattr(r.ctx.scene, "export_stats") else None
+        mats = r.instance_matrices
         if mats is None:
             mats = np.zeros((0, 4, 4))
         r.set_motion(Motion(current=mats, prev=mats, next=mats,
@@ -404,7 +463,7 @@ class ViewportSession:
             self._refine_t0 = None  # the view moved: its refinement starts again
         elif self._refine_t0 is None:
             self._refine_t0 = t0
-        _x0, _y0, w, h = r.ctx.scene.camera.window
+        _x0, _y0, w, h = r.camera.window
         if r.samples_done - before == 1:
             # the estimate sizes navigation passes, which render one sample: a batched refinement pass costs less per
             # sample (fuller chunks) and would make the next navigation pass overrun its budget
@@ -421,7 +480,8 @@ class ViewportSession:
             if self.denoise is not None:
                 image = self._denoised_combined(r, image)
             image = np.minimum(image, HALF_FLOAT_MAX)
-        _x0, _y0, w, h = r.ctx.scene.camera.window
+        _x0, _y0, w, h = r.camera.window
+        info = dict(info, note=self.note) if self.note else info
         with self._cv:
             self._image = image
             self._image_pass = self.pass_name
@@ -429,7 +489,8 @@ class ViewportSession:
                                              width=w, height=h, extra=info,
                                              navigation_passes=self.stats.navigation_passes + navigation,
                                              pass_seconds=self.stats.pass_seconds if seconds is None else seconds,
-                                             mean_m=_mean_confidence(r, "res_m") if r.candidates is not None else None,
+                                             processes=1 if self._team is None else self._team.size,
+                                             mean_m=_mean_confidence(r, "res_m") if r.resamples_direct else None,
                                              gi_mean_m=_mean_confidence(r, "gi_m"))
         self.redraw()
 

@@ -44,7 +44,14 @@ RUNS = [
     ("interior_gi DI+GI", "interior_gi", dict(integrator="RESTIR", direct_method="RESTIR",
                                               indirect_method="RESTIR_GI", max_bounces=4), 1, 4),
     ("demo F12 16 spp", "demo", {}, 16, 1),
+    # the viewport's renderer (FrameRenderer in one process with N threads, SharedViewRenderer on N processes):
+    # VIEW_MOVES full-resolution views panned one after the other (one pass each, the last view's history
+    # reprojected, the navigation candidate cap), then VIEW_REFINE samples refining the last view
+    ("viewport demo defaults", "demo", {}, 0, "viewport"),
+    ("viewport interior DI+GI", "interior_gi", dict(integrator="RESTIR", direct_method="RESTIR",
+                                                     indirect_method="RESTIR_GI", max_bounces=4), 0, "viewport"),
 ]
+VIEW_MOVES, VIEW_REFINE = 5, 8
 
 
 # -- export (bpy) ---------------------------------------------------------------------------------------------------
@@ -108,6 +115,8 @@ def one(args) -> dict:
     else:
         pool.set_thread_count(cores)
         procs = 1
+    if spec["frames"] == "viewport":
+        return _viewport(args, data, settings, procs)
     t0 = time.perf_counter()
     team = processes.team(procs) if procs > 1 else None
     if team is not None:
@@ -137,6 +146,56 @@ def one(args) -> dict:
     return {"cores": cores, "mode": args.mode, "frame_s": med["frame_s"], "frames_s": [r["frame_s"] for r in rows],
             "stages": med["stages"], "first_frame_s": rows[0]["frame_s"], "team_start_s": start,
             "checksum": digest, "method": r.stats.get("direct_method"), "indirect": r.stats.get("indirect_method")}
+
+
+def _viewport(args, data, settings, procs: int) -> dict:
+    """The viewport's passes at full resolution: a pan of VIEW_MOVES views, then VIEW_REFINE refinement samples."""
+    import dataclasses
+
+    import numpy as np
+    from restir_core.parallel import processes
+    from restir_core.pipeline.frame import FrameRenderer
+    from restir_core.pipeline.shared_view import SharedViewRenderer
+    from restir_core.scene import Motion
+    scene = data["scenes"][0]
+    scene.light_groups = None
+    full = scene.camera
+    _x0, _y0, w, h = full.window
+    settings = dataclasses.replace(settings, samples=VIEW_REFINE + VIEW_MOVES, frame=0)
+    t0 = time.perf_counter()
+    team = processes.borrow(procs) if procs > 1 else None
+    start = time.perf_counter() - t0
+    t = time.perf_counter()
+    r = SharedViewRenderer(team, scene, settings, w * h) if team is not None else FrameRenderer(scene, settings)
+    build = time.perf_counter() - t
+    mats = getattr(scene, "export_stats", {}).get("instance_matrices")
+    mats = np.zeros((0, 4, 4)) if mats is None else mats
+    moves, refine = [], []
+    for k in range(1, VIEW_MOVES + 1):
+        m = full.cam_to_world.copy()
+        m[:3, 3] += 0.05 * k * m[:3, 0]
+        prev, cam = r.camera, dataclasses.replace(full, cam_to_world=m)
+        t = time.perf_counter()
+        r.move_camera(cam, k)
+        r.set_motion(Motion(current=mats, prev=mats, next=mats, camera_prev=prev))
+        r.sample_pass(batch=1, light_candidate_cap=8 if r.reuses_history() else None)
+        moves.append(time.perf_counter() - t)
+    done = 0
+    while done < VIEW_REFINE:
+        batch = r.batch_size(VIEW_REFINE - done)
+        t = time.perf_counter()
+        r.sample_pass(batch=batch)
+        refine.append((time.perf_counter() - t) / batch)
+        done += batch
+    digest = hashlib.sha1(np.ascontiguousarray(r.combined()).tobytes()).hexdigest()[:16]
+    r.release()
+    if team is not None:
+        processes.give_back(team)
+        processes.shutdown()
+    steady = sorted(moves[1:])
+    return {"cores": int(args.cores), "mode": args.mode, "frame_s": steady[len(steady) // 2], "moves_s": moves,
+            "refine_sample_s": float(np.median(refine)), "first_frame_s": moves[0] + build, "build_s": build,
+            "team_start_s": start, "checksum": digest, "stages": {}, "method": r.method}
 
 
 # -- the sweep -------------------------------------------------------------------------------------------------------
@@ -205,7 +264,9 @@ def chart(args) -> None:
     results = json.load(open(args.json))
     out = os.path.dirname(os.path.abspath(args.json))
     runs = [r for r in results["runs"] if any(p["cores"] == 1 for p in r["points"])]
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5))
+    staged = any(p.get("stages") for r in runs for p in r["points"])  # the viewport runs time no stages
+    fig, axes = plt.subplots(1, 2 if staged else 1, figsize=(13 if staged else 7, 5), squeeze=False)
+    axes = axes[0]
     colors = plt.get_cmap("tab10").colors
     top = 1
     for i, entry in enumerate(runs):
@@ -222,6 +283,15 @@ def chart(args) -> None:
     axes[0].set_ylabel("speed-up over one core")
     axes[0].set_title(f"Frame speed-up, {results['meta'].get('size')} ({results['meta'].get('machine')})")
     axes[0].legend(fontsize=6)
+    if staged:
+        _stage_chart(axes[1], runs)
+    fig.tight_layout()
+    path = os.path.join(out, "scaling.png")
+    fig.savefig(path, dpi=110)
+    print(path)
+
+
+def _stage_chart(ax, runs) -> None:
     # per-stage speed-up of the processes at the most cores
     stages, labels, vals = [], [], []
     for entry in runs:
@@ -236,15 +306,11 @@ def chart(args) -> None:
                 stages.append(st)
                 labels.append(f"{entry['name']}: {st}")
                 vals.append(b / wall)
-    axes[1].barh(range(len(vals)), vals, color="tab:blue")
-    axes[1].set_yticks(range(len(vals)))
-    axes[1].set_yticklabels(labels, fontsize=5)
-    axes[1].set_xlabel("stage speed-up at the most cores (processes)")
-    axes[1].set_title("Per stage (stages of at least 1 % of the one-core frame)")
-    fig.tight_layout()
-    path = os.path.join(out, "scaling.png")
-    fig.savefig(path, dpi=110)
-    print(path)
+    ax.barh(range(len(vals)), vals, color="tab:blue")
+    ax.set_yticks(range(len(vals)))
+    ax.set_yticklabels(labels, fontsize=5)
+    ax.set_xlabel("stage speed-up at the most cores (processes)")
+    ax.set_title("Per stage (stages of at least 1 % of the one-core frame)")
 
 
 def main(argv=None):

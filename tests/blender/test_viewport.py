@@ -7,6 +7,7 @@ import time
 
 import bpy
 import numpy as np
+import pytest
 
 from bpy_scenes import cornell_box
 from harness.scenes import build_many_lights
@@ -162,16 +163,20 @@ def test_temporal_reuse_across_views_lowers_the_error_after_a_move(addon, monkey
     assert worse.mean() < 3 * worse.std(ddof=1) / np.sqrt(len(seeds))
 
 
-def test_viewport_passes_equal_the_render_passes(addon):
+@pytest.mark.parametrize("processes", [1, 2])
+def test_viewport_passes_equal_the_render_passes(addon, processes):
     """A still view at full resolution: every viewport pass is the render pass of the same samples (same seed,
-    frame and chunking), through the documented mapping."""
+    frame and chunking), through the documented mapping, whether the viewport renders in Blender's process or on
+    worker processes."""
     core, cam, settings = demo((96, 54))
-    settings = dataclasses.replace(settings, direct_method="RESTIR")  # reservoirs for the M/UCW passes
-    session = ViewportSession(lambda: None, budget=0.0, max_samples=2)
+    # reservoirs for the M/UCW passes; 6 chunks, so that 2 processes render
+    settings = dataclasses.replace(settings, direct_method="RESTIR", tile_pixels=1024)
+    session = ViewportSession(lambda: None, budget=0.0, max_samples=2, processes=processes)
     try:
         session.set_scene(core, settings)
         session.set_view(cam, "still")
         wait_for(lambda: session.stats.samples >= 2)
+        assert session.stats.processes == processes
         r = session.renderer
         ref = render_frame(dataclasses.replace(core, camera=cam, motion=None),
                            dataclasses.replace(settings, samples=2, frame=1, data_passes=True)).passes
@@ -313,6 +318,43 @@ def test_stop_during_a_pass_returns_promptly(addon):
     elapsed = time.perf_counter() - t0
     print(f"stopped in {elapsed:.3f} s")
     assert elapsed < 1.0 and not session.running
+    assert not [t for t in threading.enumerate() if t.name == "viewport-worker"]
+
+
+def test_viewport_worker_processes_stop_fail_and_come_back(addon):
+    """On worker processes: leaving Rendered mode during a pass stops within 1 s and gives the processes back (the
+    next session borrows them without starting any); a worker that dies gives one error in the header, and the next
+    edit renders on new processes."""
+    from restir_engine.core.parallel import processes as procs
+    core, cam, settings = demo((640, 360))
+    session = ViewportSession(lambda: None, budget=0.0, processes=2)
+    session.set_scene(core, settings)
+    session.set_view(cam, "still")
+    wait_for(lambda: session.stats.samples >= 1)
+    team = session._team
+    assert team is not None and team.size == 2 and "2 processes" in session.stats.text()
+    t0 = time.perf_counter()
+    session.halt()
+    assert time.perf_counter() - t0 < 1.0 and not session.running
+    assert team in procs._IDLE and team.alive()
+    session = ViewportSession(lambda: None, budget=0.0, processes=2)
+    try:
+        session.set_scene(core, settings)
+        session.set_view(cam, "still")
+        wait_for(lambda: session.stats.samples >= 1)
+        assert session._team is team
+        team.procs[1].kill()
+        session.set_view(*panned(cam, 1))
+        wait_for(lambda: session.last_error is not None)
+        assert "ended unexpectedly" in session.last_error and not team.alive()
+        core2, _cam, _settings = demo((640, 360))
+        before = session.stats.navigation_passes
+        session.set_scene(core2, settings)  # an edit: the viewport starts again on new processes
+        wait_for(lambda: session.stats.navigation_passes > before)
+        assert session._team is not team and session.stats.processes == 2
+        assert session.last_error is None and session._team.alive()
+    finally:
+        session.halt()
     assert not [t for t in threading.enumerate() if t.name == "viewport-worker"]
 
 

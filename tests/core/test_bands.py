@@ -57,6 +57,12 @@ def test_bands_in_two_processes_and_their_history():
     nxt = render_frame(regression_room(W, H), dataclasses.replace(st, frame=1), processes=1, bands=3,
                        history=solo.history)
     assert nxt.stats["reuse"]["temporal_accepted"] > 0.9  # the scene did not move: every band reprojects
+    # each band's history kept in the workers for the same band of the next frame (not overwritten by the other
+    # bands' first passes, not dropped when a larger band needs larger buffers)
+    team_next = render_frame(regression_room(W, H), dataclasses.replace(st, frame=1), processes=2, bands=3,
+                             history=team.history)
+    for key, image in nxt.passes.items():
+        np.testing.assert_array_equal(image, team_next.passes[key], err_msg=key)
     still = render_frame(regression_room(W, H), st, processes=1, bands=3, keep_history=False)
     assert still.history is None
 

@@ -314,3 +314,93 @@ def _two_frames_agree_in_processes(build):
         assert np.array_equal(images[0][frame], images[1][frame])
     plain = render_frame(regression_room(*SIZE), settings, processes=1).passes["Combined"]
     assert not np.array_equal(plain, images[0][0])
+
+
+# -- the viewport's renderer on worker processes (pipeline/shared_view.py) ----------------------------------------
+def _moved(camera, k, divider=1):
+    """The camera moved k steps sideways, at 1/divider of its resolution (a viewport navigation step)."""
+    m = camera.cam_to_world.copy()
+    m[:3, 3] += 0.02 * k * m[:3, 0]
+    w, h = camera.width // divider, camera.height // divider
+    return dataclasses.replace(camera, cam_to_world=m, width=w, height=h, window=(0, 0, w, h))
+
+
+def _view_session(make, scene, settings, edited):
+    """What the viewport does to its renderer, in order: passes, moves at other resolutions (the navigation
+    candidate cap, a batch of refinement samples), a pass stopped before it kept anything, an edit that carries the
+    history into a new renderer. Returns every pass's images (Combined, DI M and GI M, data passes at the end)."""
+    from restir_engine.core.scene import Motion
+    full = scene.camera
+    out = []
+    r = make(scene, settings, None)
+
+    def shot():
+        out.append((r.samples_done, r.combined().copy(), r.mean("res_m").copy(), r.mean("gi_m").copy()))
+
+    def move(cam, frame):
+        prev = r.camera
+        r.move_camera(cam, frame)
+        mats = np.zeros((0, 4, 4))
+        r.set_motion(Motion(current=mats, prev=mats, next=mats, camera_prev=dataclasses.replace(
+            prev, width=cam.width, height=cam.height, window=cam.window)))
+
+    assert r.sample_pass(batch=1)
+    shot()
+    move(_moved(full, 1, 2), 2)
+    assert r.reuses_history()
+    assert r.sample_pass(batch=1, light_candidate_cap=8)
+    shot()
+    move(_moved(full, 2, 1), 3)
+    assert not r.sample_pass(should_stop=lambda: True, batch=1)  # stopped before it kept a history
+    move(_moved(full, 3, 1), 4)  # reprojects the half-resolution view's history
+    assert r.sample_pass(batch=1)
+    shot()
+    assert r.sample_pass(batch=r.batch_size(2))
+    shot()
+    r = make(edited, settings, r)  # an edit: the newest history goes on into the new renderer
+    move(_moved(full, 4, 1), 5)
+    assert r.sample_pass(batch=1)
+    shot()
+    out.append(tuple(a.copy() for a in r.data_passes()))
+    r.release()
+    return out
+
+
+def test_the_viewport_renders_the_same_views_on_processes_as_in_one():
+    from restir_engine.core.pipeline.shared_view import SharedViewRenderer
+    from restir_engine.core.renderer import FrameRenderer
+    settings = dataclasses.replace(SETTINGS["di-gi-unbiased"], samples=64, frame=1)
+    scene = regression_room(*SIZE)
+    edited = regression_room(*SIZE)
+    edited.materials.base_color[0] = (0.2, 0.5, 0.8)  # the floor re-coloured
+    assert not np.array_equal(edited.materials.base_color, scene.materials.base_color)
+
+    def alone(sc, st, old):
+        fr = FrameRenderer(dataclasses.replace(sc, camera=scene.camera) if old else sc, st)
+        if old is not None:
+            fr.adopt_history(old.latest_history())
+            old.release()
+        return fr
+
+    team = processes.borrow(2)
+
+    def shared(sc, st, old):
+        out = SharedViewRenderer(team, dataclasses.replace(sc, camera=scene.camera) if old else sc, st,
+                                 SIZE[0] * SIZE[1], carry=old is not None)
+        if old is not None:
+            old.release()
+        return out
+
+    try:
+        a = _view_session(alone, regression_room(*SIZE), settings, edited)
+        b = _view_session(shared, regression_room(*SIZE), settings, edited)
+    finally:
+        processes.give_back(team)
+    assert len(a) == len(b) == 6
+    for i, (x, y) in enumerate(zip(a, b)):
+        if i < 5:
+            assert x[0] == y[0]
+        for u, v in zip(x[1:] if i < 5 else x, y[1:] if i < 5 else y):
+            assert np.array_equal(u, v), i
+    assert processes.borrow(2) is team  # given back, kept idle, lent again
+    processes.give_back(team)

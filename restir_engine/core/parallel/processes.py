@@ -5,7 +5,7 @@ Python runs one thread of bytecode at a time, so threads stop scaling at a few c
 own Python): each imports only the core (boot/restir_worker_boot.py), builds its own Embree scenes and renders every
 sample pass at the same time as the others, each computing the chunks it owns (team.py). They share, through
 segments of shared memory that this process creates and unlinks: the exported scene (wire.pack, once per frame),
-the three arena slots of the whole-image buffers and the film, which this process reads the passes from.
+the arena slots of the whole-image buffers and the film, which this process reads the passes from.
 
 Faults: a stop request sets a shared flag and breaks the team's barrier (every worker leaves its pass within a
 stage's task); a worker that dies or fails ends the whole team with one error (:class:`WorkerFailed`), its
@@ -99,12 +99,15 @@ class WorkerTeam:
         atexit.register(self.close)
 
     # -- shared segments ---------------------------------------------------------------------------------------
-    def ensure_slots(self, nbytes: int) -> list[str]:
-        """Names of the three arena slots, each at least ``nbytes`` (new, larger ones replace smaller ones)."""
-        if self.slot_bytes < nbytes:
+    def ensure_slots(self, nbytes: int, histories: int = 1) -> list[str]:
+        """Names of the arena slots (parallel/team.py) for frames that keep ``histories`` temporal histories: one
+        per history, one for the first pass that writes the next, one for the other passes; each at least ``nbytes``
+        (new ones replace them where they are too small or too few; their pages are committed only where written)."""
+        count = max(1, int(histories)) + 2
+        if self.slot_bytes < nbytes or len(self.slot_segs) != count:
             wire.unlink_segments(self.slot_segs)
-            self.slot_bytes = int(nbytes)
-            self.slot_segs = [wire.create_segment(self.slot_bytes) for _ in range(3)]
+            self.slot_bytes = max(int(nbytes), self.slot_bytes if len(self.slot_segs) == count else 0)
+            self.slot_segs = [wire.create_segment(self.slot_bytes) for _ in range(count)]
         return [s.name for s in self.slot_segs]
 
     def film(self, nbytes: int, dtype):
@@ -252,36 +255,77 @@ def split(threads: int | None, processes: int, chunks: int | None = None) -> tup
 _DISABLED: str | None = None  # why worker processes could not start in this session (None: they can)
 
 
+def _start(size: int, threads: int) -> WorkerTeam:
+    """A new team, started and answering (call with _TEAM_LOCK held). Raises WorkerStartFailed when workers cannot
+    start here (then for the rest of the session)."""
+    global _DISABLED
+    if _DISABLED is not None:
+        raise WorkerStartFailed(_DISABLED)
+    try:
+        started = WorkerTeam(size, threads)
+        started.run(("ping",), timeout=START_TIMEOUT)
+    except Exception as exc:  # noqa: BLE001 - any failure to start means: render in this process
+        if "started" in locals():
+            started.close(kill=True)
+        _DISABLED = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
+        raise WorkerStartFailed(_DISABLED) from exc
+    return started
+
+
 def team(size: int, threads: int = 1) -> WorkerTeam:
-    """The persistent team of ``size`` workers (a new one when the size changed or the last one failed), started
-    and answering. Raises WorkerStartFailed when workers cannot start here (then for the rest of the session)."""
-    global _TEAM, _DISABLED
+    """The persistent team of ``size`` workers that final renders use (a new one when the size changed or the last
+    one failed), started and answering. Raises WorkerStartFailed when workers cannot start here."""
+    global _TEAM
     with _TEAM_LOCK:
-        if _DISABLED is not None:
-            raise WorkerStartFailed(_DISABLED)
         if _TEAM is not None and (_TEAM.size != size or _TEAM.threads != threads or not _TEAM.alive()):
             _TEAM.close(kill=not _TEAM.alive())
             _TEAM = None
         if _TEAM is None:
-            try:
-                started = WorkerTeam(size, threads)
-                started.run(("ping",), timeout=START_TIMEOUT)
-            except Exception as exc:  # noqa: BLE001 - any failure to start means: render in this process
-                if "started" in locals():
-                    started.close(kill=True)
-                _DISABLED = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}"
-                raise WorkerStartFailed(_DISABLED) from exc
-            _TEAM = started
+            _TEAM = _start(size, threads)
         return _TEAM
 
 
+_IDLE: list[WorkerTeam] = []  # viewport teams given back, kept for the next session (at most IDLE_TEAMS)
+IDLE_TEAMS = 1
+
+
+def borrow(size: int, threads: int = 1) -> WorkerTeam:
+    """A team of ``size`` workers for one user alone (a viewport session, whose renderer lives in its workers
+    between passes while final renders use :func:`team`): an idle one of that shape, else a new one. Hand it back
+    with :func:`give_back`. Raises WorkerStartFailed when workers cannot start here."""
+    with _TEAM_LOCK:
+        for t in list(_IDLE):
+            _IDLE.remove(t)
+            if t.size == size and t.threads == threads and t.alive():
+                return t
+            t.close(kill=not t.alive())
+        return _start(size, threads)
+
+
+def give_back(team: WorkerTeam) -> None:
+    """A borrowed team is free again: kept idle for the next borrower (the newest IDLE_TEAMS), or ended."""
+    with _TEAM_LOCK:
+        if team.closed or not team.alive():
+            team.close(kill=True)
+            return
+        with contextlib.suppress(Exception):
+            team.run(("end",), timeout=QUIT_SECONDS)  # its workers drop the session's renderer
+        if team.closed:
+            return
+        _IDLE.append(team)
+        while len(_IDLE) > IDLE_TEAMS:
+            _IDLE.pop(0).close()
+
+
 def shutdown() -> None:
-    """End the persistent team (add-on unregister, interpreter exit)."""
+    """End the persistent team and the idle borrowed ones (add-on unregister, interpreter exit)."""
     global _TEAM
     with _TEAM_LOCK:
         if _TEAM is not None:
             _TEAM.close()
             _TEAM = None
+        while _IDLE:
+            _IDLE.pop().close()
 
 
 def abandon() -> None:
@@ -289,10 +333,12 @@ def abandon() -> None:
     hold it): for a process about to end itself in a signal handler (the CLI's Ctrl+C), so that no worker and no
     shared-memory segment outlives it."""
     global _TEAM
-    team, _TEAM = _TEAM, None
-    if team is not None:
+    teams = [t for t in [_TEAM] + _IDLE if t is not None]
+    _TEAM = None
+    del _IDLE[:]
+    for t in teams:
         with contextlib.suppress(Exception):
-            team.close(kill=True)
+            t.close(kill=True)
     # the team's semaphores (barrier, stop flag) are unlinked by multiprocessing's exit finalizers, which an
     # os._exit skips: run them now
     from multiprocessing import util

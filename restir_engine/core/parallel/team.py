@@ -8,9 +8,12 @@ the same for any team size. A process rendering alone uses :class:`Solo`, whose 
 whose barrier does nothing.
 
 Buffers come from an :class:`Arena`: every member allocates the same sequence of shapes, so a bump allocator gives
-each the same offsets without talking. A pass allocates from one of three slots: the first pass of a frame from slot
-0 or 1 by turns (its G-buffer and reservoirs are the next frame's history, read while that frame's first pass
-fills the other slot), the other passes from slot 2.
+each the same offsets without talking. A pass allocates from one of the slots: the other passes of a frame from the
+last slot, the first pass from one of the others that holds no history in use. A first pass's G-buffer and
+reservoirs may be kept as a temporal history (:meth:`Team.kept`), read by a later first pass while it fills another
+slot; the team holds the newest ``keep`` of them (one per band of a banded frame, else one), so with ``keep`` + 2
+slots a first pass always finds a free one, and one that keeps nothing (a still, a pass stopped before it kept its
+history) leaves its slot free for the next.
 """
 from __future__ import annotations
 
@@ -52,6 +55,9 @@ class Solo:
         return np.empty(shape, dtype)
 
     def begin_pass(self, first: bool, chunks: int = 0) -> None:
+        pass
+
+    def kept(self) -> None:
         pass
 
     def table(self, rows: dict, n: int, k: int) -> np.ndarray:
@@ -109,8 +115,10 @@ class Team:
         self.rank, self.size = int(rank), int(size)
         self.leader = self.rank == 0
         self._barrier, self.slots, self.stop = barrier, slots, stop
-        self._turn = 0
-        self.arena = slots[2]
+        self.keep = max(1, len(slots) - 2)  # histories held at most (the worker sets it per frame)
+        self._held: list[int] = []  # the slots holding the kept histories, oldest first
+        self._first_slot = 0  # the slot of the last first pass
+        self.arena = slots[-1]
         self._lock = threading.Lock()
         self.costs = costs  # [0]: the chunk count n they were measured for; [1 + s * n + i]: chunk i's seconds
         #                     in segment s (the stages between two barriers: SEGMENTS)
@@ -141,13 +149,22 @@ class Team:
         """Allocate the coming pass's buffers from the next first-pass slot (``first``) or from the slot of the
         other passes, and assign its ``chunks`` chunks."""
         if first:
-            self.arena = self.slots[self._turn]
-            self._turn = 1 - self._turn
+            free = [i for i in range(len(self.slots) - 1) if i not in self._held]
+            if not free:
+                raise ArenaFull(f"all {len(self.slots) - 1} first-pass slots hold a history in use")
+            self._first_slot = free[0]
+            self.arena = self.slots[self._first_slot]
         else:
-            self.arena = self.slots[2]
+            self.arena = self.slots[-1]
         self.arena.reset()
         self.chunk_owner = assign(chunks, self.size, self._measured(chunks))
         self._spent = {}
+
+    def kept(self) -> None:
+        """The first pass's buffers are now a temporal history, held until ``keep`` newer ones are kept."""
+        self._held = [i for i in self._held if i != self._first_slot][-(max(1, self.keep) - 1):] \
+            if self.keep > 1 else []
+        self._held.append(self._first_slot)
 
     def _measured(self, chunks: int):
         c = self.costs

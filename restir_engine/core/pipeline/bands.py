@@ -53,8 +53,9 @@ def layout(h: int, bands: int) -> tuple:
 def render_in_bands(render_one, scene, settings, bands: int, progress=None, should_stop=None, history=None,
                     clock=None, margin: int | None = None):
     """:func:`frame_render.render_frame`'s result for ``scene`` rendered in ``bands`` bands of ``margin`` extra rows each
-    side (None: :func:`margin_rows`), each by ``render_one(scene, settings, progress, should_stop, history, clock)``
-    (one band's render_frame)."""
+    side (None: :func:`margin_rows`), each by ``render_one(scene, settings, progress, should_stop, history, clock,
+    pixels)`` (one band's render_frame; ``pixels``: the largest band's, margins included, which worker processes size
+    their buffers for once, so that no band's history is dropped for a larger one)."""
     from .frame import Cancelled, FrameResult
     cam = scene.camera
     x0, y0, w, h = cam.window
@@ -65,6 +66,7 @@ def render_in_bands(render_one, scene, settings, bands: int, progress=None, shou
     passes: dict = {}
     histories, stats, samples, cancelled = [], {}, None, False
     limit = settings.time_limit / len(rows) if settings.time_limit > 0 else 0.0
+    largest = w * max(min(h, b + m) - max(0, a - m) for a, b in rows)
     try:
         for i, (a, b) in enumerate(rows):
             lo, hi = max(0, a - m), min(h, b + m)
@@ -75,7 +77,7 @@ def render_in_bands(render_one, scene, settings, bands: int, progress=None, shou
                 def report(f, msg, i=i):
                     progress((i + f) / len(rows), f"Band {i + 1}/{len(rows)} | {msg}")
             try:
-                result = render_one(scene, band_settings, report, should_stop, hist[i], clock)
+                result = render_one(scene, band_settings, report, should_stop, hist[i], clock, largest)
             except Cancelled:
                 if i == 0:
                     raise

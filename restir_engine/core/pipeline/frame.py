@@ -140,6 +140,21 @@ class FrameRenderer:
         return self.direct.candidates
 
     @property
+    def resamples_direct(self) -> bool:
+        """Whether the direct light is resampled (the film has reservoir passes)."""
+        return self.candidates is not None
+
+    @property
+    def camera(self):
+        """The camera the passes render from."""
+        return self.ctx.scene.camera
+
+    @property
+    def instance_matrices(self):
+        """The exported instances' object-to-world matrices (scene.export_stats), or None."""
+        return getattr(self.ctx.scene, "export_stats", {}).get("instance_matrices")
+
+    @property
     def indirect_method(self) -> str:
         return self.indirect.method
 
@@ -466,6 +481,7 @@ class FrameRenderer:
     def _keep_history(self, gb, res, gb_gi, gi_history, gi_reused: bool) -> None:
         """The next frame's history from this first pass; confidence at most the cap, so no reused M exceeds it."""
         st, lights = self.settings, self.ctx.lights
+        self.team.kept()
         self.history = TemporalHistory(
             gb, None if res is None else res.replace(M=np.minimum(res.M, st.confidence_cap)), self.ctx.scene.camera,
             lights.signature, st.frame, lights.light_uid, lights.uid_space,

@@ -20,7 +20,8 @@ def out_of_time(settings: RenderSettings, t0: float, done: int) -> bool:
 
 def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_stop=None, history=None,
                  clock=None, processes: int | None = None, bands: int | None = None,
-                 band_margin: int | None = None, keep_history: bool = True, history_slots: int = 1) -> FrameResult:
+                 band_margin: int | None = None, keep_history: bool = True, history_slots: int = 1,
+                 slot_pixels: int = 0) -> FrameResult:
     """Render one frame with the chosen integrator, in ``processes`` worker processes (None: the count that
     parallel.processes.process_count chooses for the thread count; 1: in this process), at most one per chunk of
     pixels. The same seed gives the same image either way.
@@ -36,23 +37,23 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     ``bands``: horizontal bands the window is rendered in (bands.py; None: as many as keep one band's working set
     within memory.band_budget, 1 for most frames) with ``band_margin`` extra rows each side (None: bands.plan's, or
     the spatial radius where ``bands`` is given); ``history_slots``: histories worker processes keep (one per band
-    of the banded frame this one belongs to).
+    of the banded frame this one belongs to) in buffers sized for at least ``slot_pixels`` pixels (its largest band).
     """
     from . import bands as bands_mod
     if bands is None:
         from . import memory
         bands, band_margin = bands_mod.plan(scene, settings, memory.available_memory(), keep_history)
     if bands > 1:
-        def one(sc, st, report, stop, hist, clk):
+        def one(sc, st, report, stop, hist, clk, pixels):
             return render_frame(sc, st, report, stop, hist, clk, processes, bands=1, keep_history=keep_history,
-                                history_slots=bands if keep_history else 1)
+                                history_slots=bands if keep_history else 1, slot_pixels=pixels)
         return bands_mod.render_in_bands(one, scene, settings, bands, progress, should_stop, history, clock,
                                          band_margin)
     team, note = _team(scene, settings, processes)
     if team is not None:
         from .shared_frame import render_frame_shared
         result = render_frame_shared(scene, settings, team, progress, should_stop, history, clock, history_slots,
-                                     keep_history)
+                                     keep_history, slot_pixels)
     else:
         result = _render_here(scene, settings, progress, should_stop, history, clock, keep_history)
     if note:
@@ -60,9 +61,10 @@ def render_frame(scene: Scene, settings: RenderSettings, progress=None, should_s
     return result
 
 
-def _team(scene: Scene, settings: RenderSettings, processes: int | None):
-    """(the worker team to render on or None for this process, a note for the user where fewer processes than
-    asked for render): at most one process per chunk, as many as fit in memory."""
+def team_size(scene: Scene, settings: RenderSettings, processes: int | None) -> tuple[int, str]:
+    """(worker processes to render ``scene``'s camera window in, a note for the user where fewer than asked for
+    render): ``processes`` (None: what parallel.processes.process_count chooses for the thread count), at most one
+    per chunk, as many as fit in memory; 1: this process alone."""
     from ..parallel import processes as procs
     _x0, _y0, w, h = scene.camera.window
     chunks = len(spans(w * h, settings.tile_pixels))
@@ -76,6 +78,14 @@ def _team(scene: Scene, settings: RenderSettings, processes: int | None):
             note = (f"{n} render processes would not fit in memory ({memory.size_text(free)} free, each needs its "
                     f"own copy of the scene's BVH): rendering with {fit}")
             n = fit
+    return max(1, n), note
+
+
+def _team(scene: Scene, settings: RenderSettings, processes: int | None):
+    """(the worker team to render on or None for this process, a note for the user where fewer processes than
+    asked for render)."""
+    from ..parallel import processes as procs
+    n, note = team_size(scene, settings, processes)
     if n <= 1:
         return None, note
     try:

@@ -61,8 +61,23 @@ def film_bytes(w: int, h: int, gi: bool, denoise_data: bool, adaptive: bool = Fa
                for _key, c in film_keys(gi, denoise_data, adaptive, groups, catchers)) + ALIGN
 
 
+def shared_film(team: WorkerTeam, scene, settings: RenderSettings) -> tuple[str, Film]:
+    """(segment name, Film) of ``scene``'s camera window over ``team``'s film segment, zero-filled: the
+    accumulators each worker's FrameRenderer lays out in the same order over the same segment."""
+    _x0, _y0, w, h = scene.camera.window
+    gi = methods.gi_possible(settings)
+    adaptive = settings.use_adaptive_sampling
+    lg = getattr(scene, "light_groups", None)
+    group_names = () if lg is None else tuple(lg.names)
+    catchers = film_mode(settings, catcher_triangles(scene) is not None)
+    name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data, adaptive, len(group_names),
+                                       catchers is not None), FILM_DTYPE)
+    return name, Film(w, h, gi, settings.denoise_data, zeros, adaptive, group_names, catchers)
+
+
 def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
-                        history=None, clock=None, keep_histories: int = 1, keep_history: bool = True) -> FrameResult:
+                        history=None, clock=None, keep_histories: int = 1, keep_history: bool = True,
+                        slot_pixels: int = 0) -> FrameResult:
     """:func:`frame_render.render_frame` on ``team``'s workers (same arguments and result; ``history`` a SharedHistory
     of this team, anything else is not reused); the workers keep the newest ``keep_histories`` histories (one per
     band of a banded frame), and this frame's only where ``keep_history``."""
@@ -71,15 +86,8 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
     with team.lock:
         cam = scene.camera
         _x0, _y0, w, h = cam.window
-        gi = methods.gi_possible(settings)
-        adaptive = settings.use_adaptive_sampling
-        lg = getattr(scene, "light_groups", None)
-        group_names = () if lg is None else tuple(lg.names)
-        catchers = film_mode(settings, catcher_triangles(scene) is not None)
-        film_name, zeros = team.film(film_bytes(w, h, gi, settings.denoise_data, adaptive, len(group_names),
-                                                catchers is not None), FILM_DTYPE)
-        film = Film(w, h, gi, settings.denoise_data, zeros, adaptive, group_names, catchers)
-        slots = team.ensure_slots(slot_bytes(w * h, settings))
+        film_name, film = shared_film(team, scene, settings)
+        slots = team.ensure_slots(slot_bytes(max(w * h, int(slot_pixels)), settings), keep_histories)
         usable = isinstance(history, SharedHistory) and history.team == team.id and history.fits(cam)
         seg, packed = wire.pack(scene)
         try:
@@ -105,7 +113,7 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
             if replies is None:
                 cancelled = True
                 break
-            rendered, converged = replies[0]
+            rendered, converged = replies[0][:2]
             done += int(rendered)
             if converged:  # adaptive sampling stopped every pixel
                 break

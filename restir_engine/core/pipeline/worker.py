@@ -4,11 +4,19 @@ pass at the same time as the other workers, into the team's shared film.
 Messages (tuples from the rendering process; each is answered with ("ok", pickled payload) or ("stopped", None) or
 ("error", text)):
   ("frame", frame)  build the frame's renderer: the scene (wire.pack), settings, the history token it may reuse,
-                    the film's and the arena slots' segments
-  ("pass", left)    render the next sample pass (at most ``left`` samples); payload: (the samples it rendered,
-                    whether adaptive sampling stopped every pixel)
+                    the film's and the arena slots' segments; with ``frame["view"]`` (a viewport's edit) the last
+                    renderer's newest history is carried into it, as the viewport does in one process; the leader's
+                    payload: :meth:`_Worker.facts`
+  ("view", view)    the viewport moved: the renderer renders from ``view["camera"]`` as frame ``view["frame"]`` into
+                    the zero-filled film segment ``view["film"]`` (FrameRenderer.move_camera); payload: facts
+  ("motion", m)     the scene's motion for the next pass's reprojection (FrameRenderer.set_motion)
+  ("pass", left[, batch, cap])  render the next sample pass (``batch`` samples, None: at most ``left`` as
+                    FrameRenderer.batch_size chooses; at most ``cap`` light candidates); payload: (the samples it
+                    rendered, whether adaptive sampling stopped every pixel, the batch the next pass may render)
+  ("data",)         the leader's payload: the data passes (Depth, Normal, Vector) of the current view
   ("finish", token) end the frame: keep its history under ``token``; the leader's payload: the frame's stats, data
                     passes and whether the film has reservoir passes
+  ("end",)          drop the renderer (a viewport session ends)
   ("ping",)         answer once started (the core imported)
   ("quit",)         exit
 """
@@ -25,6 +33,7 @@ from .film import FILM_DTYPE
 
 KEEP_SCENES = 3  # scene segments a worker keeps attached (a context may still refer to the last frames' arrays)
 KEEP_HISTORIES = 1  # temporal histories a worker keeps by default: the last frame's (a banded frame: one per band)
+ANY_BATCH = 1 << 30  # samples left when asking FrameRenderer.batch_size for its unbounded choice
 
 
 class _Worker:
@@ -43,15 +52,18 @@ class _Worker:
         self.keep_histories = KEEP_HISTORIES
 
     # -- segments --------------------------------------------------------------------------------------------
-    def _slots(self, names, costs: str) -> None:
+    def _slots(self, names, costs: str) -> bool:
+        """Attach the arena slots and the costs segment; whether they changed (histories in the old ones are
+        dropped)."""
         if self.slot_names == (names, costs):
-            return
+            return False
         segs = [wire.attach_segment(n) for n in names + [costs]]
         self._drop(getattr(self, "slot_segs", []))
         self.slot_segs, self.slot_names = segs, (names, costs)
-        self.team = Team(self.rank, self.size, self.barrier, [Arena(s.buf, s.name) for s in segs[:3]], self.stop,
-                         np.frombuffer(segs[3].buf, np.float64))
+        self.team = Team(self.rank, self.size, self.barrier, [Arena(s.buf, s.name) for s in segs[:-1]], self.stop,
+                         np.frombuffer(segs[-1].buf, np.float64))
         self.histories = {}  # they lived in the old slots
+        return True
 
     def _film(self, name: str):
         if self.film_seg is None or self.film_seg.name != name:
@@ -68,7 +80,13 @@ class _Worker:
     def frame(self, frame: dict):
         from .frame import FrameRenderer
         from ..profile import StageClock
-        self._slots(frame["slots"], frame["costs"])
+        old = self.fr
+        carried = old.latest_history() if frame.get("view") and old is not None else None
+        if old is not None:
+            old.release()
+            self.fr = None
+        if self._slots(frame["slots"], frame["costs"]):
+            carried = None
         zeros = self._film(frame["film"])
         scene = wire.unpack(frame["scene"], self.scenes)
         if len(self.scenes) > KEEP_SCENES:
@@ -77,24 +95,42 @@ class _Worker:
         settings = wire.loads(frame["settings"], frame["sender"])
         history = self.histories.pop(frame["history"], None) if frame["history"] is not None else None
         self.keep_histories = max(KEEP_HISTORIES, int(frame.get("keep_histories", KEEP_HISTORIES)))
+        self.team.keep = self.keep_histories
         self.clock = StageClock() if frame["clock"] and self.team.leader else None
         self.scene = scene
         self.fr = FrameRenderer(scene, settings, history, self.clock, team=self.team, film_zeros=zeros,
                                 keep_history=frame.get("keep_history", True))
-        return {"build_seconds": self.fr.build_seconds}
+        if carried is not None and settings.temporal_reuse:
+            self.fr.adopt_history(carried)
+        return {"build_seconds": self.fr.build_seconds, **(self.facts() or {})}
 
-    def sample_pass(self, left: int):
+    def facts(self) -> dict | None:
+        """The leader's facts about its renderer that the rendering process shows or decides by: the direct method,
+        whether it resamples, whether the next first pass reuses a history, the batch the next pass may render."""
         fr = self.fr
-        batch = fr.batch_size(int(left))
+        if not self.team.leader:
+            return None
+        return {"method": fr.method, "resampled": fr.candidates is not None, "reuses": fr.reuses_history(),
+                "batch": fr.batch_size(ANY_BATCH)}
+
+    def view(self, view: dict):
+        fr = self.fr
+        fr.film_zeros = self._film(view["film"])
+        fr.move_camera(view["camera"], view["frame"])
+        return self.facts()
+
+    def sample_pass(self, left: int, batch: int | None = None, cap: int | None = None):
+        fr = self.fr
+        batch = fr.batch_size(int(left)) if batch is None else int(batch)
         report = None
         if self.team.leader:
             self.progress.value = 0.0
 
             def report(fraction):
                 self.progress.value = fraction
-        if not fr.sample_pass(report, self.team.stopping, batch):
+        if not fr.sample_pass(report, self.team.stopping, batch, cap):
             return None
-        return batch, fr.converged
+        return batch, fr.converged, fr.batch_size(ANY_BATCH)
 
     def finish(self, token: int):
         from .frame import frame_stats
@@ -134,13 +170,25 @@ class _Worker:
                     out = None
                 elif kind == "frame":
                     out = self.frame(msg[1])
+                elif kind == "view":
+                    out = self.view(wire.loads(*msg[1]))
+                elif kind == "motion":
+                    self.fr.set_motion(wire.loads(*msg[1]))
+                    out = None
                 elif kind == "pass":
-                    out = self.sample_pass(msg[1])
+                    out = self.sample_pass(*msg[1:])
                     if out is None:
                         self.conn.send(("stopped", None))
                         continue
+                elif kind == "data":
+                    out = tuple(self.fr.data_passes()) if self.team.leader else None
                 elif kind == "finish":
                     out = self.finish(msg[1])
+                elif kind == "end":
+                    if self.fr is not None:
+                        self.fr.release()
+                    self.fr = self.scene = None
+                    out = None
                 else:
                     raise ValueError(f"unknown message {kind!r}")
                 self.conn.send(("ok", wire.dumps(out)))
