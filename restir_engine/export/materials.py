@@ -17,6 +17,7 @@ from .flat_nodes import FlatTree, cycles_output, flat_output
 from .subsurface import principled_subsurface
 from .sheen import sheen_row, sheen_set
 from .limits import clamped_radiance
+from .material_normals import NormalReader
 from .material_textures import TextureReader
 from .mix_shaders import MixShaderReader
 from .node_graph import GraphCompiler
@@ -27,7 +28,7 @@ from .node_graph import GraphCompiler
 HOLDOUT_ROW = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "metallic": 0.0, "holdout": True}
 
 
-class MaterialRegistry(MixShaderReader, TextureReader):
+class MaterialRegistry(MixShaderReader, NormalReader, TextureReader):
     """Assigns table indices to Blender materials (index 0 is Blender's default grey) and
     collects textures; reports approximations through ``warnings``."""
 
@@ -434,71 +435,6 @@ class MaterialRegistry(MixShaderReader, TextureReader):
         row["glass_multiscatter"] = row.get("multiscatter", 1.0)
 
     # -- Mix and Add shaders: a weighted sum of BSDFs, one picked per hit (core/materials/mix.py) ---------
-    def _normal(self, material, node, row: dict, g: GraphCompiler | None = None, varying: dict | None = None,
-                socket=None) -> None:
-        """A BSDF's Normal input (or ``socket``). A tangent-space Normal Map of an Image Texture and a Bump of an
-        Image Texture (over nothing or such a Normal Map) -> the row's normal_tex / bump_tex fields (read at render
-        time without a node program); any other graph -> ``varying["normal"]``, the node program's normal (Normal
-        Map and Bump of any input)."""
-        socket = node.inputs.get("Normal") if socket is None else socket
-        if socket is None or not socket.is_linked:
-            return
-        if self._image_normal(material, socket.links[0].from_node, row):
-            return
-        if g is None:
-            self._warn(material, f"the Normal input of '{node.name}' is not supported here; the mesh normal is used")
-            return
-        reg = g.value(socket, "vector", default="normal")
-        if reg.const is None:
-            varying["normal"] = reg
-
-    def _image_normal(self, material, src, row: dict) -> bool:
-        """Normal Map / Bump of plain Image Textures -> row fields; False (row unchanged) for anything else."""
-        bump = None
-        if src.type == "BUMP":
-            bump = src
-            inner = src.inputs.get("Normal")
-            src = inner.links[0].from_node if inner is not None and inner.is_linked else None
-            height = bump.inputs["Height"]
-            img = height.links[0].from_node if height.is_linked else None
-            if img is None or img.type != "TEX_IMAGE" or img.image is None or img.inputs["Vector"].is_linked:
-                return False
-        nmap = None
-        if src is not None:
-            col = src.inputs.get("Color") if src.type == "NORMAL_MAP" else None
-            img = col.links[0].from_node if col is not None and col.is_linked else None
-            if (src.type != "NORMAL_MAP" or src.space != "TANGENT" or img is None or img.type != "TEX_IMAGE"
-                    or img.image is None or img.inputs["Vector"].is_linked or src.inputs["Strength"].is_linked):
-                return False
-            nmap = (src, img)
-        if bump is not None and not self._bump(material, bump, row):
-            return False
-        if nmap is not None:
-            src, img = nmap
-            if src.uv_map:
-                self._warn(material, f"'{src.name}' names UV map '{src.uv_map}'; the render UV map is used")
-            row["normal_tex"] = self._texture(material, img.image, closest=img.interpolation == "Closest")
-            row["normal_strength"] = self._float_input(material, src.inputs["Strength"])
-        return True
-
-    def _bump(self, material, node, row: dict) -> bool:
-        """A Bump node with an Image Texture on Height (Color as luminance, or Alpha) -> row fields; False when
-        its height is anything else or its inputs are linked."""
-        height = node.inputs["Height"]
-        link = height.links[0] if height.is_linked else None
-        img = link.from_node if link is not None else None
-        if img is None or img.type != "TEX_IMAGE" or img.image is None:
-            return False
-        if node.inputs["Strength"].is_linked or node.inputs["Distance"].is_linked:
-            return False
-        sign = -1.0 if getattr(node, "invert", False) else 1.0
-        alpha = link.from_socket.name == "Alpha"
-        row["bump_tex"] = self._texture(material, img.image, alpha=alpha, luminance=not alpha,
-                                        closest=img.interpolation == "Closest")
-        row["bump_strength"] = max(0.0, self._float_input(material, node.inputs["Strength"]))
-        row["bump_distance"] = sign * self._float_input(material, node.inputs["Distance"])
-        return True
-
     def _alpha(self, material, socket, row: dict, g: GraphCompiler, varying: dict) -> None:
         """Principled Alpha: constant, a plain Image Texture's Alpha (or Color, as luminance) -> row alpha fields;
         any other graph -> the node program's "alpha" (clamped to [0, 1] as Cycles clamps it)."""

@@ -162,7 +162,7 @@ def test_tables_agree_with_cycles_published_values():
 
 def test_exact_fresnel():
     """The split dielectric Fresnel equals the mean of the s and p reflectances."""
-    from restir_engine.core.materials.bsdf import fresnel_exact
+    from restir_engine.core.materials.microfacet import fresnel_exact
     c = np.linspace(0.01, 1, 50).astype(np.float32)
     for eta in (1.2, 1.5, 2.0):
         st = np.sqrt(1 - c * c) / eta

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..sampling import dot, orthonormal_basis
-from .bsdf import fresnel_exact, ggx_normals
+from .microfacet import fresnel_exact, ggx_normals
 from .microfacet_tables import glass_albedo_at, smith_lambda
 
 DELTA_PDF = np.float32(1e15)  # "pdf" of a delta direction: power_heuristic(DELTA_PDF, any light pdf) = 1

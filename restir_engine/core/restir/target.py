@@ -34,7 +34,8 @@ import numpy as np
 from ..lights.table import spot_factor
 from ..lights.tiles import PackedPoints, light_points
 from ..materials.anisotropy import AnisoWorld
-from ..materials.bsdf import fresnel_exact, half_vector_terms, view_terms
+from ..materials.bsdf import view_terms
+from ..materials.microfacet import fresnel_exact, half_vector_terms
 from ..materials.sheen import albedo
 from ..parallel.pool import in_worker, pool
 from ..sampling import to_world
