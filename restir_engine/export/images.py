@@ -7,6 +7,8 @@ import stat
 
 import numpy as np
 
+from ..core.materials.textures import texture_bytes
+
 
 def srgb_to_linear(c: np.ndarray) -> np.ndarray:
     return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
@@ -48,10 +50,10 @@ class TextureCache:
         return self.items[key]
 
     def put(self, key, data: np.ndarray) -> None:
-        if key is None or data.nbytes > self.max_bytes:
+        if key is None or texture_bytes(data) > self.max_bytes:
             return
         self.items[key] = data
-        while sum(a.nbytes for a in self.items.values()) > self.max_bytes:
+        while sum(texture_bytes(a) for a in self.items.values()) > self.max_bytes:
             del self.items[next(iter(self.items))]
 
 

@@ -43,15 +43,14 @@ class NormalReader:
             col = src.inputs.get("Color") if src.type == "NORMAL_MAP" else None
             img = col.links[0].from_node if col is not None and col.is_linked else None
             if (src.type != "NORMAL_MAP" or src.space != "TANGENT" or img is None or img.type != "TEX_IMAGE"
-                    or img.image is None or img.inputs["Vector"].is_linked or src.inputs["Strength"].is_linked):
+                    or img.image is None or img.inputs["Vector"].is_linked or src.inputs["Strength"].is_linked
+                    or src.uv_map):  # a named UV map's tangents: the node program reads them
                 return False
             nmap = (src, img)
         if bump is not None and not self._bump(material, bump, row):
             return False
         if nmap is not None:
             src, img = nmap
-            if src.uv_map:
-                self._warn(material, f"'{src.name}' names UV map '{src.uv_map}'; the render UV map is used")
             row["normal_tex"] = self._texture(material, img.image, closest=img.interpolation == "Closest")
             row["normal_strength"] = self._float_input(material, src.inputs["Strength"])
         return True

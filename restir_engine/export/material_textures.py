@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.materials.textures import NearestImage
+from ..core.materials.textures import NearestImage, UdimImage
 from .images import TEXTURES, srgb_bytes_to_linear, unreadable_file
+from .udim import read_tile, tile_path, unreadable_set
 
 MAGENTA = (1.0, 0.0, 1.0)
 
@@ -57,8 +58,11 @@ class TextureReader:
         if key in self.texture_index:
             return self.texture_index[key]
         if getattr(image, "source", "FILE") == "TILED" and len(getattr(image, "tiles", ())) > 1:
-            self._warn(material, f"image '{image.name}' has UDIM tiles, which are not supported: its first tile "
-                       "is repeated over every tile")
+            data = self._read_udim(material, image, alpha, luminance, closest)
+            if data is not None:
+                self.texture_index[key] = len(self.textures)
+                self.textures.append(data)
+                return self.texture_index[key]
         kept = TEXTURES.key(image, key)
         data = TEXTURES.get(kept)
         if data is None:
@@ -67,6 +71,35 @@ class TextureReader:
         self.texture_index[key] = len(self.textures)
         self.textures.append(data.view(NearestImage) if closest else data)
         return self.texture_index[key]
+
+    def _read_udim(self, material, image, alpha: bool, luminance: bool, closest: bool) -> UdimImage | None:
+        """A UDIM set's tiles as one :class:`UdimImage` (a tile whose file is missing or unreadable: magenta, as
+        Cycles shows it), or None (warned) where the tiles cannot be read one by one."""
+        import bpy
+        why = unreadable_set(image)
+        if why:
+            self._warn(material, f"image '{image.name}' has UDIM tiles, which cannot be read here ({why}): its "
+                       "first tile is repeated over every tile")
+            return None
+        base = bpy.path.abspath(image.filepath, library=image.library)
+        kept = _udim_key(image, base, (alpha, luminance, closest))
+        cached = TEXTURES.get(kept)
+        if cached is not None:
+            return cached
+        tiles = []
+        for tile in image.tiles:
+            path = tile_path(base, int(tile.number))
+            got = read_tile(path, image.colorspace_settings.name)
+            if got is None:
+                self._warn(material, f"image '{image.name}': tile {tile.number} ('{path}') could not be read; "
+                           "rendered magenta")
+                data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+            else:
+                data = self._converted(material, image, got[0], alpha, luminance, got[1])
+            tiles.append((int(tile.number), data.view(NearestImage) if closest else data))
+        out = UdimImage(tiles)
+        TEXTURES.put(kept, out)
+        return out
 
     def _read_texture(self, material, image, alpha: bool, luminance: bool) -> np.ndarray:
         """The image's pixels as (h, w, 3) float32, scene-linear (magenta where it cannot be read)."""
@@ -85,24 +118,45 @@ class TextureReader:
             except (RuntimeError, ValueError):
                 data = None
         if unreadable:
-            data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
-        elif data is None or data.size == 0:
+            return np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+        if data is None or data.size == 0:
             self._warn(material, f"image '{image.name}' could not be loaded; rendered magenta")
-            data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
-        elif alpha:
+            return np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+        return self._converted(material, image, data, alpha, luminance, image.is_float)
+
+    def _converted(self, material, image, data: np.ndarray, alpha: bool, luminance: bool, is_float: bool
+                   ) -> np.ndarray:
+        """(h, w, c) pixels in [0, 1] of ``image``'s colour space (float images: as stored) -> (h, w, 3) float32
+        scene-linear RGB, or the alpha / luminance replicated to three channels."""
+        if alpha:
             a = data[..., 3:4] if data.shape[2] == 4 else np.ones(data.shape[:2] + (1,), np.float32)
             data = np.ascontiguousarray(np.repeat(a, 3, axis=2), dtype=np.float32)
         else:
             ch = data.shape[2]
             rgb = data[..., :3] if ch >= 3 else np.repeat(data[..., :1], 3, axis=2)
             space = image.colorspace_settings.name
-            if not image.is_float and space in {"sRGB", "sRGB EOTF"}:
+            if not is_float and space in {"sRGB", "sRGB EOTF"}:
                 rgb = srgb_bytes_to_linear(rgb)
             elif space not in {"sRGB", "sRGB EOTF", "Linear Rec.709", "Linear", "Non-Color", "Raw", "Linear CIE-XYZ E"} \
-                    and not image.is_float:
+                    and not is_float:
                 self._warn(material, f"image '{image.name}' colour space '{space}' treated as sRGB")
                 rgb = srgb_bytes_to_linear(rgb)
             if luminance:  # Blender's implicit colour -> float conversion
                 rgb = np.repeat((rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32))[..., None], 3, axis=2)
             data = np.ascontiguousarray(rgb, dtype=np.float32)
         return data
+
+
+def _udim_key(image, base: str, use: tuple):
+    """The texture cache's key of a UDIM set's tiles (their files' paths, modification times and sizes), or None
+    (not cached) where a tile's file is missing."""
+    import os
+    files = []
+    for tile in image.tiles:
+        path = tile_path(base, int(tile.number))
+        try:
+            st = os.stat(path)
+        except OSError:
+            return None
+        files.append((path, st.st_mtime_ns, st.st_size))
+    return ("udim", tuple(files), image.colorspace_settings.name, image.alpha_mode, use)

@@ -74,7 +74,10 @@ def _read_mesh(mesh, want_uv: bool, want_tangents: bool = False, warnings: list 
                 warnings.append(f"Mesh '{mesh.name}': no tangents for its normal map ({e}); rendered without it")
     attrs = {}
     for name in attributes:
-        got = _read_attribute(mesh, name, vidx, loops, nt)
+        if name.startswith(TANGENT_PREFIX):
+            got = _read_tangents(mesh, name[len(TANGENT_PREFIX):], loops, nt)
+        else:
+            got = _read_attribute(mesh, name, vidx, loops, nt)
         if got is not None:
             attrs[name] = got
     local = co.reshape(-1, 3)
@@ -103,6 +106,26 @@ def _texspace(mesh, local: np.ndarray) -> tuple:
         loc, half = np.array(mesh.texspace_location[:], np.float64), np.array(mesh.texspace_size[:], np.float64)
     half = np.where(half == 0, 1.0, np.where(np.abs(half) < 1e-5, np.copysign(1e-5, half), half))
     return (loc - half).astype(np.float32), (2 * half).astype(np.float32)
+
+
+TANGENT_PREFIX = "tangent@"  # attribute "tangent@<UV map>": that map's MikkTSpace tangents and bitangent signs
+
+
+def _read_tangents(mesh, uv_map: str, loops, nt: int):
+    """(t, 3, 4) object-space MikkTSpace tangents (xyz) and bitangent signs (w) of the UV map ``uv_map`` at each
+    triangle's corners (a Normal Map node naming that map); None when the mesh has no such map or Blender cannot
+    compute them (n-gons)."""
+    if mesh.uv_layers.get(uv_map) is None:
+        return None
+    try:
+        mesh.calc_tangents(uvmap=uv_map)
+    except RuntimeError:
+        return None
+    tl = np.empty(len(mesh.loops) * 3, np.float32)
+    mesh.loops.foreach_get("tangent", tl)
+    sign = np.empty(len(mesh.loops), np.float32)
+    mesh.loops.foreach_get("bitangent_sign", sign)
+    return np.concatenate([tl.reshape(-1, 3), sign[:, None]], axis=1)[loops].reshape(nt, 3, 4)
 
 
 def _read_attribute(mesh, name: str, vidx, loops, nt: int):
@@ -304,8 +327,9 @@ def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None
 
 
 def _placed(arrays: dict, m: np.ndarray) -> tuple:
-    """(verts (n, 3, 3), normals (n, 3, 3), tangents (n, 3, 4) or None) of a mesh's local arrays placed by the world
-    matrix ``m`` (float32 results of float64 arithmetic; normals by the inverse transpose, unit length)."""
+    """(verts (n, 3, 3), normals (n, 3, 3), tangents (n, 3, 4) or None, the named UV maps' tangent attributes
+    {name: (n, 3, 4)}) of a mesh's local arrays placed by the world matrix ``m`` (float32 results of float64
+    arithmetic; normals by the inverse transpose, unit length; tangents by the linear part)."""
     n = len(arrays["verts"])
     lin = m[:3, :3]
     verts = (arrays["verts"].reshape(-1, 3) @ lin.T + m[:3, 3]).reshape(n, 3, 3).astype(np.float32)
@@ -316,15 +340,22 @@ def _placed(arrays: dict, m: np.ndarray) -> tuple:
     nn = arrays["normals"].reshape(-1, 3) @ nm.T
     nn /= np.maximum(np.linalg.norm(nn, axis=1), 1e-30)[:, None]
     normals = nn.reshape(n, 3, 3).astype(np.float32)
-    tangents = None
-    if arrays["tangents"] is not None:
-        tangents = np.empty((n, 3, 4), np.float32)
-        tw = arrays["tangents"][..., :3].reshape(-1, 3) @ lin.T   # surface vectors move with the linear part
-        tw /= np.maximum(np.linalg.norm(tw, axis=1), 1e-30)[:, None]
-        tangents[:, :, :3] = tw.reshape(n, 3, 3)
-        # a mirroring transform flips the bitangent (the normal is transformed, the frame's handedness not)
-        tangents[:, :, 3] = arrays["tangents"][..., 3] * np.sign(np.linalg.det(lin) or 1.0)
-    return verts, normals, tangents
+    tangents = None if arrays["tangents"] is None else _placed_tangents(arrays["tangents"], lin)
+    named = {a: _placed_tangents(v, lin) for a, v in arrays.get("attributes", {}).items()
+             if a.startswith(TANGENT_PREFIX)}
+    return verts, normals, tangents, named
+
+
+def _placed_tangents(local: np.ndarray, lin: np.ndarray) -> np.ndarray:
+    """(n, 3, 4) tangents and bitangent signs in object space -> world space by the linear part ``lin``."""
+    n = len(local)
+    out = np.empty((n, 3, 4), np.float32)
+    tw = local[..., :3].reshape(-1, 3) @ lin.T   # surface vectors move with the linear part
+    tw /= np.maximum(np.linalg.norm(tw, axis=1), 1e-30)[:, None]
+    out[:, :, :3] = tw.reshape(n, 3, 3)
+    # a mirroring transform flips the bitangent (the normal is transformed, the frame's handedness not)
+    out[:, :, 3] = local[..., 3] * np.sign(np.linalg.det(lin) or 1.0)
+    return out
 
 
 def _usable(verts: np.ndarray) -> tuple:
@@ -352,9 +383,13 @@ def _retransformed(blocks, last, stats: dict, registry):
     post = np.cumsum(kept) - 1  # each triangle's row after the unusable ones were dropped
     verts, normals = last.verts.copy(), last.normals.copy()
     tangents = None if last.tangents is None else last.tangents.copy()
+    attributes = dict(last.attributes or {})
+    named = [a for a in attributes if a.startswith(TANGENT_PREFIX)]
+    for a in named:  # the named UV maps' tangents move with their instances (colours do not)
+        attributes[a] = attributes[a].copy()
     for k in changed:  # the moved instances, each vectorized over its triangles
         s, e = int(starts[k]), int(starts[k + 1])
-        v, nrm, tan = _placed(blocks[k][0], blocks[k][1])
+        v, nrm, tan, placed = _placed(blocks[k][0], blocks[k][1])
         _finite, keep = _usable(v)
         if not np.array_equal(keep, kept[s:e]):
             return None
@@ -365,8 +400,10 @@ def _retransformed(blocks, last, stats: dict, registry):
         normals[rows] = nrm
         if tangents is not None and tan is not None:
             tangents[rows] = tan[keep]
+        for a, vals in placed.items():
+            attributes[a][rows] = vals[keep]
     geometry = dataclasses.replace(last, verts=verts, normals=normals, tangents=tangents,
-                                   objects=_object_table(blocks))
+                                   objects=_object_table(blocks), attributes=attributes or last.attributes)
     return geometry, dict(stats, instance_matrices=mats)
 
 
@@ -390,7 +427,7 @@ def _assemble(blocks, reads: int, slots_seen: list, registry, warnings: list) ->
     at = 0
     for k, (arrays, m, slot_map, _name, _key, _info) in enumerate(blocks):  # per instance, vectorized over triangles
         n = len(arrays["verts"])
-        v, nrm, tan = _placed(arrays, m)
+        v, nrm, tan, placed = _placed(arrays, m)
         verts[at:at + n] = v
         normals[at:at + n] = nrm
         material[at:at + n] = slot_map[np.clip(arrays["slot"], 0, len(slot_map) - 1)]
@@ -398,7 +435,7 @@ def _assemble(blocks, reads: int, slots_seen: list, registry, warnings: list) ->
         if uvs is not None and arrays["uvs"] is not None:
             uvs[at:at + n] = arrays["uvs"]
         for a, vals in arrays.get("attributes", {}).items():
-            attributes[a][at:at + n] = vals
+            attributes[a][at:at + n] = placed.get(a, vals)
         if local_verts is not None:
             local_verts[at:at + n] = arrays["verts"]
         if tangents is not None and tan is not None:

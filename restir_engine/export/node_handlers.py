@@ -368,13 +368,16 @@ def _normal_map(g, node, f):
     space = node.space
     color = g.inp(node, "Color", "color", f)
     strength = g.inp(node, "Strength", "float", f)
+    params = {"space": space}
     if space == "TANGENT":
-        if node.uv_map:
-            g.warn(f"'{node.name}' names UV map '{node.uv_map}'; the render UV map's tangents are used")
         g.attribute("tangent_uv", "vector")  # (read by the operation; named so that the export makes tangents)
+        if node.uv_map:  # that map's tangents, where a mesh has it (export/meshes.py reads them as an attribute)
+            params["uv_map"] = node.uv_map
+            g.attribute(f"attr:tangent@{node.uv_map}", "vector")
+            g.attribute(f"attr_alpha:tangent@{node.uv_map}", "float")
     for name in ("normal", "backfacing"):
         g.attribute(name, "vector" if name == "normal" else "float")
-    return {"Normal": g.emit("normal_map", {"space": space}, [strength, color], ("vector",))[0]}
+    return {"Normal": g.emit("normal_map", params, [strength, color], ("vector",))[0]}
 
 
 def _bump(g, node, f):

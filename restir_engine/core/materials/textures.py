@@ -1,5 +1,5 @@
 """Texture lookups (repeat wrap), vectorized over hits: bilinear, or nearest for images marked
-:class:`NearestImage` (an Image Texture node's "Closest" interpolation).
+:class:`NearestImage` (an Image Texture node's "Closest" interpolation); UDIM sets (:class:`UdimImage`) per tile.
 
 Images are (h, w, 3) float32 scene-linear, row 0 at the bottom as Blender stores them,
 so uv (0, 0) is the bottom-left corner and texel (i, j) is centred at ((j+0.5)/w, (i+0.5)/h).
@@ -9,12 +9,59 @@ from __future__ import annotations
 import numpy as np
 
 
+MISSING_TILE = (1.0, 0.0, 1.0)  # the colour Cycles gives UVs outside every tile of a UDIM set (magenta)
+
+
 class NearestImage(np.ndarray):
     """An image sampled with nearest-texel lookups (``array.view(NearestImage)``)."""
 
 
+class UdimImage(np.ndarray):
+    """A UDIM image set: ``tiles`` ((number, (h, w, c) image) per tile; each tile an ordinary image, a NearestImage
+    where sampled so). The array itself is the first tile, what code that knows no tiles reads (its size).
+
+    As Cycles maps UVs to tiles: tile 1001 + 10 int(v) + int(u) (int: truncated toward zero; columns 0-9), sampled at
+    (u - int(u), v - int(v)); a UV on no tile of the set reads :data:`MISSING_TILE`."""
+
+    def __new__(cls, tiles):
+        tiles = tuple((int(n), t) for n, t in tiles)
+        obj = np.asarray(tiles[0][1]).view(cls)
+        obj.tiles = tiles
+        return obj
+
+    def __array_finalize__(self, obj):
+        self.tiles = getattr(obj, "tiles", ())
+
+    def __reduce__(self):
+        return (_udim_image, (self.tiles,))
+
+
+def _udim_image(tiles):
+    return UdimImage(tiles)
+
+
+def per_tile(image: UdimImage, u: np.ndarray, v: np.ndarray, lookup, channels: int, missing=MISSING_TILE
+             ) -> np.ndarray:
+    """(n, channels) float32: ``lookup(tile, u_tile, v_tile)`` of the tile each (u, v) falls on (see UdimImage),
+    ``missing`` where it falls on none."""
+    u = np.where(np.isfinite(u), u, 0.0)
+    v = np.where(np.isfinite(v), v, 0.0)
+    tu, tv = np.trunc(u), np.trunc(v)
+    number = np.where((tu >= 0) & (tv >= 0) & (tu < 10), 1001 + 10 * tv + tu, -1).astype(np.int64)
+    out = np.empty((len(u), channels), np.float32)
+    out[:] = np.asarray(missing, np.float32)[:channels]
+    for n, tile in image.tiles:
+        sel = np.flatnonzero(number == n)
+        if sel.size:
+            out[sel] = lookup(tile, u[sel] - tu[sel], v[sel] - tv[sel])
+    return out
+
+
 def sample(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     """(n, 3) texels of ``image`` at ``uv`` (n, 2), by the image's interpolation."""
+    if isinstance(image, UdimImage):
+        return per_tile(image, uv[:, 0], uv[:, 1], lambda t, u, v: sample(t, np.stack([u, v], axis=1)),
+                        image.shape[2])
     if isinstance(image, NearestImage):
         return sample_nearest(np.asarray(image), uv)
     return sample_bilinear(image, uv)
@@ -55,6 +102,9 @@ def sample_bilinear(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
 def gradient(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     """(n, 2) derivatives d/du, d/dv of the first channel of ``image`` as :func:`sample` interpolates it at ``uv``
     (bilinear: the exact derivative inside the texel cell; nearest: zero, the image being constant there)."""
+    if isinstance(image, UdimImage):
+        return per_tile(image, uv[:, 0], uv[:, 1], lambda t, u, v: gradient(t, np.stack([u, v], axis=1)), 2,
+                        (0.0, 0.0))
     if isinstance(image, NearestImage):
         return np.zeros((len(uv), 2), np.float32)
     h, w = image.shape[:2]
@@ -79,4 +129,14 @@ def apply_texture(values: np.ndarray, tex_index: np.ndarray, uv: np.ndarray | No
 
 
 def mean_color(image: np.ndarray) -> np.ndarray:
-    return image.reshape(-1, image.shape[-1]).mean(axis=0).astype(np.float32)
+    """The mean texel (c,) over the image's UV area (a UDIM set: each tile's mean, equally weighted)."""
+    if isinstance(image, UdimImage):
+        return np.mean([mean_color(np.asarray(t)) for _n, t in image.tiles], axis=0).astype(np.float32)
+    return np.asarray(image).reshape(-1, image.shape[-1]).mean(axis=0).astype(np.float32)
+
+
+def texture_bytes(image: np.ndarray) -> int:
+    """Bytes an image holds (every tile of a UDIM set)."""
+    if isinstance(image, UdimImage):
+        return sum(np.asarray(t).nbytes for _n, t in image.tiles)
+    return image.nbytes

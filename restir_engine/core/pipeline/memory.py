@@ -12,6 +12,7 @@ import os
 from dataclasses import dataclass
 
 from ..integrators.trace_context import may_be_anisotropic
+from ..materials.textures import texture_bytes
 from ..modes import DirectMethod, IndirectMethod, Integrator
 from ..restir import target
 from . import methods
@@ -138,7 +139,7 @@ def scene_size(scene) -> int:
     g = scene.geometry
     arrays = sum(a.nbytes for a in (g.verts, g.normals, g.material, g.uvs, getattr(g, "instance", None),
                                     getattr(g, "tangents", None)) if a is not None)
-    textures = sum(t.nbytes for t in scene.materials.textures)
+    textures = sum(texture_bytes(t) for t in scene.materials.textures)
     world = scene.world_image.nbytes if scene.world_image is not None else 0
     return int(arrays + textures + world + BVH_PER_TRIANGLE * len(g.verts))
 

@@ -22,14 +22,16 @@ def _unit_or(v, fallback):
 def normal_map(attrs, params, strength, color):
     """Normal Map node: the colour c as the normal 2c - 1 in the node's space. Tangent space: along the UV
     tangent T, B = sign · N x T and the interpolated normal N, the strength s scaling the tangent part
-    (xy · s, z → mix(1, z, s)); other spaces: mixed with the normal by s. Turned to face the viewer."""
+    (xy · s, z → mix(1, z, s)); T and its sign from the node's UV map (``params["uv_map"]``: the attribute
+    "tangent@<map>", where the hit's mesh has that map) or the render UV map; other spaces: mixed with the normal
+    by s. Turned to face the viewer."""
     n = attrs.get("normal")
     s = f32(strength)
     c = f32(color) * _F(2) - _F(1)
     c = np.broadcast_to(c, n.shape).astype(np.float32)
     space = params.get("space", "TANGENT")
     if space == "TANGENT":
-        tangent, sign = attrs.get("tangent_uv"), attrs.get("tangent_sign")
+        tangent, sign, has = _uv_tangent(attrs, params.get("uv_map"))
         if tangent is None:
             return n
         back = attrs.get("backfacing") > 0
@@ -38,6 +40,8 @@ def normal_map(attrs, params, strength, color):
         z = _F(1) + (c[2] - _F(1)) * np.clip(s, 0, 1)
         b = _cross(raw_n, tangent) * sign
         out = _unit_or(x * tangent + y * b + z * raw_n, raw_n)
+        if has is not None:  # hits on meshes without the named map keep their normal (as Cycles)
+            out = np.where(has, out, raw_n)
         return np.where(back, -out, out).astype(np.float32)
     if space in {"BLENDER_OBJECT", "BLENDER_WORLD"}:
         c = np.stack([c[0], -c[1], -c[2]])
@@ -47,6 +51,22 @@ def normal_map(attrs, params, strength, color):
     out = np.where(attrs.get("backfacing") > 0, -out, out)
     mixed = _unit_or(n + (out - n) * np.maximum(s, 0), n)
     return mixed
+
+
+def _uv_tangent(attrs, uv_map):
+    """(tangent (3, n), bitangent sign (n,), where the tangent exists (n,) bool or None for everywhere): of the UV
+    map ``uv_map`` where it is given (a hit whose mesh lacks that map has none), else of the render UV map;
+    (None, None, None) where no hit has one."""
+    if not uv_map:
+        return attrs.get("tangent_uv"), attrs.get("tangent_sign"), None
+    named = attrs.get(f"attr:tangent@{uv_map}")
+    length = np.sqrt(_dot(named, named))
+    has = length > _F(1e-12)
+    if not has.any():
+        return None, None, None
+    named = (named / np.maximum(length, _F(1e-30))).astype(np.float32)
+    sign = np.where(attrs.get(f"attr_alpha:tangent@{uv_map}") < 0, _F(-1), _F(1)).astype(np.float32)
+    return named, sign, has
 
 
 def bump(attrs, params, strength, distance, normal):

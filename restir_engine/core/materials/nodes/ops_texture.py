@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import noise
+from ..textures import UdimImage, per_tile
 from .hashing import hash_floats, hash_floats_to_color
 from .ops_math import _dot, _normalize, f32, safe_div
 
@@ -168,7 +169,11 @@ def _bspline(t):
 
 
 def sample_image(image: np.ndarray, u, v, interpolation: str, extension: str) -> np.ndarray:
-    """(n, c) texels of an (h, w, c) image (row 0 at the bottom) at texture coordinates (u, v) (n,) each."""
+    """(n, c) texels of an (h, w, c) image (row 0 at the bottom) at texture coordinates (u, v) (n,) each; a UDIM set
+    (textures.UdimImage) per tile, each tile with ``extension``."""
+    if isinstance(image, UdimImage):
+        return per_tile(image, np.asarray(u, np.float64), np.asarray(v, np.float64),
+                        lambda t, tu, tv: sample_image(np.asarray(t), tu, tv, interpolation, extension), image.shape[2])
     h, w = image.shape[:2]
     u = np.where(np.isfinite(u), u, 0).astype(np.float64)
     v = np.where(np.isfinite(v), v, 0).astype(np.float64)
