@@ -16,7 +16,8 @@ from restir_engine.core.renderer import FrameRenderer, RenderSettings, render_fr
 from restir_engine.engine import settings_from_scene
 from restir_engine.export import export_scene
 from restir_engine.export.incremental import SceneExporter, update_level
-from restir_engine.viewport import ViewportSession, m_colour, pass_image, ucw_colour, view_camera
+from restir_engine.viewport import ViewportSession, view_camera
+from restir_engine.viewport_passes import m_colour, pass_image, ucw_colour
 
 
 class FakeRegionData:

@@ -162,9 +162,8 @@ class Team:
 
     def kept(self) -> None:
         """The first pass's buffers are now a temporal history, held until ``keep`` newer ones are kept."""
-        self._held = [i for i in self._held if i != self._first_slot][-(max(1, self.keep) - 1):] \
-            if self.keep > 1 else []
-        self._held.append(self._first_slot)
+        self._held = [i for i in self._held if i != self._first_slot] + [self._first_slot]
+        del self._held[:-max(1, self.keep)]
 
     def _measured(self, chunks: int):
         c = self.costs

@@ -9,7 +9,8 @@ from ..parallel.pool import thread_count
 from ..parallel.tasks import spans
 from ..restir.history import TemporalHistory
 from ..scene import Scene
-from .frame import Cancelled, FrameRenderer, FrameResult, frame_stats
+from .frame import Cancelled, FrameRenderer, FrameResult
+from .frame_stats import frame_stats
 from .settings import RenderSettings
 
 

@@ -133,7 +133,7 @@ class _Worker:
         return batch, fr.converged, fr.batch_size(ANY_BATCH)
 
     def finish(self, token: int):
-        from .frame import frame_stats
+        from .frame_stats import frame_stats
         fr = self.fr
         out = None
         if self.team.leader:
