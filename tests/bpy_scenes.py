@@ -432,6 +432,50 @@ def alpha_scene(size=(96, 64)):
     return scene
 
 
+def tinted_scene(size=(96, 64)):
+    """Coloured transparency: a plane of a red Transparent BSDF alone, and a plane mixing a Diffuse (0.4) with a
+    Transparent BSDF whose Color is a blue-to-yellow gradient along the plane (a per-hit tint), standing on a floor
+    in front of a light wall; an area light above and in front throws their coloured shadows on the floor, and the
+    camera sees the wall through them."""
+    scene = reset()
+    plane("Floor", 8, (0, 0, 0), material=diffuse("Floor", (0.7, 0.7, 0.7)))
+    plane("Wall", 8, (0, 2, 2), (math.pi / 2, 0, 0), material=diffuse("Wall", (0.8, 0.8, 0.7)))
+    red = bpy.data.materials.new("RedFilm")
+    enable_nodes(red)
+    tree = red.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    film = tree.nodes.new("ShaderNodeBsdfTransparent")
+    film.inputs["Color"].default_value = (0.9, 0.25, 0.15, 1)
+    tree.links.new(film.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    plane("RedFilm", 1.6, (-1.0, 0.5, 0.9), (math.pi / 2, 0, 0.3), material=red)
+    glaze = bpy.data.materials.new("Glaze")
+    enable_nodes(glaze)
+    tree = glaze.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = 0.4
+    clear = tree.nodes.new("ShaderNodeBsdfTransparent")
+    coord = tree.nodes.new("ShaderNodeTexCoord")
+    grad = tree.nodes.new("ShaderNodeTexGradient")
+    ramp = tree.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = (0.15, 0.35, 0.95, 1)
+    ramp.color_ramp.elements[1].color = (0.95, 0.85, 0.1, 1)
+    tree.links.new(coord.outputs["UV"], grad.inputs["Vector"])
+    tree.links.new(grad.outputs["Fac"], ramp.inputs["Fac"])
+    tree.links.new(ramp.outputs["Color"], clear.inputs["Color"])
+    green = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    green.inputs["Color"].default_value = (0.3, 0.7, 0.3, 1)
+    tree.links.new(clear.outputs[0], mix.inputs[1])
+    tree.links.new(green.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    _with_uvs(plane("Glaze", 1.6, (1.0, 0.5, 0.9), (math.pi / 2, 0, -0.3), material=glaze))
+    light("AREA", (0, -1.5, 3.5), (math.radians(35), 0, 0), energy=500.0, size=1.5)
+    camera((0, -4, 1.0), (math.radians(90), 0, 0), lens=30)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene
+
+
 def sky_image(name="Sky", h=64, w=128, sun=(0.0, 40.0)):
     """An equirectangular float image: a dim blue sky, dark ground and a small bright sun at (azimuth, elevation)
     degrees (Blender's Environment Texture convention: u = 1/2 - atan2(y, x)/2π, v = 1 - θ/π), packed."""

@@ -133,6 +133,8 @@ class MaterialTable:
     alpha_sign  (m,)    +1: alpha x t, -1: alpha x (1 - t)
     transparent_shadow (m,) bool  shadow rays pass the cut-out's transparent points (Material > Settings >
                         Transparent Shadows); off: the surface shadows as if opaque
+    transparent_tint (m, 3) the colour a ray keeps where it passes a cut-out's transparent point (a Transparent BSDF's
+                        Color; white for Principled Alpha); the node program's "transparent_tint" replaces it per hit
     alpha_program (m,) bool  the node program's "alpha" field (0..1, per hit) further scales alpha (an Alpha or a
                         Transparent BSDF's Mix factor from any node graph)
     program     (m,) int32  index into ``programs`` of the material's node program (-1 = none): fields that vary
@@ -175,6 +177,7 @@ class MaterialTable:
     alpha_sign: np.ndarray = None
     alpha_program: np.ndarray = None
     transparent_shadow: np.ndarray = None
+    transparent_tint: np.ndarray = None
     mix_normalize: np.ndarray = None
     mix_first: np.ndarray = None
     mix_count: np.ndarray = None
@@ -215,6 +218,7 @@ class MaterialTable:
             alpha=col("alpha", 1.0), alpha_tex=col("alpha_tex", -1, np.int32), alpha_sign=col("alpha_sign", 1.0),
             alpha_program=col("alpha_program", False, bool),
             transparent_shadow=col("transparent_shadow", True, bool),
+            transparent_tint=col("transparent_tint", (1.0, 1.0, 1.0)),
             mix_normalize=col("mix_normalize", False, bool),
             normal_tex=col("normal_tex", -1, np.int32), normal_strength=col("normal_strength", 1.0),
             bump_tex=col("bump_tex", -1, np.int32), bump_strength=col("bump_strength", 1.0),

@@ -267,11 +267,12 @@ class MaterialRegistry(MixShaderReader, NormalReader, TextureReader):
                     "glass_beckmann": float(getattr(node, "distribution", "GGX") == "BECKMANN")}
         if t == "HOLDOUT":
             return dict(HOLDOUT_ROW)
-        if t == "BSDF_TRANSPARENT":
-            c = self._color_input(material, node.inputs["Color"], None, {}, (1, 1, 1))
-            if min(c) < 0.999:
-                self._warn(material, "a coloured Transparent BSDF is approximated by a white one (a cut-out)")
-            return {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transparent": True, "alpha": 0.0}
+        if t == "BSDF_TRANSPARENT":  # a cut-out everywhere; rays through it keep its Color
+            g, varying = self._compiler(material), {}
+            tint = self._param(material, g, node.inputs["Color"], "color", "transparent_tint", varying)
+            row = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0, "transparent": True, "alpha": 0.0,
+                   "transparent_tint": tuple(float(max(c, 0.0)) for c in tint)}
+            return self._with_program(row, g, varying)
         if t == "BSDF_DIFFUSE":
             row = {"f0": 0.0, "metallic": 0.0}
             g, varying = self._compiler(material), {}

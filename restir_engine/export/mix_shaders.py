@@ -31,6 +31,8 @@ class MixShaderReader:
         comps, emission, emit_tex = [], np.zeros(3, np.float32), -1
         out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
         clear = [p for p in parts if p[0].get("transparent")]
+        if any(p[0].get("program") is not None for p in clear):  # a transparent colour that varies per hit
+            return self._mix_program(material, node, depth)
         if clear:
             if len(clear) > 1 or node.type == "ADD_SHADER":
                 self._warn(material, "transparency added to other shaders or in several places is approximated")
@@ -68,6 +70,12 @@ class MixShaderReader:
         if see_through > 0:
             out["alpha"] = float(np.clip(out.get("alpha", 1.0) - see_through, 0, 1))
             out["mix_normalize"] = True
+        if clear:  # the colour passed: the transparent leaf's, and white for the leaves' own Alpha
+            w_clear = clear[0][1] * (0.5 if clear[0][2] >= 0 else 1.0)
+            tint = np.asarray(clear[0][0].get("transparent_tint", (1, 1, 1)), np.float64)
+            total = w_clear + see_through
+            if total > 0 and np.any(np.abs(tint - 1) > 1e-6):
+                out["transparent_tint"] = tuple(((w_clear * tint + see_through) / total).tolist())
         out.update(emission=tuple(emission.tolist()), mix=comps)
         if emit_tex >= 0:
             out["emit_tex"] = emit_tex
@@ -130,6 +138,12 @@ class MixShaderReader:
         walk(node, g.constant(1.0, "float"), 0)
         out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
         comps, outputs, emission, clear = [], {}, None, None
+        passed, coloured = None, False  # the colour let through, weighted by each transparent share (clear)
+
+        def pass_colour(colour, share):
+            nonlocal passed
+            c = g.emit("scale", {}, [colour, share], ("color",))[0]
+            passed = c if passed is None else g.emit("add", {}, [passed, c], ("color",))[0]
         for name in order:
             leaf, w = weights[name]
             if leaf.type == "BSDF_PRINCIPLED" and "Alpha" in leaf.inputs:  # its see-through share, per hit
@@ -137,6 +151,7 @@ class MixShaderReader:
                 if a.const is None or a.constant_value() < 1:
                     share = g.emit("multiply", {}, [w, g.emit("one_minus", {}, [a], ("float",))[0]], ("float",))[0]
                     clear = share if clear is None else g.emit("add", {}, [clear, share], ("float",))[0]
+                    pass_colour(g.constant((1.0, 1.0, 1.0), "color"), share)
                     w = g.emit("multiply", {}, [w, a], ("float",))[0]
             sheen = sheen_layer(self, material, g, leaf) if sheen_set(leaf) else None
             coat = coat_factors(g, leaf) if coat_set(leaf) else None
@@ -159,6 +174,9 @@ class MixShaderReader:
                 w = g.emit("multiply", {}, [w, layer], ("float",))[0]
             if row.get("transparent"):  # opacity 1 - w; summed over transparent leaves
                 clear = w if clear is None else g.emit("add", {}, [clear, w], ("float",))[0]
+                colour = g.value(leaf.inputs["Color"], "color")
+                coloured |= colour.const is None or bool(np.any(np.abs(np.asarray(colour.const) - 1) > 1e-6))
+                pass_colour(colour, w)
                 continue
             e = self._leaf_emission(g, leaf)
             if e is not None:
@@ -178,6 +196,12 @@ class MixShaderReader:
                 _add_component(comps, outputs, self.add_row(comp), w)
         if clear is not None:
             _cut_out_share(g, clear, out, outputs, comps)
+            if coloured:  # the colour passed per unit of transparent share
+                tint = g.emit("scale", {}, [passed, g.emit("reciprocal", {}, [clear], ("float",))[0]], ("color",))[0]
+                if tint.const is not None:
+                    out["transparent_tint"] = tuple(float(max(c, 0.0)) for c in tint.constant_value())
+                else:
+                    outputs["transparent_tint"] = tint
         if emission is not None:
             if emission.const is not None:
                 out["emission"] = emission.constant_value()

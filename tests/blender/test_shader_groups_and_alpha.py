@@ -428,3 +428,58 @@ def test_sunlight_through_a_glass_pane(addon):
     expected = 0.8 / math.pi * 0.9216
     se = img.std() / math.sqrt(img.size)
     assert abs(img.mean() - expected) < 5 * se + 0.002 * expected, (img.mean(), expected, se)
+
+
+def _tinted_film(varying: bool):
+    """A Transparent BSDF of Color (0.2, 0.5, 0.9), alone; or (``varying``) mixed half and half with a black
+    Principled BSDF, its Color (x, 1 - x, 0.5) across the plane (Combine Color of a Gradient)."""
+    mat = bpy.data.materials.new("Film")
+    enable_nodes(mat)
+    t = mat.node_tree
+    clear = t.nodes.new("ShaderNodeBsdfTransparent")
+    out = t.nodes["Material Output"].inputs["Surface"]
+    if not varying:
+        t.nodes.remove(t.nodes["Principled BSDF"])
+        clear.inputs["Color"].default_value = (0.2, 0.5, 0.9, 1)
+        t.links.new(clear.outputs[0], out)
+        return mat
+    x = _gradient(t)
+    inv = t.nodes.new("ShaderNodeMath")
+    inv.operation = "SUBTRACT"
+    inv.inputs[0].default_value = 1.0
+    t.links.new(x, inv.inputs[1])
+    rgb = t.nodes.new("ShaderNodeCombineColor")
+    t.links.new(x, rgb.inputs[0])
+    t.links.new(inv.outputs[0], rgb.inputs[1])
+    rgb.inputs[2].default_value = 0.5
+    t.links.new(rgb.outputs[0], clear.inputs["Color"])
+    mix = t.nodes.new("ShaderNodeMixShader")
+    mix.inputs["Fac"].default_value = 0.5
+    t.links.new(_black_principled(t).outputs[0], mix.inputs[1])
+    t.links.new(clear.outputs[0], mix.inputs[2])
+    t.links.new(mix.outputs[0], out)
+    return mat
+
+
+@pytest.mark.parametrize("varying", [False, True])
+def test_a_coloured_transparent_bsdf_tints_what_is_seen_through_it(addon, varying):
+    """The white world seen through a Transparent BSDF takes its Color: alone (every sample passes: exactly the
+    colour), or from a node graph per hit and mixed half with a black surface (per channel and column, mean
+    0.5 x colour(x) within 5 standard errors of the Bernoulli cut-out). Before, the colour was dropped with a
+    warning (white: z of 20-60 in the red and green columns)."""
+    scene = _facing_plane(lambda: _tinted_film(varying))
+    img = render_passes(scene)["Combined"][..., :3]
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    i = sc.materials.names.index("Film")
+    assert not [w for w in sc.warnings if "Transparent" in w]
+    if not varying:
+        np.testing.assert_allclose(img.reshape(-1, 3), np.tile([0.2, 0.5, 0.9], (W * H, 1)), atol=1e-5)
+        np.testing.assert_allclose(sc.materials.transparent_tint[i], (0.2, 0.5, 0.9), atol=1e-6)
+        return
+    assert "transparent_tint" in sc.materials.programs[sc.materials.program[i]].outputs
+    x = (np.arange(W) + 0.5) / W
+    for ch, tint in enumerate((x, 1 - x, np.full_like(x, 0.5))):
+        got = img[..., ch].mean(axis=0)
+        se = np.maximum(tint, 0.05) * np.sqrt(0.25 / (N * H))
+        z = (got - 0.5 * tint) / se
+        assert np.abs(z).max() < 5.0, (ch, np.round(got, 3), np.round(0.5 * tint, 3))

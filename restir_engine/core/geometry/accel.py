@@ -52,20 +52,32 @@ def shadow_rays(p: np.ndarray, ng: np.ndarray, light_pos: np.ndarray, wi: np.nda
 
 
 class Hits:
-    """Closest-hit results, SoA: prim (int32, -1 = miss), t (float32 distance), u, v (barycentrics)."""
+    """Closest-hit results, SoA: prim (int32, -1 = miss), t (float32 distance), u, v (barycentrics); ``tint``
+    (3, n) float32, the product of the transparent tints of the cut-out points each ray passed on its way (None:
+    white for every ray)."""
 
-    __slots__ = ("prim", "t", "u", "v")
+    __slots__ = ("prim", "t", "u", "v", "tint")
 
     def __init__(self, n: int):
         self.prim = np.full(n, -1, dtype=np.int32)
         self.t = np.full(n, np.inf, dtype=np.float32)
         self.u = np.zeros(n, dtype=np.float32)
         self.v = np.zeros(n, dtype=np.float32)
+        self.tint = None
 
     def take(self, rows) -> "Hits":
         out = Hits.__new__(Hits)
         out.prim, out.t, out.u, out.v = self.prim[rows], self.t[rows], self.u[rows], self.v[rows]
+        out.tint = None if self.tint is None else self.tint[:, rows]
         return out
+
+    def put(self, rows, other: "Hits") -> None:
+        """Write ``other`` (len(rows) hits) into rows ``rows``."""
+        self.prim[rows], self.t[rows], self.u[rows], self.v[rows] = other.prim, other.t, other.u, other.v
+        if other.tint is not None:
+            if self.tint is None:
+                self.tint = np.ones((3, len(self.prim)), np.float32)
+            self.tint[:, rows] = other.tint
 
 
 class Accel:
@@ -119,6 +131,11 @@ class Accel:
                                           camera)]
             if go.size == 0:
                 return
+            if self.cutout.tinted:
+                if hits.tint is None:
+                    hits.tint = np.ones((3, len(hits.prim)), np.float32)
+                hits.tint[:, go] *= self.cutout.tint(hits.prim[go], hits.u[go], hits.v[go], cols(d, go), shadow,
+                                                     camera)
             t = hits.t[go]
             dg = cols(d, go)
             p = cols(o, go) + dg * t
@@ -167,6 +184,38 @@ class Accel:
             if rows.size:
                 far = np.ascontiguousarray(tmax, dtype=np.float32)[rows]
                 out[rows] = self.intersect(cols(origins, rows), cols(directions, rows), far, shadow=True).prim >= 0
+        return out
+
+    @property
+    def tinted(self) -> bool:
+        """Whether rays passing cut-out points may change colour (then shadow rays need :meth:`transmittance`)."""
+        return self.cutout is not None and self.cutout.tinted
+
+    def passed(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray):
+        """(the indices of the shadow rays that reach their end, their transmittance (3, k) or None where no cut-out
+        tints light): :meth:`occluded` and :meth:`transmittance` in one, for light to be scaled by what passes."""
+        if not self.tinted:
+            return np.flatnonzero(~self.occluded(origins, directions, tmax)), None
+        tr = self.transmittance(origins, directions, tmax)
+        keep = np.flatnonzero(vmax(tr) > 0)
+        return keep, tr[:, keep]
+
+    def transmittance(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+        """(3, n) float32: the light the segments origin + t*direction, 0 < t < tmax, let through: 0 where
+        something opaque lies on them, else the product of the transparent tints of the cut-out points they pass
+        (1 without any)."""
+        blocked = self._occluded(origins, directions, tmax)
+        out = np.ones((3, len(blocked)), np.float32)
+        rows = np.flatnonzero(blocked)
+        if rows.size:
+            far = np.ascontiguousarray(tmax, dtype=np.float32)[rows]
+            if self.cutout is None:
+                out[:, rows] = 0.0
+                return out
+            hits = self.intersect(cols(origins, rows), cols(directions, rows), far, shadow=True)
+            if hits.tint is not None:
+                out[:, rows] = hits.tint
+            out[:, rows[hits.prim >= 0]] = 0.0
         return out
 
     def _occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:

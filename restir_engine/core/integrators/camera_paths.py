@@ -23,13 +23,16 @@ from .trace_context import TraceContext
 class PrimaryHits:
     """Camera rays through n raster points: emission seen directly (3, n), alpha (n,), the rows that hit
     geometry (k,) and their surfaces (surface.Surface, k); with light groups ``emitted_g`` (G, 3, n), the emission
-    by the group of what emits it (lights/groups.py)."""
+    by the group of what emits it (lights/groups.py). ``tint`` (3, k) or None: the colour the rays to those surfaces
+    kept through coloured transparent surfaces in front (the emission seen already has it; the light the surfaces
+    reflect is to be scaled by it)."""
 
     emitted: np.ndarray
     alpha: np.ndarray
     rows: np.ndarray
     surf: Surface
     emitted_g: np.ndarray = None
+    tint: np.ndarray = None
 
 
 def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray | None = None,
@@ -57,7 +60,7 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
                 if not transparent and ctx.groups.world >= 0:
                     emitted_g[ctx.groups.world] = ctx.world.color[:, None]
                 emitted_g[:, :, idx] = sub.emitted_g
-            return PrimaryHits(emitted, alpha, idx[sub.rows], sub.surf, emitted_g)
+            return PrimaryHits(emitted, alpha, idx[sub.rows], sub.surf, emitted_g, sub.tint)
     cam = ctx.scene.camera
     o, d, tmax = camera_mod.generate_rays(cam, x, y, lens_uv)
     if may_hit is None or may_hit.all():
@@ -66,11 +69,11 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
         hits = Hits(len(x))
         idx = np.flatnonzero(may_hit)
         if idx.size:
-            sub = ctx.geom_accel.intersect(cols(o, idx), cols(d, idx), None if tmax is None else tmax[idx],
-                                           camera=True)
-            hits.prim[idx], hits.t[idx], hits.u[idx], hits.v[idx] = sub.prim, sub.t, sub.u, sub.v
+            hits.put(idx, ctx.geom_accel.intersect(cols(o, idx), cols(d, idx), None if tmax is None else tmax[idx],
+                                                   camera=True))
     emitted, alpha, emitted_g = _seen(ctx, o, d, tmax, hits, lamp_mask=may_see_lamp)
     rows = np.flatnonzero(hits.prim >= 0)
+    tint = None if hits.tint is None else cols(hits.tint, rows)
     surf = Surface(ctx, hits.prim[rows], hits.u[rows], hits.v[rows], cols(o, rows), cols(d, rows), hits.t[rows],
                    camera=True)
     held = holdout_hits(ctx, surf)
@@ -82,7 +85,7 @@ def primary(ctx: TraceContext, x: np.ndarray, y: np.ndarray, may_hit: np.ndarray
         scale = np.ones(len(rows), np.float32)
         scale[held] = 0.0
         surf.params.scale(scale)
-    return PrimaryHits(emitted, alpha, rows, surf, emitted_g)
+    return PrimaryHits(emitted, alpha, rows, surf, emitted_g, tint)
 
 
 def holdout_hits(ctx: TraceContext, surf) -> np.ndarray | None:
@@ -106,6 +109,14 @@ def seen_emission(ctx: TraceContext, x: np.ndarray, y: np.ndarray, lens_uv: np.n
     (extra rays per pixel for pixel coverage)."""
     o, d, tmax = camera_mod.generate_rays(ctx.scene.camera, x, y, lens_uv)
     return _seen(ctx, o, d, tmax, ctx.geom_accel.intersect(o, d, tmax, camera=True))
+
+
+def _tinted(hits, emitted, emitted_g):
+    """The emission rays ``hits`` saw (3, n) (and by light group (G, 3, n) or None) times the colour they kept
+    through the transparent surfaces in front of it."""
+    if hits.tint is None:
+        return emitted, emitted_g
+    return emitted * hits.tint, None if emitted_g is None else emitted_g * hits.tint
 
 
 def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: np.ndarray | None = None):
@@ -159,6 +170,7 @@ def _seen(ctx: TraceContext, o, d, tmax, hits, camera: bool = True, lamp_mask: n
             alpha[dead] = 0.0
             if emitted_g is not None:
                 emitted_g[:, :, dead] = 0.0
+    emitted, emitted_g = _tinted(hits, emitted, emitted_g)
     return finite(emitted), alpha, None if emitted_g is None else finite(emitted_g)
 
 
@@ -184,7 +196,7 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
     n = len(hits.rows)
     prim, b1, b2 = s.prim.copy(), s.b1.copy(), s.b2.copy()
     o, d, t = s.p.copy(), -s.wo, np.zeros(n, np.float32)
-    thr = np.ones((3, n), np.float32)
+    thr = np.ones((3, n), np.float32) if hits.tint is None else hits.tint.copy()
     depth = np.zeros(n, np.int64)
     alive = np.ones(n, bool)
     idx = np.flatnonzero(s.glass)
@@ -201,11 +213,13 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
         absorbed = volume.transmittance(ctx, hit.prim, hit.t, ray.d)  # the segment inside an absorbing mesh
         if absorbed is not None:
             thr[:, idx] *= absorbed
-        em, _a, em_g = _seen(ctx, ray.o, ray.d, None, hit, camera=False)
+        em, _a, em_g = _seen(ctx, ray.o, ray.d, None, hit, camera=False)  # (through the tints in front of it)
         pix = hits.rows[idx]
         hits.emitted[:, pix] += finite(cols(thr, idx) * em)
         if em_g is not None:
             hits.emitted_g[:, :, pix] += finite(cols(thr, idx) * em_g)
+        if hit.tint is not None:
+            thr[:, idx] *= hit.tint
         got = (hit.prim >= 0) & (depth[idx] <= ctx.max_bounces)
         alive[idx[~got]] = False
         sel = np.flatnonzero(got)
@@ -225,6 +239,7 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
     keep = np.flatnonzero(alive)
     hits.rows = hits.rows[keep]
     hits.surf = Surface(ctx, prim[keep], b1[keep], b2[keep], o[:, keep], d[:, keep], t[keep], walks=True)
+    hits.tint = None
     return SpecularChains(thr[:, keep], depth[keep])
 
 

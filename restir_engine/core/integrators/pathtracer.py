@@ -80,8 +80,9 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
     if live.size:
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), cols(ls.pos, live), cols(ls.wi, live),
                                   ls.dist[live])
-        lv = live[~ctx.geom_accel.occluded(so, sd, far)]
-        out[:, lv] = finite(cols(contrib, lv))
+        keep, tr = ctx.geom_accel.passed(so, sd, far)
+        lv = live[keep]
+        out[:, lv] = finite(cols(contrib, lv) if tr is None else cols(contrib, lv) * tr)
     group = ctx.groups.of_lights(ls.light[lv]) if (taps or taps_d) and lv.size else None
     if group is not None:
         tap_add(taps, lv, group, cols(out, lv))
@@ -92,6 +93,8 @@ def next_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, throughp
         kd = diffuse_f(s.view, cols(wi_l, lv), lv)
         out_d[:, lv] = finite(kd * cols(ls.le, lv) * (np.abs(wi_l[2, lv]) * w[lv] /
                                                        np.maximum(ls.pdf[lv], np.float32(1e-30))))
+        if tr is not None:
+            out_d[:, lv] *= tr
         if group is not None:
             tap_add(taps_d, lv, group, cols(out_d, lv))
     if w_out is not None:
@@ -120,8 +123,9 @@ def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, through
     if live.size:
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), np.zeros((3, live.size), np.float32),
                                   cols(wi, live), np.full(live.size, np.inf, np.float32))
-        live = live[~ctx.geom_accel.occluded(so, sd, far)]
-        out[:, live] = finite(cols(contrib, live))
+        keep, tr = ctx.geom_accel.passed(so, sd, far)
+        live = live[keep]
+        out[:, live] = finite(cols(contrib, live) if tr is None else cols(contrib, live) * tr)
     grouped = bool(taps or taps_d) and live.size > 0
     if grouped:
         tap_add(taps, live, ctx.groups.world, cols(out, live))
@@ -130,6 +134,8 @@ def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, through
     out_d = np.zeros((3, n), np.float32)
     if live.size:
         out_d[:, live] = finite(diffuse_f(s.view, cols(wi_l, live), live) * cols(le, live) * scale[live])
+        if tr is not None:
+            out_d[:, live] *= tr
         if grouped:
             tap_add(taps_d, live, ctx.groups.world, cols(out_d, live))
     return out, out_d
@@ -201,7 +207,8 @@ class FirstBounce:
     emission, which is the primary surface's direct light), ``lo_d`` (3, k) the part of it x2's diffuse lobe
     reflects (the same light samples weighed by the diffuse lobe alone). The path tracer's indirect light is
     throughput · lo. With light groups, ``lo_g`` and ``lo_d_g`` (G, 3, k): lo and lo_d by the group of their lights
-    (lights/groups.py)."""
+    (lights/groups.py). ``tint`` (3, k) or None: the colour the ray kept through the transparent surfaces it passed
+    on its way to x2 (in ``throughput`` too)."""
 
     rows: np.ndarray
     throughput: np.ndarray
@@ -213,6 +220,7 @@ class FirstBounce:
     lo_d: np.ndarray = None
     lo_g: np.ndarray = None
     lo_d_g: np.ndarray = None
+    tint: np.ndarray = None
 
 
 @dataclass
@@ -362,6 +370,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         else:
             hits = hits.take(keep)
         absorbed = volume.transmittance(ctx, hits.prim, hits.t, d)  # rays that crossed an absorbing mesh
+        if hits.tint is not None:  # ... and coloured transparent surfaces
+            absorbed = hits.tint if absorbed is None else absorbed * hits.tint
         if absorbed is not None:
             throughput = throughput * absorbed
             if dthr is not None:
@@ -392,7 +402,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             # from here on the path estimates the radiance leaving x2: throughput 1, accumulated per first hit
             first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.facing_normals()[0], s.params,
                                 np.zeros((3, len(idx)), np.float32), np.zeros((3, len(idx)), np.float32),
-                                light_groups.zeros(ctx.groups, len(idx)), light_groups.zeros(ctx.groups, len(idx)))
+                                light_groups.zeros(ctx.groups, len(idx)), light_groups.zeros(ctx.groups, len(idx)),
+                                None if hits.tint is None else cols(hits.tint, hsel))
             if budget is not None:
                 budget = budget[idx]
             idx = np.arange(len(idx))

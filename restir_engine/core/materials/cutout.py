@@ -6,14 +6,16 @@ value t or 1 - t at the hit's UV, times its node program's "alpha" at the hit) a
 behind it. The decision is a hash of the hit (triangle and barycentrics, salted apart from the Mix pick), so every
 ray that reaches the same point agrees (a shadow ray is blocked exactly where a camera ray would stop), and over the
 points of a pixel the surface covers a fraction α of them: Cycles' transparency of a white Transparent BSDF, on
-average. Objects whose Ray Visibility excludes a kind of ray are passed the same way by that kind: shadow rays pass
+average. A ray that passes a transparent point keeps the material's transparent tint there (a Transparent BSDF's
+Color, constant or from its node program; white for an Alpha): rays carry the product of the tints they passed
+(accel.Hits.tint), shadow rays return it as their transmittance (accel.Accel.transmittance). Objects whose Ray Visibility excludes a kind of ray are passed the same way by that kind: shadow rays pass
 objects that cast no shadow, camera rays objects the camera does not see.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..sampling import barycentric, norm
+from ..sampling import barycentric, cols, norm
 from .mix import hash_uniform
 from .nodes import HitAttributes, run_programs
 from .textures import sample
@@ -37,6 +39,11 @@ class Cutout:
         self.shadow_cut = self.cut & (shadows[mat] if shadows is not None else True)
         self.shadow_pass = _passed_by(geometry, "casts_shadow")  # (n,) bool or None: triangles shadow rays ignore
         self.camera_pass = _passed_by(geometry, "camera_visible")  # ... and camera rays
+        tint = getattr(materials, "transparent_tint", None)
+        self.tint_of = np.ones((len(materials.alpha), 3), np.float32) if tint is None else tint.astype(np.float32)
+        self.tint_program = _programs_with(materials, "transparent_tint")  # (m,) bool
+        coloured = (np.abs(self.tint_of - 1) > 1e-6).any(axis=1) | self.tint_program
+        self.tinted = bool((self.cut & coloured[mat]).any())
         self.uvs = geometry.uvs
         self.textures = materials.textures
         self.geometry, self.materials = geometry, materials
@@ -94,6 +101,31 @@ class Cutout:
         out[sel] = xi < a
         return out
 
+    def tint(self, prim: np.ndarray, u: np.ndarray, v: np.ndarray, d: np.ndarray | None = None,
+             shadow: bool = False, camera: bool = False) -> np.ndarray:
+        """(3, n) float32: the colour rays along ``d`` (3, n) keep where they pass the points (prim, u, v) that
+        :meth:`opaque` let them through (white where an object's Ray Visibility let them pass)."""
+        mat = self.geometry.material[prim]
+        out = np.ascontiguousarray(self.tint_of[mat].T)
+        rows = np.flatnonzero(self.tint_program[mat])
+        if rows.size:
+            wo = None if d is None else cols(d, rows)
+            wo = None if wo is None else (-wo / np.maximum(norm(wo), np.float32(1e-30))).astype(np.float32)
+
+            def attrs(r):
+                return HitAttributes(self.geometry, prim[rows[r]], u[rows[r]], v[rows[r]], self.textures,
+                                     wo=None if wo is None else wo[:, r])
+            for r, got in run_programs(self.materials, mat[rows], attrs, ("transparent_tint",)):
+                if "transparent_tint" in got:
+                    out[:, rows[r]] = np.maximum(got["transparent_tint"], 0)
+        free = np.zeros(len(prim), bool)
+        if shadow and self.shadow_pass is not None:
+            free |= self.shadow_pass[prim]
+        if camera and self.camera_pass is not None:
+            free |= self.camera_pass[prim]
+        out[:, free] = 1.0
+        return out
+
     def _program_alpha(self, prim, u, v, d) -> np.ndarray:
         """The node programs' "alpha" (clamped to [0, 1]) at hits on materials that have one."""
         wo = None if d is None else (-d / np.maximum(norm(d), np.float32(1e-30))).astype(np.float32)
@@ -106,6 +138,16 @@ class Cutout:
             if "alpha" in got:
                 out[r] = np.clip(got["alpha"], 0, 1)
         return out
+
+
+def _programs_with(materials, name: str) -> np.ndarray:
+    """(m,) bool: the materials whose node program computes field ``name``."""
+    m = len(materials.alpha)
+    index, programs = getattr(materials, "program", None), getattr(materials, "programs", None)
+    if index is None or not programs:
+        return np.zeros(m, bool)
+    has = np.array([p.has(name) for p in programs], bool)
+    return (index >= 0) & has[np.maximum(index, 0)]
 
 
 def _passed_by(geometry, flag: str):

@@ -173,9 +173,11 @@ class Film:
             flat["aux"][sel] += 2.0 * rgb[half]
 
         def add_batch(c):
-            """A chunk of ``batch`` samples per pixel (no reservoirs or glass chains: those passes do not batch):
-            each result summed over the samples of its pixel."""
+            """A chunk of ``batch`` samples per pixel (no reservoirs or glass chains: those passes do not batch;
+            a chain of coloured transparent surfaces in front may come): each result summed over the samples of its
+            pixel."""
             n = len(c.pixels) // c.batch
+            chain = None if c.chain is None else c.chain.throughput
             base = c.pixels[:n]
             span = _pixels(base)
             emitted = c.hits.emitted.reshape(3, c.batch, n)
@@ -183,9 +185,9 @@ class Film:
             flat["alpha"][span] += c.hits.alpha.reshape(c.batch, n).sum(axis=0)
             rgb = np.ascontiguousarray(emitted.transpose(1, 2, 0), dtype=FILM_DTYPE) if "aux" in flat else None
 
-            def add_rows(key, value, light=False):  # (3, hits) values of the hit rows, summed into their pixels
+            def add_rows(key, value, light=False, tinted=True):  # (3, hits) values of the hit rows, per pixel
                 dense = np.zeros((len(c.pixels), 3), np.float32)
-                dense[c.hits.rows] = value.T
+                dense[c.hits.rows] = (value if chain is None or not tinted else value * chain).T
                 dense = dense.reshape(c.batch, n, 3)
                 flat[key][span] += dense.sum(axis=0)
                 if light and rgb is not None:
@@ -206,7 +208,7 @@ class Film:
                     add_adaptive(base, rgb[b])
             if "albedo" in flat and len(c.hits.rows):
                 add_rows("albedo", denoising_albedo(c.hits.surf))
-                add_rows("dnormal", world_to_cam @ c.hits.surf.facing_normals()[1])
+                add_rows("dnormal", world_to_cam @ c.hits.surf.facing_normals()[1], tinted=False)
 
         map_tasks(add, chunks, stop)
 

@@ -28,13 +28,16 @@ class CameraMasks:
 
 
 def primary(ctx, plan: PassPlan, masks: CameraMasks, c: Chunk, catchers=None) -> None:
-    """Fill ``c.hits`` (and ``c.chain`` where camera rays continue through glass; ``c.catcher`` and what the
-    catchers hide where camera rays meet shadow catchers: shadow_catcher.Catchers)."""
+    """Fill ``c.hits`` (and ``c.chain`` where camera rays continue through glass or coloured transparent surfaces;
+    ``c.catcher`` and what the catchers hide where camera rays meet shadow catchers: shadow_catcher.Catchers)."""
     camera_rays(ctx, plan, masks, c)
     if plan.glass_chains and ctx.has_glass:
         # camera rays that met glass continue to the surface behind it, where resampling runs (without
         # resampling, the path continuation handles glass as the path tracer does, at less cost)
         c.chain = camera_paths.follow_specular(ctx, c.hits, plan.rng(STREAM_CHAIN, c.index))
+    if c.chain is None and c.hits.tint is not None:  # coloured transparent surfaces in front: a chain of no glass
+        c.chain = camera_paths.SpecularChains(c.hits.tint, np.zeros(len(c.hits.rows), np.int64))
+        c.hits.tint = None
     if catchers is not None:
         hits = c.hits
         c.catcher = catchers.hits(hits.surf, c.chain)

@@ -276,12 +276,18 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator, sums=None) -> 
         o = np.concatenate([r[3] for r in rays], axis=1)
         d = np.concatenate([r[4] for r in rays], axis=1)
         far = np.concatenate([r[5] for r in rays])
-        visible = ~ctx.geom_accel.occluded(o, d, far)
+        keep, tr = ctx.geom_accel.passed(o, d, far)
+        visible = np.zeros(len(far), bool)
+        visible[keep] = True
+        if tr is not None:  # coloured transparent surfaces on the way: the light they let through
+            through = np.ones((3, len(far)), np.float32)
+            through[:, keep] = tr
         start = 0
         for rows, contrib, group, *_ in rays:  # rows are unique within each kind
             vis = visible[start:start + len(rows)]
-            out[:, rows[vis]] += contrib[:, vis]
+            c = contrib[:, vis] if tr is None else contrib[:, vis] * through[:, start:start + len(rows)][:, vis]
+            out[:, rows[vis]] += c
             if group is not None:
-                light_groups.add(sums, rows[vis], group[vis], finite(contrib[:, vis]))
+                light_groups.add(sums, rows[vis], group[vis], finite(c))
             start += len(rows)
     return finite(out)

@@ -159,6 +159,10 @@ def initial(first, terms, n: int, glossy: np.ndarray, space=None):
     if rows.size == 0:
         return res, rest, rest_g
     lo_d = first.lo_d
+    lo_d_g = first.lo_d_g
+    if first.tint is not None:  # the reservoir holds the light that reached x1 through the transparent tints
+        lo_d = lo_d * first.tint
+        lo_d_g = None if lo_d_g is None else lo_d_g * first.tint
     here = terms.take(rows)
     pts = PackedPoints(first.p, first.n2, lo_d, np.zeros(len(rows), np.float32), np.zeros(len(rows), bool))
     p_hat = (space or GISpace()).evaluate(here, pts)
@@ -175,7 +179,9 @@ def initial(first, terms, n: int, glossy: np.ndarray, space=None):
         ci = np.maximum(dot(cols(d, np.flatnonzero(g)), cols(here.ns, np.flatnonzero(g))), 0.0) / \
             np.sqrt(np.maximum(d2[g], 1e-30))
         carried[:, g] = kd_t * (ci / np.maximum(first.pdf[g], 1e-30))
-    rest[:, rows] = finite(first.throughput * (first.lo - lo_d) + (first.throughput - carried) * lo_d)
+        if first.tint is not None:
+            carried[:, g] *= first.tint[:, g]
+    rest[:, rows] = finite(first.throughput * (first.lo - first.lo_d) + (first.throughput - carried) * first.lo_d)
     if groups:
         rest_g[:, :, rows] = finite(first.throughput * (first.lo_g - first.lo_d_g) +
                                     (first.throughput - carried) * first.lo_d_g)
@@ -188,7 +194,7 @@ def initial(first, terms, n: int, glossy: np.ndarray, space=None):
     res.p_hat[r] = p_hat[sel]
     res.W[r] = 1.0 / p_area[sel]
     if groups:
-        res.set_group_lo(r, first.lo_d_g[:, :, sel])
+        res.set_group_lo(r, lo_d_g[:, :, sel])
     return res, rest, rest_g
 
 
