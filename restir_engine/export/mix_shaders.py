@@ -139,11 +139,6 @@ class MixShaderReader:
         out = {"base_color": (0.0, 0.0, 0.0), "f0": 0.0}
         comps, outputs, emission, clear = [], {}, None, None
         passed, coloured = None, False  # the colour let through, weighted by each transparent share (clear)
-
-        def pass_colour(colour, share):
-            nonlocal passed
-            c = g.emit("scale", {}, [colour, share], ("color",))[0]
-            passed = c if passed is None else g.emit("add", {}, [passed, c], ("color",))[0]
         for name in order:
             leaf, w = weights[name]
             if leaf.type == "BSDF_PRINCIPLED" and "Alpha" in leaf.inputs:  # its see-through share, per hit
@@ -151,7 +146,7 @@ class MixShaderReader:
                 if a.const is None or a.constant_value() < 1:
                     share = g.emit("multiply", {}, [w, g.emit("one_minus", {}, [a], ("float",))[0]], ("float",))[0]
                     clear = share if clear is None else g.emit("add", {}, [clear, share], ("float",))[0]
-                    pass_colour(g.constant((1.0, 1.0, 1.0), "color"), share)
+                    passed = _add_colour(g, passed, g.constant((1.0, 1.0, 1.0), "color"), share)
                     w = g.emit("multiply", {}, [w, a], ("float",))[0]
             sheen = sheen_layer(self, material, g, leaf) if sheen_set(leaf) else None
             coat = coat_factors(g, leaf) if coat_set(leaf) else None
@@ -176,7 +171,7 @@ class MixShaderReader:
                 clear = w if clear is None else g.emit("add", {}, [clear, w], ("float",))[0]
                 colour = g.value(leaf.inputs["Color"], "color")
                 coloured |= colour.const is None or bool(np.any(np.abs(np.asarray(colour.const) - 1) > 1e-6))
-                pass_colour(colour, w)
+                passed = _add_colour(g, passed, colour, w)
                 continue
             e = self._leaf_emission(g, leaf)
             if e is not None:
@@ -196,12 +191,8 @@ class MixShaderReader:
                 _add_component(comps, outputs, self.add_row(comp), w)
         if clear is not None:
             _cut_out_share(g, clear, out, outputs, comps)
-            if coloured:  # the colour passed per unit of transparent share
-                tint = g.emit("scale", {}, [passed, g.emit("reciprocal", {}, [clear], ("float",))[0]], ("color",))[0]
-                if tint.const is not None:
-                    out["transparent_tint"] = tuple(float(max(c, 0.0)) for c in tint.constant_value())
-                else:
-                    outputs["transparent_tint"] = tint
+            if coloured:
+                _transparent_tint(g, passed, clear, out, outputs)
         if emission is not None:
             if emission.const is not None:
                 out["emission"] = emission.constant_value()
@@ -274,6 +265,22 @@ def _add_component(comps: list, outputs: dict, index: int, weight) -> None:
     else:
         outputs[f"mix:{len(comps)}"] = weight
         comps.append((index, 1.0, -1, 0.0))
+
+
+def _add_colour(g: GraphCompiler, passed, colour, share):
+    """The register ``passed`` (None: nothing yet) plus ``colour`` weighted by the transparent ``share``."""
+    c = g.emit("scale", {}, [colour, share], ("color",))[0]
+    return c if passed is None else g.emit("add", {}, [passed, c], ("color",))[0]
+
+
+def _transparent_tint(g: GraphCompiler, passed, clear, out: dict, outputs: dict) -> None:
+    """The colour a mix row's transparent points pass, ``passed`` (the leaves' colours weighted by their shares) per
+    unit of its transparent share ``clear``: the row's constant, or the program's "transparent_tint"."""
+    tint = g.emit("scale", {}, [passed, g.emit("reciprocal", {}, [clear], ("float",))[0]], ("color",))[0]
+    if tint.const is not None:
+        out["transparent_tint"] = tuple(float(max(c, 0.0)) for c in tint.constant_value())
+    else:
+        outputs["transparent_tint"] = tint
 
 
 def _cut_out_share(g: GraphCompiler, clear, out: dict, outputs: dict, comps: list) -> None:

@@ -369,9 +369,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
             hits = ctx.geom_accel.intersect(o, d)
         else:
             hits = hits.take(keep)
-        absorbed = volume.transmittance(ctx, hits.prim, hits.t, d)  # rays that crossed an absorbing mesh
-        if hits.tint is not None:  # ... and coloured transparent surfaces
-            absorbed = hits.tint if absorbed is None else absorbed * hits.tint
+        absorbed = _kept(ctx, hits, d)
         if absorbed is not None:
             throughput = throughput * absorbed
             if dthr is not None:
@@ -417,6 +415,15 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         out.first = first
     out.add_walked_indirect(indirect, indirect_g)
     return out
+
+
+def _kept(ctx: TraceContext, hits, d: np.ndarray):
+    """(3, k) the light rays ``d`` kept on their way to ``hits``: through absorbing meshes (volume.transmittance)
+    and the tints of coloured transparent surfaces (Hits.tint); None where both are white."""
+    absorbed = volume.transmittance(ctx, hits.prim, hits.t, d)
+    if hits.tint is None:
+        return absorbed
+    return hits.tint if absorbed is None else absorbed * hits.tint
 
 
 def _ray_throughput(ray: BsdfRay, s: Surface, throughput, dthr, at_x2: bool, roulette: bool, rng):
