@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 
 import bpy
+import mathutils
 import numpy as np
 
 from harness.render import configure_cycles, configure_restir, render_scene
@@ -771,6 +772,47 @@ def node_planes(graphs, cols: int, px: int = 16, name="Nodes"):
             graph.setup(obj)
     camera((0, 0, 5), (0, 0, 0), ortho_scale=max(cols, rows))
     scene.render.resolution_x, scene.render.resolution_y = cols * px, rows * px
+    return scene
+
+
+def derived_attributes_scene(size=(128, 64)):
+    """Geometry > Pointiness (red) and Random Per Island (green) through an Emission shader (blue 0.2), seen by a
+    camera under a black world: a Suzanne under a Subdivision Surface (three islands: the head and the eyes) and
+    one mesh of eight rotated cubes (eight islands) under a three-segment Bevel. Each pixel is the attributes'
+    value; no lights."""
+    import bmesh
+    scene = reset()
+    black_world(scene)
+    mat = emission("Derived", (1, 1, 1), 1.0)
+    tree = mat.node_tree
+    geo = tree.nodes.new("ShaderNodeNewGeometry")
+    comb = tree.nodes.new("ShaderNodeCombineColor")
+    comb.inputs["Blue"].default_value = 0.2
+    tree.links.new(geo.outputs["Pointiness"], comb.inputs["Red"])
+    tree.links.new(geo.outputs["Random Per Island"], comb.inputs["Green"])
+    tree.links.new(comb.outputs["Color"], tree.nodes["Emission"].inputs["Color"])
+    bpy.ops.mesh.primitive_monkey_add(location=(-1.3, 0, 0))
+    monkey = bpy.context.object
+    monkey.data.materials.append(mat)
+    sub = monkey.modifiers.new("Subdivision", "SUBSURF")
+    sub.levels = sub.render_levels = 1
+    bm = bmesh.new()
+    rng = np.random.default_rng(7)
+    for k in range(8):
+        rot = rng.uniform(0, math.pi, 3)
+        m = (mathutils.Matrix.Translation(((k % 4) * 0.55 + 0.55, 0, (k // 4) * 0.6 - 0.3)) @
+             mathutils.Euler(rot).to_matrix().to_4x4() @ mathutils.Matrix.Scale(0.22, 4))
+        bmesh.ops.create_cube(bm, size=1.0, matrix=m)
+    data = bpy.data.meshes.new("Cubes")
+    bm.to_mesh(data)
+    bm.free()
+    cubes = bpy.data.objects.new("Cubes", data)
+    scene.collection.objects.link(cubes)
+    data.materials.append(mat)
+    bevel = cubes.modifiers.new("Bevel", "BEVEL")
+    bevel.width, bevel.segments = 0.05, 3
+    camera((0, -6, 0), (math.pi / 2, 0, 0), lens=50.0)
+    scene.render.resolution_x, scene.render.resolution_y = size
     return scene
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .derived_attributes import DERIVED, read_derived
+
 
 TANGENT_PREFIX = "tangent@"  # attribute "tangent@<UV map>": that map's MikkTSpace tangents and bitangent signs
 
@@ -28,6 +30,9 @@ def read_tangents(mesh, uv_map: str, loops, nt: int):
 def read_attribute(mesh, name: str, vidx, loops, nt: int):
     """(t, 3, 4) RGBA corner values of a colour attribute (or a float / vector geometry attribute), linear; None
     when the mesh has none of that name."""
+    if name in DERIVED:  # computed from the shape (Geometry > Pointiness): the value in every channel
+        vals = np.repeat(read_derived(mesh, name)[:, None], 4, axis=1)
+        return vals[vidx].reshape(nt, 3, 4)
     attr = None
     if name == "":
         ca = mesh.color_attributes

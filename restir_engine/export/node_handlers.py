@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .derived_attributes import POINTINESS, RANDOM_PER_ISLAND
 from .node_graph import Reg
 
 #: samples of a Color Ramp or curve table (Cycles' 257 entries over [0, 1])
@@ -61,7 +62,9 @@ def _geometry(g, node, f):
     return {"Position": g.attribute("position", "vector"), "Normal": g.attribute("normal", "vector"),
             "True Normal": g.attribute("true_normal", "vector"), "Incoming": g.attribute("incoming", "vector"),
             "Parametric": g.attribute("parametric", "vector"), "Backfacing": g.attribute("backfacing", "float"),
-            "Tangent": g.attribute("tangent", "vector")}
+            "Tangent": g.attribute("tangent", "vector"),
+            "Pointiness": g.attribute(f"attr_alpha:{POINTINESS}", "float"),
+            "Random Per Island": g.attribute(f"attr_alpha:{RANDOM_PER_ISLAND}", "float")}
 
 
 def _object_info(g, node, f):
