@@ -816,6 +816,39 @@ def derived_attributes_scene(size=(128, 64)):
     return scene
 
 
+def _with_falloff(lamp_obj, output, strength, smooth=0.0):
+    """Wire a Light Falloff node's ``output`` (Quadratic, Linear, Constant) into the lamp's Emission Strength."""
+    data = lamp_obj.data
+    if data.node_tree is None:  # Blender 5.0 lights still make their node tree on use_nodes
+        data.use_nodes = True
+    tree = data.node_tree
+    em = next(n for n in tree.nodes if n.type == "EMISSION")
+    fo = tree.nodes.new("ShaderNodeLightFalloff")
+    fo.inputs["Strength"].default_value = strength
+    fo.inputs["Smooth"].default_value = smooth
+    tree.links.new(fo.outputs[output], em.inputs["Strength"])
+
+
+def falloff_scene(size=(96, 64)):
+    """A long grey floor and a back wall lit by three lamps whose strength goes through Light Falloff nodes: a point
+    lamp with Linear falloff, a spot lamp with Constant falloff and Smooth 2, and a small area lamp with Quadratic
+    falloff and Smooth 1; the camera looks down the floor, so the lit points lie at distances of 0.5 to 6 m."""
+    scene = reset()
+    black_world(scene)
+    floor_mat = diffuse("Floor", (0.6, 0.6, 0.6))
+    plane("Floor", 1.0, (0, 2, 0), material=floor_mat, scale=(4, 8, 1))
+    plane("Wall", 1.0, (0, 6, 2), rotation=(math.pi / 2, 0, 0), material=diffuse("Wall", (0.5, 0.6, 0.7)),
+          scale=(4, 4, 1))
+    _with_falloff(light("POINT", (-1.0, 0.0, 1.0), energy=40.0, shadow_soft_size=0.1), "Linear", 1.0)
+    _with_falloff(light("SPOT", (1.0, 3.0, 2.5), rotation=(0.5, 0, 0), energy=20.0, shadow_soft_size=0.1,
+                        spot_size=1.2, spot_blend=0.3), "Constant", 0.3, smooth=2.0)
+    _with_falloff(light("AREA", (0.0, 4.0, 1.5), rotation=(-1.2, 0, 0), energy=60.0, size=0.5), "Quadratic", 1.0,
+                  smooth=1.0)
+    camera((0, -2.5, 1.6), (math.radians(70), 0, 0), lens=24.0)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene
+
+
 def node_materials_scene(size=(96, 64)):
     """Lit materials whose inputs come from node graphs: a floor whose Roughness and Metallic come from a Checker
     through Map Range and whose Base Color is Noise through a Color Ramp; a sphere with Base Color from a Gradient

@@ -119,7 +119,8 @@ def assert_cells_match(ours: np.ndarray, ref: np.ndarray, names, power=()) -> No
     ma, mb = ours.mean(axis=0), ref.mean(axis=0)
     se = np.sqrt(ours.var(axis=0, ddof=1) / len(ours) + ref.var(axis=0, ddof=1) / len(ref))
     ok = agree(ma, mb, se)
-    report = [f"{n}: ours/reference {a / b:.4f} (rel SE {s / b:.4f})" for n, a, b, s in zip(names, ma, mb, se)]
+    with np.errstate(invalid="ignore", divide="ignore"):  # a black cell reads nan
+        report = [f"{n}: ours/reference {a / b:.4f} (rel SE {s / b:.4f})" for n, a, b, s in zip(names, ma, mb, se)]
     assert ok.all(), "\n".join(r for r, good in zip(report, ok) if not good)
     k = 1.0 + POWER_ERROR
     _log_power(ours, ref, list(power), (POWER_ERROR - MARGIN) / Z_MAX)

@@ -294,6 +294,8 @@ class Lamps:
     sphere_first: np.ndarray = None
     group: np.ndarray = None      # (n,) int16 the lamp's light group (lights/groups.py; -1: none), None: no groups
     sun_group: np.ndarray = None  # (s,) int16 each sun's
+    falloff: np.ndarray = None
+    falloff_smooth: np.ndarray = None
 
     def __post_init__(self):
         n = len(self.spot_cos)
@@ -301,6 +303,18 @@ class Lamps:
             self.sphere_radius = np.zeros(n, np.float32)
         if self.sphere_first is None:
             self.sphere_first = np.full(n, -1, np.int32)
+
+    def falloff_terms(self) -> tuple:
+        """(k (n,), smooth (n,)) float32 per lamp triangle: zeros where none were given (the physical falloff)."""
+        n = len(self.spot_cos)
+        if self.falloff is None or len(self.falloff) != n:
+            return np.zeros(n, np.float32), np.zeros(n, np.float32)
+        return self.falloff, self.falloff_smooth
+
+    def receiver_dependent(self) -> np.ndarray:
+        """(n,) bool: lamp triangles whose radiance depends on where the receiver is (a spot cone, a falloff)."""
+        k, s = self.falloff_terms()
+        return (self.spot_cos > -1.5) | (k != 0) | (s > 0)
 
     @staticmethod
     def empty() -> Lamps:

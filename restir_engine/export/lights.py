@@ -70,10 +70,26 @@ def _area_shape(light) -> np.ndarray:
     return tris
 
 
-def _light_node_scale(light, warnings: list, name: str):
+def _falloff(found: list, name: str, warnings: list) -> tuple:
+    """(k, smooth) of the Light Falloff nodes a lamp's Emission reads (``found``: (node name, the indices of the
+    outputs used: 0 Quadratic, 1 Linear, 2 Constant, smooth)); (0, 0) without one. Two different ones are named in a
+    warning and the first is used."""
+    kinds = {(k, smooth) for _n, used, smooth in found for k in (used or [0])}
+    if not kinds:
+        return 0, 0.0
+    first = next((k, smooth) for _n, used, smooth in found for k in (used or [0]))
+    if len(kinds) > 1:
+        warnings.append(f"Light '{name}': its Light Falloff nodes mix falloffs; only one is supported "
+                        f"({('Quadratic', 'Linear', 'Constant')[first[0]]}, Smooth {first[1]:g}) and used")
+    return first
+
+
+def _light_node_scale(light, warnings: list, name: str, falloff: list | None = None):
     """RGB factor of a light's node tree: its Emission node's Color x Strength, each folded to a constant through
     whatever nodes feed it (RGB, Math, Mix, Blackbody, Light Falloff ...; core/materials/nodes); 1 without nodes.
-    A graph that varies over the light (a texture) is named in a warning and its sockets' own values are used."""
+    A graph that varies over the light (a texture) is named in a warning and its sockets' own values are used.
+    ``falloff`` (a list of two) receives the (k, smooth) of a Light Falloff node the Emission reads (scene.Lamps)."""
+    falloff = [0, 0.0] if falloff is None else falloff
     tree = light.node_tree
     if tree is None or not getattr(light, "use_nodes", True):
         return np.ones(3)
@@ -90,8 +106,10 @@ def _light_node_scale(light, warnings: list, name: str):
     from .node_graph import GraphCompiler
     notes = []
     g = GraphCompiler(lambda image, alpha: 0, notes.append)
+    g.falloffs = []
     color, strength = g.value(node.inputs["Color"], "color"), g.value(node.inputs["Strength"], "float")
     warnings.extend(f"Light '{name}': {n}" for n in dict.fromkeys(notes))
+    falloff[:] = _falloff(g.falloffs, name, warnings)
     out = []
     for reg, sock in ((color, node.inputs["Color"]), (strength, node.inputs["Strength"])):
         if reg.const is not None:
@@ -104,15 +122,15 @@ def _light_node_scale(light, warnings: list, name: str):
     return out[0] * out[1]
 
 
-def _lamp_power(light, name: str, warnings: list) -> np.ndarray:
+def _lamp_power(light, name: str, warnings: list, falloff: list | None = None) -> np.ndarray:
     """Colour x Power (W) x 2^Exposure, times the Temperature's colour where the light uses one and its node
-    tree's factor."""
+    tree's factor (``falloff``: see :func:`_light_node_scale`)."""
     power = np.array(light.color[:3], np.float64) * float(light.energy)
     power *= 2.0 ** float(getattr(light, "exposure", 0.0))
     if getattr(light, "use_temperature", False):
         from ..core.lights.blackbody import blackbody_rgb
         power *= blackbody_rgb(float(light.temperature)).astype(np.float64).reshape(3)
-    return power * _light_node_scale(light, warnings, name)
+    return power * _light_node_scale(light, warnings, name, falloff)
 
 
 def _area(tris: np.ndarray) -> float:
@@ -123,7 +141,7 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
     """The depsgraph's Light objects; ``groups`` ({light group name: index}, export/light_groups.py) gives each lamp
     its group (Lamps.group per triangle, sun_group per sun; -1: none)."""
     groups = groups or {}
-    parts = []  # (world tris, material index, spot, camera visible, sphere radius, light group)
+    parts = []  # (world tris, material index, spot, camera visible, sphere radius, light group, falloff)
     suns = []
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -131,7 +149,8 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
             continue
         light = obj.data
         m = np.array(inst.matrix_world, np.float64)
-        power = _lamp_power(light, obj.name, warnings)
+        falloff = [0, 0.0]
+        power = _lamp_power(light, obj.name, warnings, falloff)
         if not np.isfinite(m).all() or not np.isfinite(power).all():
             warnings.append(f"Light '{obj.name}' has a non-finite transform or power and was skipped")
             continue
@@ -139,6 +158,8 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
             continue
         visible = bool(getattr(obj, "visible_camera", True))
         if light.type == "SUN":
+            if tuple(falloff) != (0, 0.0):
+                warnings.append(f"Sun '{obj.name}': Light Falloff does not apply to a sun; its falloff is ignored")
             axis = m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-30)
             suns.append((axis, np.cos(min(float(light.angle), np.pi) / 2),
                          clamped_radiance(power, f"Sun '{obj.name}' irradiance", warnings),
@@ -176,8 +197,8 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
             radiance = power / np.pi
         mat = registry.add_row({"name": f"(light {obj.name})", "base_color": (0, 0, 0), "f0": 0.0,
                                 "emission": tuple(radiance), "two_sided_emission": False})
-        parts.append((world.astype(np.float32), mat, spot, visible, sphere, groups.get(getattr(obj, "lightgroup", ""),
-                                                                                      -1)))
+        parts.append((world.astype(np.float32), mat, spot, visible, sphere,
+                      groups.get(getattr(obj, "lightgroup", ""), -1), tuple(falloff)))
 
     lamps = Lamps.empty()
     if parts:
@@ -196,6 +217,8 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
         lamps.camera_visible = rep([p[3] for p in parts], bool)
         lamps.sphere_radius = rep([p[4] for p in parts], np.float32)
         lamps.group = rep([p[5] for p in parts], np.int16)
+        lamps.falloff = rep([p[6][0] for p in parts], np.float32)
+        lamps.falloff_smooth = rep([p[6][1] for p in parts], np.float32)
         first = np.repeat(np.cumsum([0] + counts[:-1]), counts)
         lamps.sphere_first = np.where(lamps.sphere_radius > 0, first, -1).astype(np.int32)
     if suns:

@@ -402,13 +402,20 @@ def _blackbody(g, node, f):
 
 
 def _light_falloff(g, node, f):
+    """Every output is the Strength; the distance factor of the output used is recorded where the graph is a lamp's
+    (``g.falloffs``, a list: the lamp applies it per receiver) and approximated by the physical one elsewhere."""
     strength = g.inp(node, "Strength", "float", f)
-    if node.outputs["Linear"].is_linked or node.outputs["Constant"].is_linked:
-        g.warn(f"'{node.name}' (Light Falloff): Linear and Constant falloff are approximated by the physical "
-               "(quadratic) falloff")
     smooth = g.inp(node, "Smooth", "float", f)
+    used = [k for k, name in enumerate(("Quadratic", "Linear", "Constant")) if node.outputs[name].is_linked]
+    lamp = getattr(g, "falloffs", None)
+    if lamp is not None and smooth.const is not None:
+        lamp.append((node.name, used, float(smooth.const)))
+        return {"Quadratic": strength, "Linear": strength, "Constant": strength}
+    if set(used) - {0}:
+        g.warn(f"'{node.name}' (Light Falloff): Linear and Constant falloff are approximated by the physical "
+               "(quadratic) falloff outside lamps")
     if smooth.const is None or float(smooth.const) != 0.0:
-        g.warn(f"'{node.name}' (Light Falloff): Smooth is not supported (treated as 0)")
+        g.warn(f"'{node.name}' (Light Falloff): Smooth is not supported here (treated as 0)")
     return {"Quadratic": strength, "Linear": strength, "Constant": strength}
 
 

@@ -123,3 +123,24 @@ def test_floor_under_sphere_light_matches_closed_form(method):
     mean, se = np.mean(reps), standard_error(reps)
     assert se < 0.01  # the test can see a 3 % error
     assert abs(mean - 1.0) < 5 * se + 5e-4, (mean, se)
+
+
+def test_light_falloff_scales_a_lamp_by_its_distance_to_the_receiver():
+    """A Light Falloff output multiplies a lamp's radiance by d^k (k 1 Linear, 2 Constant) and, with Smooth s,
+    by d² / (s + d²), d from the receiver to the light point (the lamp's centre when none is given); spot cones and
+    falloffs multiply; a lamp without one reads 1, also when a scene built its Lamps without falloff arrays."""
+    from restir_engine.core.lights.table import spot_factor
+    lamps = floor_under_sphere().lamps
+    n = len(lamps.spot_cos)
+    tri = np.zeros(4, np.int64)
+    p = np.array([[0, 0, 0], [3, 0, 1.5], [0, 0, 5.5], [0, 2, 1.5]], np.float32).T  # distances 1.5, 3, 4, 2
+    d = np.float32([1.5, 3, 4, 2])
+    np.testing.assert_allclose(spot_factor(lamps, tri, p), 1.0)
+    for k, s in ((1, 0.0), (2, 0.0), (0, 2.0), (1, 0.5)):
+        lamps.falloff, lamps.falloff_smooth = np.full(n, k, np.float32), np.full(n, s, np.float32)
+        want = d ** k * (d * d / (s + d * d) if s > 0 else 1.0)
+        np.testing.assert_allclose(spot_factor(lamps, tri, p), want, rtol=1e-5)
+        q = np.array([[0, 0, 1.0]] * 4, np.float32).T  # a light point 0.5 below the centre
+        dq = np.linalg.norm(p - q, axis=0)
+        want_q = dq ** k * (dq * dq / (s + dq * dq) if s > 0 else 1.0)
+        np.testing.assert_allclose(spot_factor(lamps, tri, p, q), want_q, rtol=1e-5)

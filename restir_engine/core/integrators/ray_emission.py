@@ -61,7 +61,8 @@ def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
     cos_l = lh.cos_l[sel]
     lamps = ctx.scene.lamps
     le = emitted_radiance(lamps.tris, ctx.scene.materials, prim, lh.u[sel], lh.v[sel])
-    le *= spot_factor(lamps, prim, cols(o, sel)) * (cos_l > 0)
+    os, ds = cols(o, sel), cols(d, sel)
+    le *= spot_factor(lamps, prim, os, os + ds * np.where(np.isfinite(t), t, 0).astype(np.float32)) * (cos_l > 0)
     light = ctx.lights.lamp_to_light[prim]
     pdf = np.where(light >= 0, ctx.lights.pdf_solid_angle(np.maximum(light, 0), cols(o, sel), t, cos_l), 0.0)
     return le, pdf.astype(np.float32)

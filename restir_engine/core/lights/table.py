@@ -83,9 +83,10 @@ def program_emission_density(tris: TriangleSet, materials: MaterialTable) -> tup
     return tri, np.maximum(np.maximum(dens, floor), 1e-12).astype(np.float32)
 
 
-def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Spot cone attenuation (n,) of lamp triangles seen from points p ((3, n) rows; Cycles' smoothstep
-    blend)."""
+def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray, q: np.ndarray | None = None) -> np.ndarray:
+    """Receiver-dependent factor (n,) of lamp triangles' radiance seen from points p ((3, n) rows): the spot cone's
+    attenuation (Cycles' smoothstep blend) times the lamp's Light Falloff, d^k · d² / (s + d²) (the last factor only
+    where s > 0) with d the distance from p to the light point q ((3, n); None: the lamp's centre)."""
     cos_cut = lamps.spot_cos[lamp_tri]
     out = np.ones(len(lamp_tri), np.float32)
     spot = np.flatnonzero(cos_cut > -1.5)
@@ -99,6 +100,15 @@ def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray) -> np.ndarray
         x = np.where(sm > 0, (t - cut) / np.maximum(sm, 1e-12), np.where(t > cut, 1.0, 0.0))
         x = np.clip(x, 0.0, 1.0)
         out[spot] = x * x * (3 - 2 * x)
+    k, s = (a[lamp_tri] for a in lamps.falloff_terms())
+    off = np.flatnonzero((k != 0) | (s > 0))
+    if off.size:
+        tri = lamp_tri[off]
+        at = lamps.spot_center[tri].T if q is None else np.take(q, off, axis=1)
+        d = norm(np.take(p, off, axis=1) - at).astype(np.float32)
+        d2 = d * d
+        f = np.power(d, k[off]) * np.where(s[off] > 0, d2 / np.maximum(s[off] + d2, np.float32(1e-30)), np.float32(1))
+        out[off] *= f.astype(np.float32)
     return out
 
 
@@ -173,7 +183,7 @@ class LightTable:
             self.tri_textured = self.tri_textured | emission_programs(mats)[tri_mat]
         self.any_textured = bool(self.tri_textured.any())
         self.rows_le = np.ascontiguousarray(self.tri_le.T)
-        self.any_spots = bool(len(lamps.tris) and (lamps.spot_cos[l_idx] > -1.5).any())
+        self.any_spots = bool(len(lamps.tris) and lamps.receiver_dependent()[l_idx].any())
         # power (W, luminance-weighted) decides selection; zero-area triangles get zero power
         tri_density = np.concatenate([geom_density[g_idx], mat_power_density[lamps.tris.material[l_idx]]]) \
             if len(tri_mat) else np.zeros(0)
@@ -371,18 +381,20 @@ class LightTable:
             lm = np.flatnonzero(light >= self.n_geom)
             if lm.size:
                 t = self.lamp_ids[light[lm] - self.n_geom]
-                out[:, lm] *= spot_factor(scene.lamps, t, np.take(p_receiver, lm, axis=1))
+                out[:, lm] *= spot_factor(scene.lamps, t, np.take(p_receiver, lm, axis=1),
+                                          self.positions(light[lm], b1[lm], b2[lm]))
         return out
 
     def spot_lamp_tri(self, light: np.ndarray) -> np.ndarray:
-        """Lamp triangle index (n,) int32 of lights with a spot cone, -1 for every other light."""
+        """Lamp triangle index (n,) int32 of lights whose radiance depends on the receiver (a spot cone, a Light
+        Falloff: :func:`spot_factor`), -1 for every other light."""
         out = np.full(len(light), -1, np.int32)
         if not self.any_spots:
             return out
         lm = np.flatnonzero((light >= self.n_geom) & (light < self.n_tri))
         if lm.size:
             t = self.lamp_ids[light[lm] - self.n_geom]
-            spot = self.scene.lamps.spot_cos[t] > -1.5
+            spot = self.scene.lamps.receiver_dependent()[t]
             out[lm[spot]] = t[spot]
         return out
 

@@ -107,7 +107,8 @@ class FrameRenderer:
                 # any change of what emits light (a lamp moved, switched, re-coloured) drops the GI history:
                 # its cached radiance would be stale
                 self.gi_light_key = fingerprint(lights.tri_verts, lights.rows_le, lights.power, lamps.sun_dir,
-                                                lamps.sun_irradiance, self.ctx.scene.world_radiance,
+                                                lamps.sun_irradiance, lamps.falloff, lamps.falloff_smooth,
+                                                self.ctx.scene.world_radiance,
                                                 getattr(self.ctx.scene, "world_image", None))
         self._choose_direct()
         self.space = di.LightSpace(self.ctx.lights)

@@ -342,14 +342,17 @@ class ShadingTerms:
 
 
 def with_spots(pts: PackedPoints, spot_tri: np.ndarray, lamps, receivers: np.ndarray) -> PackedPoints:
-    """``pts`` with the spot-cone attenuation of lamp triangles ``spot_tri`` (same shape as the points,
-    -1 = no cone) towards ``receivers`` ((3, n), broadcasting like the points) applied to the radiance."""
+    """``pts`` with the receiver-dependent factor of lamp triangles ``spot_tri`` (same shape as the points, -1 =
+    none: lights/table.spot_factor, a spot cone and a Light Falloff) towards ``receivers`` ((3, n), broadcasting
+    like the points) applied to the radiance."""
     spot = np.nonzero(spot_tri >= 0)
     if spot[0].size == 0:
         return pts
     rec = np.broadcast_to(receivers, (3,) + spot_tri.shape)
+    at = np.broadcast_to(pts.pos, (3,) + spot_tri.shape)
     le = pts.le.copy()
-    f = spot_factor(lamps, spot_tri[spot], np.stack([rec[i][spot] for i in range(3)]))
+    f = spot_factor(lamps, spot_tri[spot], np.stack([rec[i][spot] for i in range(3)]),
+                    np.stack([at[i][spot] for i in range(3)]))
     for i in range(3):
         le[i][spot] *= f
     return PackedPoints(pts.pos, pts.normal, le, pts.pdf, pts.two_sided)
