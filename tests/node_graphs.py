@@ -262,6 +262,22 @@ def curves(kind):
     return graph
 
 
+def vector_curves():
+    """Vector Curves over Object coordinates scaled to [-0.8, 0.8], a point added to each curve (absolute)."""
+    def graph(tree, socket):
+        m = _node(tree, "ShaderNodeVectorMath", operation="SCALE")
+        _link(tree, _coords(tree, "Object"), m.inputs[0])
+        _set(m, "Scale", 1.6)
+        node = _node(tree, "ShaderNodeVectorCurve")
+        for k, c in enumerate(node.mapping.curves):
+            c.points.new(-0.3 + 0.3 * k, 0.4 - 0.3 * k)
+        node.mapping.update()
+        _in(node, "Fac").default_value = 0.9
+        _link(tree, m.outputs[0], node.inputs["Vector"])
+        _link(tree, _vabs(tree, node.outputs["Vector"]), socket)
+    return graph
+
+
 CONVERTERS = [
     *[(f"ramp {k.lower()}", ramp(k)) for k in ("LINEAR", "CONSTANT", "EASE", "CARDINAL", "B_SPLINE")],
     ("ramp hsv", ramp("LINEAR", "HSV", "FAR")), ("ramp hsl", ramp("LINEAR", "HSL", "CW")),
@@ -281,7 +297,7 @@ CONVERTERS = [
     ("hue saturation", color_node("ShaderNodeHueSaturation", Hue=0.3, Saturation=1.4, Value=0.9, Fac=0.9)),
     ("rgb to bw", color_node("ShaderNodeRGBToBW")),
     ("separate combine hsv", separate_combine("HSV")), ("separate combine hsl", separate_combine("HSL")),
-    ("rgb curves", curves("RGB")), ("float curve", curves("FLOAT")),
+    ("rgb curves", curves("RGB")), ("float curve", curves("FLOAT")), ("vector curves", vector_curves()),
 ]
 
 
@@ -479,6 +495,35 @@ def pass_index(output, value):
     return graph
 
 
+def camera_data(output, tilt=0.6):
+    """Camera Data's View Vector (absolute), or its View Z Depth / View Distance scaled by 0.15, on a tilted plane."""
+    def graph(tree, socket):
+        c = _node(tree, "ShaderNodeCameraData")
+        out = c.outputs[output]
+        if out.type == "VECTOR":
+            out = _vabs(tree, out)
+        else:
+            m = _node(tree, "ShaderNodeMath", operation="MULTIPLY")
+            _link(tree, out, m.inputs[0])
+            m.inputs[1].default_value = 0.15
+            out = m.outputs[0]
+        _link(tree, out, socket)
+    graph.setup = lambda obj: setattr(obj, "rotation_euler", (tilt, 0.5 * tilt, 0))
+    return graph
+
+
+def normal_node(output, direction=(0.3, -0.5, 0.8), tilt=0.7):
+    """The Normal node on a tilted plane: its Dot with the Geometry normal (absolute), or its own direction."""
+    def graph(tree, socket):
+        n = _node(tree, "ShaderNodeNormal")
+        n.outputs["Normal"].default_value = direction
+        _link(tree, _node(tree, "ShaderNodeNewGeometry").outputs["Normal"], n.inputs["Normal"])
+        out = _abs(tree, n.outputs["Dot"]) if output == "Dot" else _vabs(tree, n.outputs["Normal"])
+        _link(tree, out, socket)
+    graph.setup = lambda obj: setattr(obj, "rotation_euler", (tilt, -0.4 * tilt, 0))
+    return graph
+
+
 INPUTS = [
     ("generated", coords("Generated")), ("object", coords("Object", scale=1.5)), ("uv", coords("UV")),
     ("object normal", coords("Normal")), ("reflection", coords("Reflection")),
@@ -498,6 +543,9 @@ INPUTS = [
     ("object index", pass_index("Object Index", 3)), ("material index", pass_index("Material Index", 5)),
     ("light path camera", light_path()),
     ("wireframe", wireframe(0.12, turn=0.3)), ("wireframe pixel size", wireframe(2.0, pixel_size=True, turn=-0.2)),
+    ("camera data view vector", camera_data("View Vector")), ("camera data z depth", camera_data("View Z Depth")),
+    ("camera data distance", camera_data("View Distance", -0.9)),
+    ("normal dot", normal_node("Dot")), ("normal direction", normal_node("Normal")),
 ]
 
 def _vabs(tree, out):

@@ -26,6 +26,21 @@ def _texcoord(g, node, f):
     return out
 
 
+def _camera_data(g, node, f):
+    """Camera Data: the hit in the camera's frame (Texture Coordinate > Camera: x right, y up, +z forward) as a unit
+    View Vector, its View Z Depth (z) and View Distance (length), as Cycles computes them."""
+    if g.camera is None:
+        g.warn(f"'{node.name}' (Camera Data) has no camera here; its outputs are 0")
+        zero = g.constant(0.0, "float")
+        return {"View Vector": g.constant(0.0, "vector"), "View Z Depth": zero, "View Distance": zero}
+    cam = g.emit("camera_coords", {"camera": g.camera}, [g.attribute("position", "vector")], ("vector",))[0]
+    zero_v, zero_f = g.constant(0.0, "vector"), g.constant(0.0, "float")
+    unit = g.emit("vector_math", {"op": "NORMALIZE"}, [cam, zero_v, zero_v, zero_f], ("vector", "float"))[0]
+    length = g.emit("vector_math", {"op": "LENGTH"}, [cam, zero_v, zero_v, zero_f], ("vector", "float"))[1]
+    depth = g.emit("separate", {"mode": "RGB"}, [cam], ("float", "float", "float"))[2]
+    return {"View Vector": unit, "View Z Depth": depth, "View Distance": length}
+
+
 def _tangent(g, node, f):
     if node.direction_type == "UV_MAP":
         g.attribute("tangent_uv", "vector")
@@ -260,6 +275,28 @@ def _rgb_curves(g, node, f):
                             ("color",))[0]}
 
 
+def _vector_curves(g, node, f):
+    """Vector Curves: X, Y and Z each through their curve over the mapping's range (Cycles' curve lookup, as RGB
+    Curves without the combined curve), mixed with the input by Fac."""
+    m = node.mapping
+    tables, rng, extra = _curve_tables(m, list(m.curves)[:3])
+    ins = [g.inp(node, "Fac", "float", f), g.inp(node, "Vector", "vector", f)]
+    return {"Vector": g.emit("rgb_curves", {"tables": tables, "range": rng, "extrapolate": extra}, ins,
+                             ("vector",))[0]}
+
+
+def _normal(g, node, f):
+    """Normal node: its own unit direction, and Dot, that direction against the unit input Normal (as Cycles)."""
+    d = np.array(node.outputs["Normal"].default_value[:3], np.float64)
+    d = d / max(np.linalg.norm(d), 1e-30)
+    direction = g.constant(tuple(float(x) for x in d), "vector")
+    inp = g.inp(node, "Normal", "vector", f)
+    zero_v, zero_f = g.constant(0.0, "vector"), g.constant(0.0, "float")
+    unit = g.emit("vector_math", {"op": "NORMALIZE"}, [inp, zero_v, zero_v, zero_f], ("vector", "float"))[0]
+    dot = g.emit("vector_math", {"op": "DOT_PRODUCT"}, [direction, unit, zero_v, zero_f], ("vector", "float"))[1]
+    return {"Normal": direction, "Dot": dot}
+
+
 def _float_curve(g, node, f):
     m = node.mapping
     tables, rng, extra = _curve_tables(m, [m.curves[0]])
@@ -445,7 +482,8 @@ HANDLERS = {
     "COMBRGB": _combine(("R", "G", "B"), lambda n: "RGB", "Image", "color"),
     "SEPHSV": _separate(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "COMBHSV": _combine(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
-    "VALTORGB": _color_ramp, "CURVE_RGB": _rgb_curves, "CURVE_FLOAT": _float_curve, "TEX_IMAGE": _image,
+    "VALTORGB": _color_ramp, "CURVE_RGB": _rgb_curves, "CURVE_FLOAT": _float_curve, "CURVE_VEC": _vector_curves,
+    "CAMERA": _camera_data, "NORMAL": _normal, "TEX_IMAGE": _image,
     "TEX_ENVIRONMENT": _environment,
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
