@@ -524,6 +524,32 @@ def normal_node(output, direction=(0.3, -0.5, 0.8), tilt=0.7):
     return graph
 
 
+def vector_transform(kind, src, dst, tilt=0.6):
+    """Vector Transform of the Geometry Position (POINT, scaled to about [0, 1]), Incoming (VECTOR) or a constant
+    direction (NORMAL: the inverse transpose of a non-uniform scale shows) on a tilted plane stretched to 0.9 x 0.55
+    (an object transform with a non-uniform scale), absolute."""
+    def graph(tree, socket):
+        t = _node(tree, "ShaderNodeVectorTransform", vector_type=kind, convert_from=src, convert_to=dst)
+        if kind == "NORMAL":
+            t.inputs["Vector"].default_value = (0.6, 0.3, 0.74)
+        else:
+            source = "Position" if kind == "POINT" else "Incoming"
+            _link(tree, _node(tree, "ShaderNodeNewGeometry").outputs[source], t.inputs["Vector"])
+        out = t.outputs["Vector"]
+        if kind == "POINT":
+            m = _node(tree, "ShaderNodeVectorMath", operation="SCALE")
+            _link(tree, out, m.inputs[0])
+            _set(m, "Scale", 1.5 if dst == "OBJECT" else 0.3)
+            out = m.outputs[0]
+        _link(tree, _vabs(tree, out), socket)
+
+    def setup(obj):
+        obj.rotation_euler = (tilt, 0.5 * tilt, 0.3)
+        obj.scale = (0.9, 0.55, 1.0)
+    graph.setup = setup
+    return graph
+
+
 INPUTS = [
     ("generated", coords("Generated")), ("object", coords("Object", scale=1.5)), ("uv", coords("UV")),
     ("object normal", coords("Normal")), ("reflection", coords("Reflection")),
@@ -546,6 +572,10 @@ INPUTS = [
     ("camera data view vector", camera_data("View Vector")), ("camera data z depth", camera_data("View Z Depth")),
     ("camera data distance", camera_data("View Distance", -0.9)),
     ("normal dot", normal_node("Dot")), ("normal direction", normal_node("Normal")),
+    *[(f"vector transform {k.lower()} {a.lower()} {b.lower()}", vector_transform(k, a, b)) for k, a, b in
+      (("POINT", "WORLD", "OBJECT"), ("POINT", "OBJECT", "CAMERA"), ("VECTOR", "WORLD", "CAMERA"),
+       ("VECTOR", "CAMERA", "OBJECT"), ("NORMAL", "WORLD", "OBJECT"), ("NORMAL", "OBJECT", "CAMERA"),
+       ("NORMAL", "OBJECT", "WORLD"))],
 ]
 
 def _vabs(tree, out):

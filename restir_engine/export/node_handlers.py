@@ -41,6 +41,15 @@ def _camera_data(g, node, f):
     return {"View Vector": unit, "View Z Depth": depth, "View Distance": length}
 
 
+def _vector_transform(g, node, f):
+    """Vector Transform: a point, direction or normal between world, object and camera space (core ops_spaces)."""
+    spaces = {node.convert_from, node.convert_to}
+    if "CAMERA" in spaces and g.camera is None:
+        g.warn(f"'{node.name}' (Vector Transform) has no camera here; camera space is taken as world space")
+    params = {"type": node.vector_type, "from": node.convert_from, "to": node.convert_to, "camera": g.camera}
+    return {"Vector": g.emit("vector_transform", params, [g.inp(node, "Vector", "vector", f)], ("vector",))[0]}
+
+
 def _tangent(g, node, f):
     if node.direction_type == "UV_MAP":
         g.attribute("tangent_uv", "vector")
@@ -483,7 +492,7 @@ HANDLERS = {
     "SEPHSV": _separate(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "COMBHSV": _combine(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "VALTORGB": _color_ramp, "CURVE_RGB": _rgb_curves, "CURVE_FLOAT": _float_curve, "CURVE_VEC": _vector_curves,
-    "CAMERA": _camera_data, "NORMAL": _normal, "TEX_IMAGE": _image,
+    "CAMERA": _camera_data, "NORMAL": _normal, "VECT_TRANSFORM": _vector_transform, "TEX_IMAGE": _image,
     "TEX_ENVIRONMENT": _environment,
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,

@@ -65,6 +65,11 @@ class HitAttributes:
         m = objs.world_to_object[inst][:, :, :3].astype(np.float32)  # world -> object; normals go with Mᵀ
         return np.einsum("nji,jn->in", m, np.asarray(n, np.float32)).astype(np.float32)
 
+    def world_to_object(self) -> np.ndarray | None:
+        """(n, 3, 4) float64 world-to-object matrices of the hits' instances; None without instances."""
+        inst, objs = self._instances()
+        return None if inst is None else objs.world_to_object[inst].astype(np.float64)
+
     def __len__(self) -> int:
         return len(self.prim)
 
@@ -208,6 +213,10 @@ class DirectionAttributes:
 
     def __len__(self) -> int:
         return self.dirs.shape[1]
+
+    def world_to_object(self):
+        """None: a world shader has no object (object space is world space)."""
+        return None
 
     def get(self, name: str):
         n = len(self)
