@@ -51,7 +51,7 @@ def test_unbiased_restir_direct_light_matches_cycles(addon, kind):
 def test_restir_gi_matches_cycles(addon, kind):
     """The default integrator with ReSTIR GI (unbiased, 4 spatial passes per sample) converges to Cycles with
     three bounces: the same agreement test (5 SE + 0.5 %) and the same power (able to see a 3 % error)."""
-    assert_matches_cycles(kind, 3, 16, integrator="RESTIR", direct_method="AUTO", indirect_method="RESTIR_GI",
+    assert_matches_cycles(kind, 3, 8, integrator="RESTIR", direct_method="AUTO", indirect_method="RESTIR_GI",
                           bias_correction="UNBIASED")
 
 
