@@ -69,19 +69,34 @@ def test_exposure_temperature_and_node_tree(addon):
     np.testing.assert_allclose(got, base * np.array(em.inputs["Color"].default_value[:3]) * 6.0, rtol=1e-5)
 
 
-@pytest.mark.parametrize("output", ["Quadratic", "Linear"])
+@pytest.mark.parametrize("output", ["Quadratic", "Linear", "Constant"])
 def test_light_falloff(addon, output):
+    """A lamp's Light Falloff: its Strength folds into the power, and the output used (with its Smooth) becomes
+    the lamp's distance factor (scene.Lamps.falloff, applied per receiver: tests/cycles test_light_falloff), with
+    no warning; two falloffs of different kinds are named and the first used."""
+    from restir_engine.export.lights import _lamp_power
     light = _lamp(f"Falloff {output}")
     light.use_nodes = True
     tree = light.node_tree
     em = next(n for n in tree.nodes if n.type == "EMISSION")
     fo = tree.nodes.new("ShaderNodeLightFalloff")
     fo.inputs["Strength"].default_value = 4.0
+    fo.inputs["Smooth"].default_value = 0.5
     tree.links.new(fo.outputs[output], em.inputs["Strength"])
-    got, warns = _power(light)
+    warns, falloff = [], [0, 0.0]
+    got = _lamp_power(light, light.name, warns, falloff)
     np.testing.assert_allclose(got, np.array([10.0, 5.0, 2.5]) * np.array(em.inputs["Color"].default_value[:3]) * 4,
                                rtol=1e-6)
-    assert bool(warns) == (output != "Quadratic")
+    assert not warns
+    assert tuple(falloff) == (("Quadratic", "Linear", "Constant").index(output), 0.5)
+    other = tree.nodes.new("ShaderNodeLightFalloff")
+    mix = tree.nodes.new("ShaderNodeMath")
+    tree.links.new(fo.outputs[output], mix.inputs[0])
+    tree.links.new(other.outputs["Constant" if output != "Constant" else "Linear"], mix.inputs[1])
+    tree.links.new(mix.outputs[0], em.inputs["Strength"])
+    warns, falloff = [], [0, 0.0]
+    _lamp_power(light, light.name, warns, falloff)
+    assert any("mix falloffs" in w for w in warns) and falloff[0] == ("Quadratic", "Linear", "Constant").index(output)
 
 
 @pytest.mark.parametrize("kind", ["POINT", "SPOT", "AREA_DISK", "AREA_RECTANGLE"])

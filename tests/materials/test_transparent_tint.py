@@ -82,3 +82,25 @@ def test_a_filter_under_a_constant_world_tints_the_floor_twice():
     expected = np.square(np.array(RED_FILM, np.float32))
     np.testing.assert_allclose(rgb.reshape(-1, 3).mean(axis=0), expected, rtol=1e-4)
     assert np.abs(rgb - expected).max() < 1e-3
+
+
+def test_a_hit_behind_a_passed_cut_out_lies_on_its_surface():
+    """A ray that passes a transparent point continues from an origin stepped off that surface along its normal;
+    the hit it reports (o + d t from the original origin) must still lie on the surface it hits, not up to the
+    step's size beside it, where the shadow ray's own small offset could not clear it (the floor then shadowed
+    itself: black patches behind alpha cut-outs). A vertical film 6 units from the origin, 45° rays through it to
+    a floor near the origin: the step there is 10x the floor's own offset."""
+    geometry = concat([tris(quad((0, 0, 0), (1, 0, 0), (0, 1, 0)), 0),
+                       tris(quad((-6, 0, 5), (0, 8, 0), (0, 0, 8)), 1)])  # the film: the plane x = -6
+    materials = films([(1.0, 1.0, 1.0)])
+    accel = accel_of(geometry, materials)
+    n = 64
+    rng = np.random.default_rng(3)
+    target = np.vstack([rng.uniform(-0.9, 0.9, (2, n)), np.zeros((1, n))]).astype(np.float32)
+    o = np.repeat(np.array([[-12.0], [0.0], [11.0]], np.float32), n, axis=1)
+    d = target - o
+    d /= np.linalg.norm(d, axis=0)
+    hits = accel.intersect(o, d)
+    assert (geometry.material[hits.prim] == 0).all()  # every ray passed the film and met the floor
+    p = o + d * hits.t
+    assert np.abs(p[2]).max() < 2e-5, np.abs(p[2]).max()  # on the floor (the film's step is 1.2e-3 there)

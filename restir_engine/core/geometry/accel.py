@@ -144,12 +144,31 @@ class Accel:
             sub = self._intersect(o2, dg, far)
             hit = sub.prim >= 0
             hits.prim[go] = sub.prim
-            # t from the original origin: the offset of o2 along the ray counted (its part across the ray moves
-            # the hit by the offset's size, far below a pixel)
+            # t from the original origin: the offset of o2 along the ray counted, then the point o + d t put on the
+            # hit triangle's plane (the offset's part across the ray would leave it up to the offset's size off
+            # the surface, on either side, where a shadow ray's own offset could not clear it)
             along = dot(o2 - p, dg) / np.maximum(dot(dg, dg), np.float32(1e-30))
-            hits.t[go] = np.where(hit, sub.t + t + along, np.inf)
+            t_hit = np.where(hit, sub.t + t + along, np.inf)
+            on = np.flatnonzero(hit)
+            if on.size:
+                t_hit[on] = self._on_plane(sub.prim[on], cols(o, go[on]), cols(dg, on), t_hit[on])
+            hits.t[go] = t_hit
             hits.u[go] = sub.u
             hits.v[go] = sub.v
+
+    def _on_plane(self, prim: np.ndarray, o: np.ndarray, d: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """``t`` (n,) of rays o + d t near triangles ``prim`` moved to where each ray meets its triangle's plane
+        (float64), where the ray is not grazing that plane and the move is within a few offsets; else kept."""
+        ng = cols(self._ng_rows, prim).astype(np.float64)
+        v0 = self.cutout.geometry.verts[prim, 0].T.astype(np.float64)
+        d64 = d.astype(np.float64)
+        den = (d64 * ng).sum(axis=0)
+        dn = np.sqrt((d64 * d64).sum(axis=0))
+        ok = np.abs(den) > 1e-3 * dn
+        tp = ((v0 - o.astype(np.float64)) * ng).sum(axis=0) / np.where(ok, den, 1.0)
+        mag = np.maximum(np.abs(o).max(axis=0), np.abs(v0).max(axis=0))
+        near = np.abs(tp - t) * dn < 1e-2 * np.maximum(mag, 1.0)
+        return np.where(ok & near & (tp > 0), tp, t).astype(np.float32)
 
     def _intersect(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray | None = None) -> Hits:
         n = origins.shape[1]
