@@ -433,6 +433,44 @@ def alpha_scene(size=(96, 64)):
     return scene
 
 
+def _ray_switched(name, color, output, transparent_when):
+    """A Mix of a Diffuse ``color`` and a Transparent BSDF whose factor is Light Path ``output``: transparent to the
+    rays that output marks (``transparent_when`` True) or to every other ray (False)."""
+    mat = bpy.data.materials.new(name)
+    enable_nodes(mat)
+    tree = mat.node_tree
+    tree.nodes.remove(tree.nodes["Principled BSDF"])
+    mix = tree.nodes.new("ShaderNodeMixShader")
+    clear = tree.nodes.new("ShaderNodeBsdfTransparent")
+    body = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    body.inputs["Color"].default_value = (*color, 1)
+    path = tree.nodes.new("ShaderNodeLightPath")
+    tree.links.new(path.outputs[output], mix.inputs["Fac"])
+    first, second = (body, clear) if transparent_when else (clear, body)
+    tree.links.new(first.outputs[0], mix.inputs[1])
+    tree.links.new(second.outputs[0], mix.inputs[2])
+    tree.links.new(mix.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def light_path_scene(size=(96, 64)):
+    """Surfaces that hide from one kind of ray through Light Path: a red plane transparent to shadow rays (seen,
+    casting no shadow) and a blue one transparent to camera rays (unseen, casting its shadow), over a floor in front
+    of a wall, under an area light."""
+    scene = reset()
+    plane("Floor", 8, (0, 0, 0), material=diffuse("Floor", (0.7, 0.7, 0.7)))
+    plane("Wall", 8, (0, 2, 2), (math.pi / 2, 0, 0), material=diffuse("Wall", (0.6, 0.6, 0.5)))
+    plane("NoShadow", 1.4, (-1.0, 0.3, 0.9), (math.pi / 2, 0, 0.3),
+          material=_ray_switched("NoShadow", (0.8, 0.1, 0.1), "Is Shadow Ray", True))
+    plane("Unseen", 1.4, (1.0, 0.3, 0.9), (math.pi / 2, 0, -0.3),
+          material=_ray_switched("Unseen", (0.1, 0.2, 0.8), "Is Camera Ray", True))
+    light("AREA", (0, -1.5, 3.5), (math.radians(35), 0, 0), energy=500.0, size=1.5)
+    camera((0, -4, 1.0), (math.radians(90), 0, 0), lens=30)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene
+
+
 def tinted_scene(size=(96, 64)):
     """Coloured transparency: a plane of a red Transparent BSDF alone, and a plane mixing a Diffuse (0.4) with a
     Transparent BSDF whose Color is a blue-to-yellow gradient along the plane (a per-hit tint), standing on a floor

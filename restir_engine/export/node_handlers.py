@@ -60,14 +60,15 @@ def _tangent(g, node, f):
 
 
 def _light_path(g, node, f):
-    linked = [o.name for o in node.outputs if o.is_linked and o.name not in ("Is Camera Ray", "Ray Length")]
+    linked = [o.name for o in node.outputs
+              if o.is_linked and o.name not in ("Is Camera Ray", "Is Shadow Ray", "Ray Length")]
     if linked:
         g.warn(f"'{node.name}' (Light Path): {', '.join(linked)} approximated (camera hits read as a camera ray, "
                "other hits as a reflection of depth 1)")
     camera = g.attribute("is_camera_ray", "float")
     one_minus = g.emit("one_minus", {}, [camera], ("float",))[0]
     zero = g.constant(0.0, "float")
-    return {"Is Camera Ray": camera, "Is Shadow Ray": zero, "Is Diffuse Ray": one_minus, "Is Glossy Ray": zero,
+    return {"Is Camera Ray": camera, "Is Shadow Ray": g.attribute("is_shadow_ray", "float"), "Is Diffuse Ray": one_minus, "Is Glossy Ray": zero,
             "Is Singular Ray": zero, "Is Reflection Ray": one_minus, "Is Transmission Ray": zero,
             "Is Volume Scatter Ray": zero, "Ray Length": g.attribute("ray_length", "float"),
             "Ray Depth": one_minus, "Diffuse Depth": one_minus, "Glossy Depth": zero, "Transparent Depth": zero,

@@ -96,7 +96,8 @@ class Cutout:
                 a[rows] *= np.where(self.sign[p[rows]] > 0, val, 1 - val)
         rows = np.flatnonzero(self.program[p])
         if rows.size:
-            a[rows] *= self._program_alpha(p[rows], u[sel][rows], v[sel][rows], None if d is None else d[:, sel][:, rows])
+            a[rows] *= self._program_alpha(p[rows], u[sel][rows], v[sel][rows],
+                                           None if d is None else d[:, sel][:, rows], shadow, camera)
         xi = hash_uniform(p ^ SALT, u[sel], v[sel])
         out[sel] = xi < a
         return out
@@ -114,7 +115,7 @@ class Cutout:
 
             def attrs(r):
                 return HitAttributes(self.geometry, prim[rows[r]], u[rows[r]], v[rows[r]], self.textures,
-                                     wo=None if wo is None else wo[:, r])
+                                     wo=None if wo is None else wo[:, r], camera_ray=camera, shadow_ray=shadow)
             for r, got in run_programs(self.materials, mat[rows], attrs, ("transparent_tint",)):
                 if "transparent_tint" in got:
                     out[:, rows[r]] = np.maximum(got["transparent_tint"], 0)
@@ -126,14 +127,15 @@ class Cutout:
         out[:, free] = 1.0
         return out
 
-    def _program_alpha(self, prim, u, v, d) -> np.ndarray:
-        """The node programs' "alpha" (clamped to [0, 1]) at hits on materials that have one."""
+    def _program_alpha(self, prim, u, v, d, shadow: bool = False, camera: bool = False) -> np.ndarray:
+        """The node programs' "alpha" (clamped to [0, 1]) at hits on materials that have one, as the rays that
+        reach them see it (Light Path's Is Shadow Ray / Is Camera Ray: a surface may hide from either)."""
         wo = None if d is None else (-d / np.maximum(norm(d), np.float32(1e-30))).astype(np.float32)
         out = np.ones(len(prim), np.float32)
 
         def attrs(r):
             return HitAttributes(self.geometry, prim[r], u[r], v[r], self.textures,
-                                 wo=None if wo is None else wo[:, r])
+                                 wo=None if wo is None else wo[:, r], camera_ray=camera, shadow_ray=shadow)
         for r, got in run_programs(self.materials, self.geometry.material[prim], attrs, ("alpha",)):
             if "alpha" in got:
                 out[r] = np.clip(got["alpha"], 0, 1)

@@ -4,7 +4,8 @@ World-space vectors are (3, n) float32 rows; normals face the viewer where the v
 exporter's programs read them): "position", "normal" (shading), "true_normal", "incoming" (towards the viewer),
 "backfacing" (1 or 0), "uv" (u, v, 0), "generated" (the object's texture space, [0, 1] over its box),
 "object" (object-space position), "object_normal", "reflection", "parametric", "object_location",
-"object_color", "object_alpha", "object_random", "attr:<name>" / "attr_alpha:<name>" for a colour attribute
+"object_color", "object_alpha", "object_random", "is_camera_ray" / "is_shadow_ray" (1 or 0: Light Path, as the
+ray that reached the point), "attr:<name>" / "attr_alpha:<name>" for a colour attribute
 (RGB and alpha, linear), "tangent_uv" / "tangent_sign" (the UV map's interpolated tangent and bitangent sign, or
 None without tangents) and "footprint" (a pixel's width on the surface, scene units)."""
 from __future__ import annotations
@@ -22,7 +23,7 @@ class HitAttributes:
     ``textures``: the material table's images."""
 
     def __init__(self, tris, prim, b1, b2, textures, wo=None, normal=None, true_normal=None, footprint=None,
-                 camera_ray: bool = False, ray_length=None):
+                 camera_ray: bool = False, ray_length=None, shadow_ray: bool = False):
         self.tris, self.prim = tris, np.asarray(prim, np.intp)
         self.b1, self.b2 = np.asarray(b1, np.float32), np.asarray(b2, np.float32)
         self.textures = textures
@@ -37,6 +38,8 @@ class HitAttributes:
         self._given = {"normal": normal, "true_normal": true_normal, "footprint": footprint}
         self.camera_ray = bool(camera_ray)
         self._cache["is_camera_ray"] = np.full(len(self.prim), _F(1.0 if camera_ray else 0.0), np.float32)
+        self.shadow_ray = bool(shadow_ray)
+        self._cache["is_shadow_ray"] = np.full(len(self.prim), _F(1.0 if shadow_ray else 0.0), np.float32)
         if ray_length is not None:
             self._cache["ray_length"] = np.broadcast_to(np.asarray(ray_length, np.float32), self.b1.shape)
         if footprint is not None:
@@ -55,7 +58,7 @@ class HitAttributes:
         return HitAttributes(self.tris, self.prim, self.b1 + db1, self.b2 + db2, self.textures, wo=self._wo,
                              normal=self.get("normal"), true_normal=self.get("true_normal"),
                              footprint=self.get("footprint"), camera_ray=self.camera_ray,
-                             ray_length=self._cache.get("ray_length"))
+                             ray_length=self._cache.get("ray_length"), shadow_ray=self.shadow_ray)
 
     def object_normal_to_world(self, n) -> np.ndarray:
         """Object-space normals (3, n) in world space (the inverse transpose of each instance's matrix)."""
@@ -232,6 +235,8 @@ class DirectionAttributes:
             return np.full(n, _F(1e-3), np.float32)
         if name == "is_camera_ray":
             return np.full(n, _F(1.0 if self.camera_ray else 0.0), np.float32)
+        if name == "is_shadow_ray":
+            return np.zeros(n, np.float32)
         if name == "ray_length":
             return np.full(n, _F(3.4e38), np.float32)
         if name in {"tangent_uv", "tangent_sign"}:
