@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.materials.textures import NearestImage, UdimImage
+from ..core.materials.textures import MissingImage, NearestImage, UdimImage
 from .images import TEXTURES, srgb_bytes_to_linear, unreadable_file
 from .udim import read_tile, tile_path, unreadable_set
 
@@ -69,7 +69,7 @@ class TextureReader:
             data = self._read_texture(material, image, alpha, luminance)
             TEXTURES.put(kept, data)
         self.texture_index[key] = len(self.textures)
-        self.textures.append(data.view(NearestImage) if closest else data)
+        self.textures.append(data.view(NearestImage) if closest and not isinstance(data, MissingImage) else data)
         return self.texture_index[key]
 
     def _read_udim(self, material, image, alpha: bool, luminance: bool, closest: bool) -> UdimImage | None:
@@ -118,10 +118,10 @@ class TextureReader:
             except (RuntimeError, ValueError):
                 data = None
         if unreadable:
-            return np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+            return MissingImage(MAGENTA)
         if data is None or data.size == 0:
             self._warn(material, f"image '{image.name}' could not be loaded; rendered magenta")
-            return np.array(MAGENTA, np.float32).reshape(1, 1, 3)
+            return MissingImage(MAGENTA)
         return self._converted(material, image, data, alpha, luminance, image.is_float)
 
     def _converted(self, material, image, data: np.ndarray, alpha: bool, luminance: bool, is_float: bool

@@ -225,3 +225,33 @@ def test_principled_sheen_becomes_a_sheen_component_over_the_base(addon):
     sc, _ = _principled_plane(off)
     i = sc.materials.names.index("Wired")
     assert sc.materials.mix_first[i] == -1 and not [w for w in sc.warnings if "Sheen" in w]
+
+
+def test_a_missing_image_reads_magenta_at_every_point(addon):
+    """An Image Texture whose file is gone reads Cycles' magenta (1, 0, 1) at every point, whatever its
+    interpolation and extension and wherever its coordinates fall (before: a 1 x 1 magenta image, which Clip and
+    Linear sampling faded to black toward the plane's edges)."""
+    from bpy_scenes import render_passes
+    from harness.render import configure_restir
+    made = []
+
+    def graph(interpolation, extension):
+        def wire(tree, socket):
+            if not made:
+                image = bpy.data.images.new("Gone", 4, 4)
+                image.source = "FILE"
+                image.filepath = "/nonexistent/gone.png"
+                made.append(image)
+            tex = _node(tree, "ShaderNodeTexImage", image=made[0], interpolation=interpolation, extension=extension)
+            scale = _node(tree, "ShaderNodeVectorMath", operation="SCALE")
+            tree.links.new(_node(tree, "ShaderNodeTexCoord").outputs["UV"], scale.inputs[0])
+            _set(scale, "Scale", 1.7)
+            tree.links.new(scale.outputs[0], tex.inputs["Vector"])
+            tree.links.new(tex.outputs["Color"], socket)
+        return wire
+    cases = [("Linear", "CLIP"), ("Closest", "CLIP"), ("Cubic", "EXTEND"), ("Linear", "REPEAT")]
+    scene = node_planes([graph(i, e) for i, e in cases], len(cases), 16)
+    configure_restir(scene, 2, 0, 0, integrator="PATH")
+    image = render_passes(scene)["Combined"][..., :3]
+    inner = image[3:-3].reshape(10, len(cases), 16, 3)[:, :, 3:-3]  # each plane's inside, away from its edges
+    np.testing.assert_allclose(inner, np.broadcast_to([1.0, 0.0, 1.0], inner.shape), atol=1e-5)

@@ -16,6 +16,19 @@ class NearestImage(np.ndarray):
     """An image sampled with nearest-texel lookups (``array.view(NearestImage)``)."""
 
 
+class MissingImage(np.ndarray):
+    """An image that could not be read: every lookup, at any coordinates, with any interpolation and extension,
+    reads its one texel (magenta), with alpha 1, as Cycles shows a missing image."""
+
+    def __new__(cls, color=MISSING_TILE):
+        return np.array(color, np.float32).reshape(1, 1, 3).view(cls)
+
+
+def missing_lookup(image: np.ndarray, n: int) -> np.ndarray:
+    """(n, c) texels of a :class:`MissingImage`."""
+    return np.repeat(np.asarray(image).reshape(1, -1), n, axis=0).astype(np.float32)
+
+
 class UdimImage(np.ndarray):
     """A UDIM image set: ``tiles`` ((number, (h, w, c) image) per tile; each tile an ordinary image, a NearestImage
     where sampled so). The array itself is the first tile, what code that knows no tiles reads (its size).
@@ -62,6 +75,8 @@ def sample(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
     if isinstance(image, UdimImage):
         return per_tile(image, uv[:, 0], uv[:, 1], lambda t, u, v: sample(t, np.stack([u, v], axis=1)),
                         image.shape[2])
+    if isinstance(image, MissingImage):
+        return missing_lookup(image, len(uv))
     if isinstance(image, NearestImage):
         return sample_nearest(np.asarray(image), uv)
     return sample_bilinear(image, uv)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import noise
-from ..textures import UdimImage, per_tile
+from ..textures import MissingImage, UdimImage, missing_lookup, per_tile
 from .hashing import hash_floats, hash_floats_to_color
 from .ops_math import _dot, _normalize, f32, safe_div
 
@@ -174,6 +174,8 @@ def sample_image(image: np.ndarray, u, v, interpolation: str, extension: str) ->
     if isinstance(image, UdimImage):
         return per_tile(image, np.asarray(u, np.float64), np.asarray(v, np.float64),
                         lambda t, tu, tv: sample_image(np.asarray(t), tu, tv, interpolation, extension), image.shape[2])
+    if isinstance(image, MissingImage):
+        return missing_lookup(image, len(np.atleast_1d(u)))
     h, w = image.shape[:2]
     u = np.where(np.isfinite(u), u, 0).astype(np.float64)
     v = np.where(np.isfinite(v), v, 0).astype(np.float64)
@@ -216,7 +218,8 @@ def image_texture(attrs, params, vector):
         alpha = sample_image(textures[alpha_tex], vec[0], vec[1], interp, ext)[:, 0]
     else:
         alpha = np.ones(len(attrs), np.float32)
-        if ext == "CLIP":  # an image without alpha is opaque inside and transparent outside
+        if ext == "CLIP" and not isinstance(textures[params["tex"]], MissingImage):
+            # an image without alpha is opaque inside and transparent outside
             alpha = sample_image(np.ones((*textures[params["tex"]].shape[:2], 1), np.float32), vec[0], vec[1],
                                  interp, ext)[:, 0]
     return np.ascontiguousarray(color, np.float32), alpha.astype(np.float32)
