@@ -2,6 +2,7 @@
 writes the Sample Count pass when asked for; off, every pixel takes the samples asked for and the pass does not
 exist (no placeholder)."""
 import numpy as np
+import pytest
 
 
 def _cornell(samples: int):
@@ -32,6 +33,7 @@ def test_new_scene_renders_adaptively_with_a_sample_count_pass(addon):
     assert "Sample Count" not in render_passes(scene)
 
 
+@pytest.mark.slow_case  # long: dealt out between the Blenders in CI (tests/conftest.py)
 def test_adaptive_image_agrees_with_uniform_sampling(addon):
     """The box's mean radiance from the adaptive render (Noise Threshold 0.01) against a uniform render of as many
     samples: the lower quadrants of the image (floor and walls; the upper ones hold the lamp's edge, whose pixel

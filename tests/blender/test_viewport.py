@@ -126,6 +126,7 @@ def _final_view_error(core, cam, settings, reference, temporal, steps, seed):
         session.halt()
 
 
+@pytest.mark.slow_case  # long: dealt out between the Blenders in CI (tests/conftest.py)
 def test_temporal_reuse_across_views_lowers_the_error_after_a_move(addon, monkeypatch):
     """A scripted pan (10 views, one pass each, 160x90) over the harness's many-lights street (1000 emitters,
     direct light, ReSTIR DI): the image right after the last move has a lower error (clipped_rel_mse) with the

@@ -93,6 +93,7 @@ def _many_coloured_lights(width=40):
     return Scene(concat(sets), mats, Lamps.empty(), top_down_camera(width, width, height_above=0.3, half_extent=1.2))
 
 
+@pytest.mark.slow_case  # long: dealt out between the Blenders in CI (tests/conftest.py)
 @pytest.mark.parametrize("sampler", ["POWER", "SPATIAL"])
 @pytest.mark.parametrize("method", ["RIS", "RESTIR"])
 def test_tile_candidates_converge_to_the_path_tracer(method, sampler):

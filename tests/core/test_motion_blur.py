@@ -100,6 +100,7 @@ def _columns(images: np.ndarray) -> np.ndarray:
     return images[:, rows].mean(axis=1)
 
 
+@pytest.mark.slow_case  # long: dealt out between the Blenders in CI (tests/conftest.py)
 @pytest.mark.parametrize("integrator", ["PATH", "RESTIR"])
 def test_a_moving_emitter_blurs_as_integrated_over_the_shutter(integrator):
     """Each column's mean (over the square's rows; 16 seeds of 32 passes, strata shorter than the time the square

@@ -16,6 +16,7 @@ METHODS = {"path tracer": dict(integrator="PATH"),
                                       light_candidates=4, spatial_neighbors=3)}
 
 
+@pytest.mark.slow_case  # long: dealt out between the Blenders in CI (tests/conftest.py)
 @pytest.mark.parametrize("method", list(METHODS))
 def test_negative_emitter_subtracts_its_direct_light(method):
     """The floor point under the centre of an emissive square of radiance LE < 0: L = albedo/π · LE · F, negative,

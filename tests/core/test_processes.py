@@ -283,6 +283,7 @@ def test_anisotropic_and_sheen_frames_render_the_same_in_processes():
     _two_frames_agree_in_processes(lambda: _anisotropic_sheen_room(*SIZE))
 
 
+@pytest.mark.slow_case  # long: dealt out between the Blenders in CI (tests/conftest.py)
 def test_subsurface_frames_render_the_same_in_processes():
     """ReSTIR DI + GI (unbiased) over two frames with history where the walls scatter beneath their surface
     (core/integrators/subsurface.py: one walk per camera hit, on the chunk's own random stream): finite, and 2
