@@ -8,6 +8,7 @@ import numpy as np
 
 from .derived_attributes import POINTINESS, RANDOM_PER_ISLAND
 from .node_graph import Reg
+from .node_space_handlers import camera_data, normal, vector_transform
 
 #: samples of a Color Ramp or curve table (Cycles' 257 entries over [0, 1])
 TABLE_SIZE = 257
@@ -24,30 +25,6 @@ def _texcoord(g, node, f):
         out["Camera"] = g.emit("camera_coords", {"camera": g.camera}, [pos], ("vector",))[0]
         out["Window"] = g.emit("window_coords", {"camera": g.camera}, [pos], ("vector",))[0]
     return out
-
-
-def _camera_data(g, node, f):
-    """Camera Data: the hit in the camera's frame (Texture Coordinate > Camera: x right, y up, +z forward) as a unit
-    View Vector, its View Z Depth (z) and View Distance (length), as Cycles computes them."""
-    if g.camera is None:
-        g.warn(f"'{node.name}' (Camera Data) has no camera here; its outputs are 0")
-        zero = g.constant(0.0, "float")
-        return {"View Vector": g.constant(0.0, "vector"), "View Z Depth": zero, "View Distance": zero}
-    cam = g.emit("camera_coords", {"camera": g.camera}, [g.attribute("position", "vector")], ("vector",))[0]
-    zero_v, zero_f = g.constant(0.0, "vector"), g.constant(0.0, "float")
-    unit = g.emit("vector_math", {"op": "NORMALIZE"}, [cam, zero_v, zero_v, zero_f], ("vector", "float"))[0]
-    length = g.emit("vector_math", {"op": "LENGTH"}, [cam, zero_v, zero_v, zero_f], ("vector", "float"))[1]
-    depth = g.emit("separate", {"mode": "RGB"}, [cam], ("float", "float", "float"))[2]
-    return {"View Vector": unit, "View Z Depth": depth, "View Distance": length}
-
-
-def _vector_transform(g, node, f):
-    """Vector Transform: a point, direction or normal between world, object and camera space (core ops_spaces)."""
-    spaces = {node.convert_from, node.convert_to}
-    if "CAMERA" in spaces and g.camera is None:
-        g.warn(f"'{node.name}' (Vector Transform) has no camera here; camera space is taken as world space")
-    params = {"type": node.vector_type, "from": node.convert_from, "to": node.convert_to, "camera": g.camera}
-    return {"Vector": g.emit("vector_transform", params, [g.inp(node, "Vector", "vector", f)], ("vector",))[0]}
 
 
 def _tangent(g, node, f):
@@ -295,18 +272,6 @@ def _vector_curves(g, node, f):
                              ("vector",))[0]}
 
 
-def _normal(g, node, f):
-    """Normal node: its own unit direction, and Dot, that direction against the unit input Normal (as Cycles)."""
-    d = np.array(node.outputs["Normal"].default_value[:3], np.float64)
-    d = d / max(np.linalg.norm(d), 1e-30)
-    direction = g.constant(tuple(float(x) for x in d), "vector")
-    inp = g.inp(node, "Normal", "vector", f)
-    zero_v, zero_f = g.constant(0.0, "vector"), g.constant(0.0, "float")
-    unit = g.emit("vector_math", {"op": "NORMALIZE"}, [inp, zero_v, zero_v, zero_f], ("vector", "float"))[0]
-    dot = g.emit("vector_math", {"op": "DOT_PRODUCT"}, [direction, unit, zero_v, zero_f], ("vector", "float"))[1]
-    return {"Normal": direction, "Dot": dot}
-
-
 def _float_curve(g, node, f):
     m = node.mapping
     tables, rng, extra = _curve_tables(m, [m.curves[0]])
@@ -493,7 +458,7 @@ HANDLERS = {
     "SEPHSV": _separate(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "COMBHSV": _combine(("H", "S", "V"), lambda n: "HSV", "Color", "color"),
     "VALTORGB": _color_ramp, "CURVE_RGB": _rgb_curves, "CURVE_FLOAT": _float_curve, "CURVE_VEC": _vector_curves,
-    "CAMERA": _camera_data, "NORMAL": _normal, "VECT_TRANSFORM": _vector_transform, "TEX_IMAGE": _image,
+    "CAMERA": camera_data, "NORMAL": normal, "VECT_TRANSFORM": vector_transform, "TEX_IMAGE": _image,
     "TEX_ENVIRONMENT": _environment,
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
