@@ -410,21 +410,12 @@ def alpha_scene(size=(96, 64)):
     glass = principled("Veil", (0.2, 0.4, 0.9), roughness=0.6)
     glass.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = 0.4
     plane("Veil", 1.6, (-1.0, 0.5, 0.9), (math.pi / 2, 0, 0.3), material=glass)
-    fence = bpy.data.materials.new("Fence")
-    enable_nodes(fence)
-    tree = fence.node_tree
-    tree.nodes.remove(tree.nodes["Principled BSDF"])
-    mix = tree.nodes.new("ShaderNodeMixShader")
-    clear = tree.nodes.new("ShaderNodeBsdfTransparent")
-    green = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    green.inputs["Color"].default_value = (0.2, 0.8, 0.3, 1)
-    tex = tree.nodes.new("ShaderNodeTexImage")
-    tex.image = bpy.data.images.get("Checker") or checker_image()
-    tex.interpolation = "Closest"
-    tree.links.new(tex.outputs["Color"], mix.inputs["Fac"])
-    tree.links.new(clear.outputs[0], mix.inputs[1])
-    tree.links.new(green.outputs[0], mix.inputs[2])
-    tree.links.new(mix.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
+    def checker(tree):
+        tex = tree.nodes.new("ShaderNodeTexImage")
+        tex.image = bpy.data.images.get("Checker") or checker_image()
+        tex.interpolation = "Closest"
+        return tex.outputs["Color"]
+    fence = see_through("Fence", (0.2, 0.8, 0.3), checker, transparent_at_one=False)
     _with_uvs(plane("Fence", 1.6, (1.0, 0.5, 0.9), (math.pi / 2, 0, -0.3), material=fence))
     light("AREA", (0, -1.5, 3.5), (math.radians(35), 0, 0), energy=500.0, size=1.5)
     camera((0, -4, 1.0), (math.radians(90), 0, 0), lens=30)
@@ -433,9 +424,10 @@ def alpha_scene(size=(96, 64)):
     return scene
 
 
-def _ray_switched(name, color, output, transparent_when):
-    """A Mix of a Diffuse ``color`` and a Transparent BSDF whose factor is Light Path ``output``: transparent to the
-    rays that output marks (``transparent_when`` True) or to every other ray (False)."""
+def see_through(name, color, factor, transparent_at_one):
+    """A material mixing a Diffuse ``color`` and a Transparent BSDF by the socket ``factor(tree)`` returns (nodes it
+    adds to the material's tree): the Transparent BSDF where the factor reads 1 (``transparent_at_one``) or where
+    it reads 0."""
     mat = bpy.data.materials.new(name)
     enable_nodes(mat)
     tree = mat.node_tree
@@ -444,13 +436,17 @@ def _ray_switched(name, color, output, transparent_when):
     clear = tree.nodes.new("ShaderNodeBsdfTransparent")
     body = tree.nodes.new("ShaderNodeBsdfDiffuse")
     body.inputs["Color"].default_value = (*color, 1)
-    path = tree.nodes.new("ShaderNodeLightPath")
-    tree.links.new(path.outputs[output], mix.inputs["Fac"])
-    first, second = (body, clear) if transparent_when else (clear, body)
+    tree.links.new(factor(tree), mix.inputs["Fac"])
+    first, second = (body, clear) if transparent_at_one else (clear, body)
     tree.links.new(first.outputs[0], mix.inputs[1])
     tree.links.new(second.outputs[0], mix.inputs[2])
     tree.links.new(mix.outputs[0], tree.nodes["Material Output"].inputs["Surface"])
     return mat
+
+
+def _ray_switched(name, color, output):
+    """:func:`see_through`, transparent to the rays Light Path ``output`` marks."""
+    return see_through(name, color, lambda tree: tree.nodes.new("ShaderNodeLightPath").outputs[output], True)
 
 
 def light_path_scene(size=(96, 64)):
@@ -461,9 +457,9 @@ def light_path_scene(size=(96, 64)):
     plane("Floor", 8, (0, 0, 0), material=diffuse("Floor", (0.7, 0.7, 0.7)))
     plane("Wall", 8, (0, 2, 2), (math.pi / 2, 0, 0), material=diffuse("Wall", (0.6, 0.6, 0.5)))
     plane("NoShadow", 1.4, (-1.0, 0.3, 0.9), (math.pi / 2, 0, 0.3),
-          material=_ray_switched("NoShadow", (0.8, 0.1, 0.1), "Is Shadow Ray", True))
+          material=_ray_switched("NoShadow", (0.8, 0.1, 0.1), "Is Shadow Ray"))
     plane("Unseen", 1.4, (1.0, 0.3, 0.9), (math.pi / 2, 0, -0.3),
-          material=_ray_switched("Unseen", (0.1, 0.2, 0.8), "Is Camera Ray", True))
+          material=_ray_switched("Unseen", (0.1, 0.2, 0.8), "Is Camera Ray"))
     light("AREA", (0, -1.5, 3.5), (math.radians(35), 0, 0), energy=500.0, size=1.5)
     camera((0, -4, 1.0), (math.radians(90), 0, 0), lens=30)
     black_world(scene)
