@@ -117,6 +117,70 @@ def test_a_stop_keeps_the_finished_passes_and_the_team_goes_on():
     assert np.array_equal(again.passes["Combined"], one.passes["Combined"])
 
 
+STILLS = {  # stills whose passes after the first render one per worker (pipeline/spread.py)
+    "path": RenderSettings(integrator="PATH", samples=7, max_bounces=2, tile_pixels=TILE),
+    "path-batched": RenderSettings(integrator="PATH", samples=9, max_bounces=1, tile_pixels=TILE, sample_batch=2),
+    "restir-di-light-tiles": RenderSettings(integrator="RESTIR", direct_method="RESTIR", samples=7, max_bounces=1,
+                                            tile_pixels=TILE, bias_correction="UNBIASED", light_tiles="ON",
+                                            denoise_data=True),
+    "di-gi": RenderSettings(integrator="RESTIR", direct_method="RESTIR", indirect_method="RESTIR_GI", samples=7,
+                            max_bounces=2, tile_pixels=TILE),
+    "auto": RenderSettings(integrator="RESTIR", direct_method="AUTO", indirect_method="AUTO", samples=7,
+                           max_bounces=2, tile_pixels=TILE),
+}
+
+
+@pytest.mark.parametrize("name", list(STILLS))
+def test_passes_rendered_one_per_worker_give_the_image_one_process_renders(name):
+    """A still's passes after the first go whole to the workers in turn, at the same time; each pixel's samples
+    still reach the film in sample order, so the image is the one process's, bit for bit (any other order of the
+    float32 sums changes the last bits of most pixels)."""
+    settings = STILLS[name]
+    scene = regression_room(*SIZE)
+    alone = render_frame(scene, settings, processes=1)
+    for n in (2, 3):
+        team = render_frame(scene, settings, processes=n)
+        assert team.stats["passes_one_per_process"] >= n, (name, n, team.stats["passes_one_per_process"])
+        assert team.samples_done == alone.samples_done == settings.samples
+        for key, image in alone.passes.items():
+            assert np.array_equal(image, team.passes[key]), (name, n, key)
+        for key in ("gi_skipped_passes", "boiling_dropped", "light_tiles", "indirect_method", "direct_method"):
+            assert team.stats[key] == alone.stats[key], (name, n, key)
+
+
+def test_passes_that_change_the_next_one_are_not_rendered_one_per_worker():
+    """Adaptive sampling reads the film and Auto indirect measures every ReSTIR GI pass: their passes are shared
+    out pass by pass."""
+    scene = regression_room(*SIZE)
+    adaptive = dataclasses.replace(STILLS["path"], use_adaptive_sampling=True, adaptive_min_samples=2)
+    gi_auto = dataclasses.replace(STILLS["auto"], direct_method="RESTIR")
+    for settings in (adaptive, gi_auto):
+        result = render_frame(scene, settings, processes=2)
+        if settings is gi_auto and result.stats["indirect_method"] != "RESTIR_GI":
+            continue  # Auto chose path tracing: its later passes are independent
+        assert result.stats["passes_one_per_process"] == 0
+
+
+def test_a_stop_among_passes_rendered_one_per_worker_keeps_the_first_ones():
+    """Stopped while the workers render passes one each: the film holds the passes committed before the stop (always
+    the first ones, each whole), so the image is one process's image of that many samples."""
+    settings = dataclasses.replace(STILLS["restir-di-light-tiles"], samples=40)
+    scene = regression_room(*SIZE)
+    seen = {}
+
+    def progress(fraction, label):
+        seen["k"] = int(label.split()[1].split("/")[0])
+
+    result = render_frame(scene, settings, progress=progress, should_stop=lambda: seen.get("k", 0) >= 6,
+                          processes=3)
+    assert result.cancelled and 1 <= result.samples_done < settings.samples
+    one = render_frame(scene, dataclasses.replace(settings, samples=result.samples_done), processes=1)
+    for key, image in one.passes.items():
+        assert np.array_equal(image, result.passes[key]), key
+    again = render_frame(scene, STILLS["path"], processes=3)  # the team goes on
+    assert again.stats["passes_one_per_process"] > 0 and not again.cancelled
+
+
 def _segments(team):
     return [s.name for s in team.slot_segs + ([team.film_seg] if team.film_seg is not None else [])]
 
@@ -405,3 +469,26 @@ def test_the_viewport_renders_the_same_views_on_processes_as_in_one():
             assert np.array_equal(u, v), i
     assert processes.borrow(2) is team  # given back, kept idle, lent again
     processes.give_back(team)
+
+
+def test_how_many_passes_render_one_per_worker():
+    """Whole rounds of one pass per worker, and a last partial round only where it keeps 3/4 of them busy (else
+    its passes are shared out: one pass alone on a worker takes the time the team takes for several)."""
+    from restir_engine.core.pipeline.spread import passes_at_once
+    assert passes_at_once(15, 1, 16) == 15  # the demo's F12 after its first pass: one round, one worker idle
+    assert passes_at_once(17, 1, 16) == 16  # the 17th pass is shared out
+    assert passes_at_once(10, 1, 16) == 0
+    assert passes_at_once(15, 1, 2) == 14
+    assert passes_at_once(13, 2, 3) == 6  # 7 passes of 2 samples (the last of 1)
+    assert passes_at_once(1, 1, 2) == 0
+
+
+def test_passes_one_per_worker_only_where_their_working_sets_fit():
+    from restir_engine.core.pipeline.spread import fits, working_set
+    scene = regression_room(*SIZE)
+    st = STILLS["di-gi"]
+    each = working_set(scene, st, "RESTIR", True)
+    assert each > working_set(scene, st, "LIGHT_SAMPLING", False) > 0
+    assert fits(scene, st, "RESTIR", True, 4, free=None)
+    assert fits(scene, st, "RESTIR", True, 4, free=8 * each)
+    assert not fits(scene, st, "RESTIR", True, 4, free=4 * each)

@@ -74,6 +74,8 @@ class WorkerTeam:
         self.barrier = ctx.Barrier(self.size)
         self.stop = ctx.RawValue("b", 0)
         self.progress = ctx.RawValue("d", 0.0)  # the leader's fraction of the pass in flight
+        # the order of the passes that workers render at the same time, one each (team.Independent)
+        self.order = ctx.Array("q", 1 + COST_ENTRIES)
         self.closed = False
         self.slot_segs, self.slot_bytes = [], 0
         self.film_seg = None
@@ -90,7 +92,7 @@ class WorkerTeam:
                 mine, theirs = ctx.Pipe()
                 p = ctx.Process(target=restir_worker_boot.main, name=f"restir-worker-{rank}", daemon=True,
                                 args=(CORE_DIR, rank, self.size, theirs, self.barrier, self.stop, self.progress,
-                                      self.threads))
+                                      self.threads, self.order))
                 p.start()
                 theirs.close()
                 self.conns.append(mine)
@@ -180,6 +182,16 @@ class WorkerTeam:
             if any(r[0] == "stopped" for r in replies):
                 return None
         return [wire.loads(r[1], "restir_core") for r in replies]
+
+    def start_order(self) -> None:
+        """Before the workers render passes at once, one each (team.Independent): none committed, no chunk added."""
+        with self.order.get_lock():
+            np.frombuffer(self.order.get_obj(), np.int64)[:] = 0
+
+    def committed(self) -> int:
+        """How many of the passes rendered at once are in the film (they are always the first ones)."""
+        with self.order.get_lock():
+            return int(self.order[0])
 
     def _died(self, i: int) -> str:
         p = self.procs[i]

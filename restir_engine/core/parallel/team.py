@@ -18,6 +18,7 @@ history) leaves its slot free for the next.
 from __future__ import annotations
 
 import threading
+import time
 
 import numpy as np
 
@@ -50,6 +51,13 @@ class Solo:
 
     def barrier(self) -> None:
         pass
+
+    def commit(self) -> None:
+        """The pass is rendered: from here on it adds to the film whole (nothing to wait for alone)."""
+
+    def in_order(self, add):
+        """``add(chunk)`` as the film's accumulation calls it (alone: as it is)."""
+        return add
 
     def empty(self, shape, dtype) -> np.ndarray:
         return np.empty(shape, dtype)
@@ -145,6 +153,14 @@ class Team:
         """Release every member waiting at (or arriving at) the barrier with Stopped."""
         self._barrier.abort()
 
+    def commit(self) -> None:
+        """The pass is rendered: every member shaded its chunks (a barrier), so the film takes all of the pass."""
+        self.barrier()
+
+    def in_order(self, add):
+        """``add(chunk)`` as the film's accumulation calls it: the members add disjoint chunks of the same pass."""
+        return add
+
     def begin_pass(self, first: bool, chunks: int = 0) -> None:
         """Allocate the coming pass's buffers from the next first-pass slot (``first``) or from the slot of the
         other passes, and assign its ``chunks`` chunks."""
@@ -222,3 +238,48 @@ def assign(chunks: int, size: int, cost: np.ndarray | None) -> np.ndarray:
         owner[i] = m
         load[m] += cost[:, i]
     return owner
+
+
+WAIT_SECONDS = 0.0005  # how often a pass waiting for its turn at the film looks again
+FAILED = 2  # the stop flag's value when a member failed (1: a stop request)
+
+
+class Independent(Solo):
+    """A process rendering a whole sample pass alone while other processes of its team render other passes of the
+    same frame (passes that no earlier pass changes: pipeline/spread.py). Its buffers are private arrays. Its pass is
+    the ``ordinal``-th of those rendered at once (0 first), and adds to the shared film only after the ones before
+    it, so every pixel's sum is added in sample order, as one process adds it (the same image, bit for bit).
+
+    ``order``: a shared int64 array behind ``lock`` (a multiprocessing lock, whose acquire and release also order
+    the film's memory between processes): [0] the passes committed so far, [1 + i] the passes the film's chunk i
+    holds. A pass commits (:meth:`commit`) once every earlier pass has committed, unless a stop request (``stop``, a
+    shared flag) comes first, so the committed passes are always the first ones and each adds all of its chunks;
+    then each chunk is added once the earlier passes added theirs (:meth:`in_order`). A member that fails sets
+    ``stop`` to FAILED, which ends every wait."""
+
+    def __init__(self, ordinal: int, order: np.ndarray, lock, stop):
+        self.ordinal, self.order, self.lock, self.stop = int(ordinal), order, lock, stop
+
+    def _wait(self, index: int, stoppable: bool) -> None:
+        """Until ``order[index]`` counts this pass's ordinal; then (``index`` 0) count it in. A stop request while
+        ``stoppable`` raises Stopped."""
+        while True:
+            with self.lock:
+                if self.order[index] == self.ordinal:
+                    if index == 0:
+                        self.order[0] = self.ordinal + 1
+                    return
+            if self.stop.value == FAILED or (stoppable and self.stop.value):
+                raise Stopped  # a member failed: the frame is lost, nothing waits for its turn
+            time.sleep(WAIT_SECONDS)
+
+    def commit(self) -> None:
+        self._wait(0, stoppable=True)
+
+    def in_order(self, add):
+        def in_turn(chunk):
+            self._wait(1 + chunk.index, stoppable=False)
+            add(chunk)
+            with self.lock:
+                self.order[1 + chunk.index] = self.ordinal + 1
+        return in_turn

@@ -111,9 +111,10 @@ class Film:
                 BUFFERS.put(a)
         self.acc = {}
 
-    def accumulate(self, chunks, resampled: bool, world_to_cam: np.ndarray, stop) -> None:
+    def accumulate(self, chunks, resampled: bool, world_to_cam: np.ndarray, stop, in_order=None) -> None:
         """Add the chunks' results to the running sums (chunks hold disjoint pixels: one pool task each);
-        ``world_to_cam`` (3, 3) float32 turns normals into camera space for the denoising normal."""
+        ``world_to_cam`` (3, 3) float32 turns normals into camera space for the denoising normal; ``in_order(add)``
+        wraps each chunk's addition where other processes add other passes to the same film (parallel/team.py)."""
         flat = {k: a.reshape(len(a) * a.shape[1], -1) if a.ndim == 3 else a.reshape(-1) for k, a in self.acc.items()}
 
         def add(c):
@@ -210,7 +211,7 @@ class Film:
                 add_rows("albedo", denoising_albedo(c.hits.surf))
                 add_rows("dnormal", world_to_cam @ c.hits.surf.facing_normals()[1], tinted=False)
 
-        map_tasks(add, chunks, stop)
+        map_tasks(add if in_order is None else in_order(add), chunks, stop)
 
     def _inverse_counts(self):
         """1 / samples: a scalar, or (h, w) float32 per pixel where each pixel's count is kept."""

@@ -46,6 +46,7 @@ from .shadow_catcher import Catchers, film_mode
 from .work import frame_reservoirs, hand_back, make_chunks, own, place
 
 MAX_BATCH = 8  # samples one pass renders at most (FrameRenderer.batch_size)
+ANY_BATCH = 1 << 30  # samples left when asking FrameRenderer.batch_size for its unbounded choice
 
 
 class Cancelled(Exception):
@@ -163,7 +164,7 @@ class FrameRenderer:
     def gi_auto(self) -> bool:
         return self.indirect.auto
 
-    def _gi_runs(self) -> bool:
+    def gi_runs(self) -> bool:
         """ReSTIR GI runs in the next pass (Auto: while its last measurement says so)."""
         return self.gi is not None and (not self.gi_auto or self.indirect.method == "RESTIR_GI")
 
@@ -219,6 +220,8 @@ class FrameRenderer:
         self.adaptive = AdaptiveSampling(w, h, st.samples, st.adaptive_threshold, st.adaptive_min_samples) \
             if st.use_adaptive_sampling else None
         self._surfaces_per_chunk = None  # surfaces per chunk and sample in the last pass (batch_size)
+        self._settled_batch = None  # the batch of every later pass, once the passes are independent (batch_size)
+        self._sample = None  # the pass to render where it is not the next one (independent_pass)
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
         self.gi_skipped = 0  # samples whose pass kept path-traced indirect light (GI_MIN_SHARE)
         self.reuse_stats = {}  # the last pass's temporal acceptance and confidence (diagnostics)
@@ -313,15 +316,60 @@ class FrameRenderer:
                 self.team.abort()  # the other processes of the team stop at their next barrier
             return False
         self.film.samples += done
+        self._settle()
         return True
+
+    def passes_independent(self) -> bool:
+        """Whether the frame's later passes render the same whatever rendered the passes before them, so that they
+        may render at the same time, each by another process (pipeline/spread.py): the first pass is done (it may
+        reuse a history, probe and choose the methods) and no pass changes what the next one does: no adaptive
+        sampling (it reads the film), no motion blur (each pass poses the scene from the last pose), no Auto
+        indirect choice that measures every pass it runs ReSTIR GI in."""
+        return (self.samples_done > 0 and self.adaptive is None and self.blur is None
+                and not (self.gi_auto and self.gi_runs()))
+
+    def _settle(self) -> None:
+        """Fix the batch of the frame's later passes once they are independent (:meth:`batch_size`)."""
+        if self._settled_batch is None and self.passes_independent():
+            self._settled_batch = self.batch_size(ANY_BATCH)
+
+    def independent_pass(self, sample: int, batch: int, team, should_stop=None, progress=None) -> bool:
+        """Render pass ``sample`` (``batch`` samples) alone, as ``team`` (parallel/team.Independent) orders it into
+        the shared film, while other processes render other passes of the frame (:meth:`passes_independent` must
+        hold); ``progress(fraction)`` as the pass's chunks finish. The film's sample count is left to the caller.
+        Returns False when ``should_stop`` stopped it before it committed (the film then holds none of it)."""
+        saved, self.team, self._sample = self.team, team, int(sample)
+        try:
+            with quiet_float_errors():
+                self._sample_pass(progress, should_stop, batch, None)
+        except Stopped:
+            return False
+        finally:
+            self.team, self._sample = saved, None
+        return True
+
+    def counts(self) -> dict:
+        """The frame's pass counts that its stats report (frame_stats.py), which :meth:`add_counts` adds to."""
+        return {"gi_skipped": self.gi_skipped, "boiling_dropped": self.boiling_dropped,
+                "used_tiles": int(self.used_tiles)}
+
+    def add_counts(self, counts: dict) -> None:
+        """Add another process's :meth:`counts` (of the passes it rendered for this frame)."""
+        self.gi_skipped += int(counts.get("gi_skipped", 0))
+        self.boiling_dropped += int(counts.get("boiling_dropped", 0))
+        self.used_tiles = bool(self.used_tiles or counts.get("used_tiles", 0))
 
     def batch_size(self, remaining: int) -> int:
         """Samples the next pass should render at once (at most ``remaining``): the setting, else as many as bring a
-        chunk to about ``tile_pixels`` surfaces, judged by the last pass (1 before any pass), at most MAX_BATCH."""
+        chunk to about ``tile_pixels`` surfaces, judged by the last pass (1 before any pass), at most MAX_BATCH; once
+        the passes are independent (:meth:`passes_independent`), the choice after the first such pass for the rest of
+        the frame, so that its later passes are the same whatever renders them."""
         st = self.settings
         if not self._can_batch():
             return 1
-        if st.sample_batch > 0:
+        if self._settled_batch is not None:
+            batch = min(remaining, self._settled_batch)
+        elif st.sample_batch > 0:
             batch = max(1, min(remaining, int(st.sample_batch)))
         elif self._surfaces_per_chunk is None:
             return 1
@@ -333,7 +381,7 @@ class FrameRenderer:
         """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
         ReSTIR GI), measures nothing for Auto indirect (no probe; the first pass without a measurement probes) and
         is not motion-blurred (each sample at its own shutter time)."""
-        if self.candidates is not None or self._gi_runs() or self.blur is not None or self.catchers is not None:
+        if self.candidates is not None or self.gi_runs() or self.blur is not None or self.catchers is not None:
             return False
         if self.gi is None or self.samples_done > 0:
             return True
@@ -342,13 +390,13 @@ class FrameRenderer:
     def _plan(self, batch: int, cap) -> PassPlan:
         """The pass's plan (plan.py), after the Auto indirect probe where nothing is measured yet."""
         st, ctx = self.settings, self.ctx
-        s = self.samples_done
+        s = self.samples_done if self._sample is None else self._sample
         if not self._can_batch():
             batch = 1
         if self.gi_auto and s == 0 and not self.indirect.measured:
             with self.clock.stage("probe"):  # nothing measured yet (a still, a first frame): measure before choosing
                 self._measured(self.indirect.probe(ctx, st.seed, self.masks.may_hit, self._make_gi))
-        gi_on = self._gi_runs()
+        gi_on = self.gi_runs()
         probe = self.gi_auto and not gi_on and s == 0 and self.indirect.start_first_pass()
         candidates = self.candidates
         resampled = candidates is not None
@@ -448,11 +496,11 @@ class FrameRenderer:
         with run.stage("shade"):
             run.map_chunks(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c, self.catchers), chunks, 2)
         team.publish_costs()
-        team.barrier()  # every process shaded its chunks: from here on the pass is not stopped (the film takes
-        run.stop.should_stop = None  # all of it or, stopped before, none)
+        team.commit()  # the pass is shaded: from here on it is not stopped (the film takes all of it or, stopped
+        run.stop.should_stop = None  # before, none)
         with run.stage("passes"):
             world_to_cam = np.ascontiguousarray(ctx.scene.camera.cam_to_world[:3, :3].T, dtype=np.float32)
-            self.film.accumulate(mine, plan.resampled, world_to_cam, run.stop)
+            self.film.accumulate(mine, plan.resampled, world_to_cam, run.stop, team.in_order)
         if self.adaptive is not None and self.adaptive.due(plan.sample + plan.batch):
             team.barrier()  # every process's samples are in the film
             self.adaptive.check(self.film, plan.sample + plan.batch)

@@ -15,7 +15,7 @@ import numpy as np
 from ..parallel import wire
 from ..parallel.processes import WorkerTeam
 from ..sampling import finite
-from . import methods
+from . import memory, methods, spread
 from .film import FILM_DTYPE, Film, film_keys
 from .shadow_catcher import catcher_triangles, film_mode
 from .frame import Cancelled, FrameResult
@@ -75,6 +75,29 @@ def shared_film(team: WorkerTeam, scene, settings: RenderSettings) -> tuple[str,
     return name, Film(w, h, gi, settings.denoise_data, zeros, adaptive, group_names, catchers)
 
 
+def _spread(team: WorkerTeam, done: int, count: int, batch: int, samples: int, counts: dict, progress,
+            should_stop) -> tuple[int, bool]:
+    """(samples rendered, whether stopped) of ``count`` independent passes of ``batch`` samples from sample ``done``
+    on, rendered at once, one per worker (spread.py); the workers' pass counts other than the leader's are added to
+    ``counts``. A stop keeps the passes already in the film (the first ones)."""
+    poll = None
+    if progress:
+        def poll():  # the passes in the film, and those in flight as far as the leader is through its own
+            committed = team.committed()
+            flying = min(team.size, count - committed) * team.progress.value
+            k = done + min(samples - done, committed * batch)
+            progress(min(samples, k + flying * batch) / samples, f"Sample {min(k + 1, samples)}/{samples}")
+    team.start_order()
+    replies = team.run(("spread", done, count, batch, samples), should_stop, on_poll=poll)
+    rendered = min(samples, done + team.committed() * batch) - done
+    if replies is None:
+        return rendered, True
+    for r in replies[1:]:
+        for k, v in r.items():
+            counts[k] = counts.get(k, 0) + v
+    return rendered, False
+
+
 def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progress=None, should_stop=None,
                         history=None, clock=None, keep_histories: int = 1, keep_history: bool = True,
                         slot_pixels: int = 0) -> FrameResult:
@@ -97,8 +120,21 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
                                 "costs": team.costs_seg.name, "clock": clock is not None}))
         finally:  # every worker attached (or the team is gone): the name is no longer needed
             wire.unlink_segments([seg])
-        done, cancelled = 0, False
+        done, cancelled, counts, settled, at_once = 0, False, {}, None, 0
         while done < settings.samples and not out_of_time(settings, t0, done):
+            if settled is not None and settings.time_limit <= 0:
+                count = spread.passes_at_once(settings.samples - done, batch, team.size)
+                if count and spread.fits(scene, settings, settled["method"], settled["gi"], team.size,
+                                         memory.available_memory()):
+                    rendered, stopped = _spread(team, done, count, batch, settings.samples, counts, progress,
+                                                should_stop)
+                    done += rendered
+                    at_once += -(-rendered // batch)
+                    if stopped:
+                        cancelled = True
+                        break
+                    settled = None  # the rest (fewer passes than workers) shared out pass by pass
+                    continue
             poll = None
             if progress:
                 label = f"Sample {done + 1}/{settings.samples}"
@@ -113,12 +149,12 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
             if replies is None:
                 cancelled = True
                 break
-            rendered, converged = replies[0][:2]
+            rendered, converged, batch, settled = replies[0][:4]
             done += int(rendered)
             if converged:  # adaptive sampling stopped every pixel
                 break
         token = team.next_token()
-        out = team.run(("finish", token))[0]
+        out = team.run(("finish", token, counts))[0]
         if done == 0:
             raise Cancelled("render cancelled before the first sample pass finished")
         film.samples = done
@@ -128,6 +164,7 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         film.release()
         stats = out["stats"]
         stats["processes"] = team.size
+        stats["passes_one_per_process"] = at_once  # rendered whole by one worker each, at the same time
         if clock is not None and "stages" in stats:
             clock.stages.update(stats["stages"])
         hist = SharedHistory(team.id, token, _view_size(cam)) if out["history"] else None

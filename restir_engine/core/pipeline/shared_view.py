@@ -128,7 +128,7 @@ class SharedViewRenderer:
         replies = self.team.run(("pass", int(batch), int(batch), light_candidate_cap), should_stop)
         if replies is None:
             return False
-        rendered, converged, next_batch = replies[0]
+        rendered, converged, next_batch = replies[0][:3]
         self.film.samples += int(rendered)
         self._converged = bool(converged)
         self._facts["batch"] = next_batch

@@ -12,9 +12,13 @@ Messages (tuples from the rendering process; each is answered with ("ok", pickle
   ("motion", m)     the scene's motion for the next pass's reprojection (FrameRenderer.set_motion)
   ("pass", left[, batch, cap])  render the next sample pass (``batch`` samples, None: at most ``left`` as
                     FrameRenderer.batch_size chooses; at most ``cap`` light candidates); payload: (the samples it
-                    rendered, whether adaptive sampling stopped every pixel, the batch the next pass may render)
+                    rendered, whether adaptive sampling stopped every pixel, the batch the next pass may render,
+                    None or, where the frame's later passes are independent, the methods they render with)
+  ("spread", first, count, batch, end)  render ``count`` independent passes at once, one per worker in turn
+                    (:meth:`_Worker.spread`); payload: the worker's pass counts
   ("data",)         the leader's payload: the data passes (Depth, Normal, Vector) of the current view
-  ("finish", token) end the frame: keep its history under ``token``; the leader's payload: the frame's stats, data
+  ("finish", token[, counts])  end the frame (the other workers' pass ``counts`` added to the leader's): keep
+                    its history under ``token``; the leader's payload: the frame's stats, data
                     passes and whether the film has reservoir passes
   ("end",)          drop the renderer (a viewport session ends)
   ("ping",)         answer once started (the core imported)
@@ -28,18 +32,20 @@ import numpy as np
 
 from ..parallel import wire
 from ..parallel.pool import set_thread_count
-from ..parallel.team import Arena, Team, film_zeros
+from ..parallel.team import FAILED, Arena, Team, film_zeros
 from .film import FILM_DTYPE
+from .frame import ANY_BATCH
 
 KEEP_SCENES = 3  # scene segments a worker keeps attached (a context may still refer to the last frames' arrays)
 KEEP_HISTORIES = 1  # temporal histories a worker keeps by default: the last frame's (a banded frame: one per band)
-ANY_BATCH = 1 << 30  # samples left when asking FrameRenderer.batch_size for its unbounded choice
 
 
 class _Worker:
-    def __init__(self, rank: int, size: int, conn, barrier, stop, progress, threads: int):
+    def __init__(self, rank: int, size: int, conn, barrier, stop, progress, threads: int, order):
         self.rank, self.size, self.conn, self.barrier, self.stop = rank, size, conn, barrier, stop
         self.progress = progress  # the leader's fraction of the pass in flight (a shared double)
+        # the order of passes rendered at once, one per worker (team.Independent), and its lock
+        self.order_lock, self.order = order.get_lock(), np.frombuffer(order.get_obj(), np.int64)
         set_thread_count(max(1, int(threads)))
         self.team = None
         self.slot_names = None
@@ -130,13 +136,38 @@ class _Worker:
                 self.progress.value = fraction
         if not fr.sample_pass(report, self.team.stopping, batch, cap):
             return None
-        return batch, fr.converged, fr.batch_size(ANY_BATCH)
+        settled = {"method": fr.method, "gi": fr.gi_runs()} if fr.passes_independent() else None
+        return batch, fr.converged, fr.batch_size(ANY_BATCH), settled
 
-    def finish(self, token: int):
+    def spread(self, first: int, count: int, batch: int, end: int):
+        """Render ``count`` independent passes of ``batch`` samples from sample ``first`` on (the last one ends at
+        sample ``end`` at most) at the same time as the other workers: the ``j``-th pass by worker ``j`` mod team
+        size, each whole and alone, added to the shared film in sample order (team.Independent). Payload: this
+        worker's pass counts for the frame's stats (FrameRenderer.counts); None when stopped."""
+        from ..parallel.team import Independent
+        fr = self.fr
+        before = fr.counts()
+        report = None
+        if self.team.leader:
+            def report(fraction):
+                self.progress.value = fraction
+        for j in range(self.rank, count, self.size):
+            s = first + j * batch
+            member = Independent(j, self.order, self.order_lock, self.stop)
+            if report is not None:
+                report(0.0)
+            if not fr.independent_pass(s, min(batch, end - s), member, self.team.stopping, report):
+                return None
+        fr.film.samples = min(end, first + count * batch)
+        return {k: v - before[k] for k, v in fr.counts().items()}
+
+    def finish(self, token: int, counts: dict | None = None):
         from .frame_stats import frame_stats
         fr = self.fr
         out = None
         if self.team.leader:
+            if counts:  # what the other workers' independent passes counted (spread)
+                fr.add_counts(counts)
             data = tuple(a for a in fr.data_passes()) if fr.settings.data_passes else None
             out = {"stats": frame_stats(fr, self.scene, self.clock), "data": data,
                    "reservoirs": fr.candidates is not None, "history": fr.history is not None}
@@ -175,15 +206,15 @@ class _Worker:
                 elif kind == "motion":
                     self.fr.set_motion(wire.loads(*msg[1]))
                     out = None
-                elif kind == "pass":
-                    out = self.sample_pass(*msg[1:])
+                elif kind in ("pass", "spread"):
+                    out = self.sample_pass(*msg[1:]) if kind == "pass" else self.spread(*msg[1:])
                     if out is None:
                         self.conn.send(("stopped", None))
                         continue
                 elif kind == "data":
                     out = tuple(self.fr.data_passes()) if self.team.leader else None
                 elif kind == "finish":
-                    out = self.finish(msg[1])
+                    out = self.finish(*msg[1:])
                 elif kind == "end":
                     if self.fr is not None:
                         self.fr.release()
@@ -192,10 +223,11 @@ class _Worker:
                 else:
                     raise ValueError(f"unknown message {kind!r}")
                 self.conn.send(("ok", wire.dumps(out)))
-            except Exception as exc:  # the others must not wait for this one at a barrier
+            except Exception as exc:  # the others must not wait for this one at a barrier or for its turn
+                self.stop.value = FAILED
                 self.barrier.abort()
                 self.conn.send(("error", f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}"))
 
 
-def serve(rank: int, size: int, conn, barrier, stop, progress, threads: int) -> None:
-    _Worker(rank, size, conn, barrier, stop, progress, threads).serve()
+def serve(rank: int, size: int, conn, barrier, stop, progress, threads: int, order) -> None:
+    _Worker(rank, size, conn, barrier, stop, progress, threads, order).serve()
