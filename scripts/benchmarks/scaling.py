@@ -109,12 +109,10 @@ def one(args) -> dict:
                                    data_passes=False)
     if spec.get("tile"):
         settings = dataclasses.replace(settings, tile_pixels=int(spec["tile"]))
-    if args.mode == "processes":
-        pool.set_thread_count(1)
-        procs = cores
-    else:
-        pool.set_thread_count(cores)
-        procs = 1
+    # the thread pool of the rendering process holds N threads either way, as the add-on's with Threads = N (it
+    # turns the film into passes while the workers wait); the workers get N // processes threads each
+    pool.set_thread_count(cores)
+    procs = cores if args.mode == "processes" else 1
     if spec["frames"] == "viewport":
         return _viewport(args, data, settings, procs)
     t0 = time.perf_counter()
