@@ -202,8 +202,9 @@ def _segments(team):
 
 
 @pytest.mark.skipif(not os.path.isdir("/dev/shm"), reason="shared-memory segments are listed in /dev/shm here")
-def test_a_worker_dying_in_a_render_ends_the_team_with_one_error_and_nothing_left_behind():
-    settings = dataclasses.replace(SETTINGS["restir-di-unbiased"], samples=3)
+@pytest.mark.parametrize("samples", [3, 7])  # 7: killed while the workers render passes one each (others wait for
+def test_a_worker_dying_in_a_render_ends_the_team_with_one_error_and_nothing_left_behind(samples):  # its turn)
+    settings = dataclasses.replace(SETTINGS["restir-di-unbiased"], samples=samples)
     scene = regression_room(*SIZE)
     render_frame(scene, settings, processes=3)
     team = processes.team(3)
