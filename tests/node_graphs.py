@@ -278,6 +278,19 @@ def vector_curves():
     return graph
 
 
+def wavelength_node():
+    """Wavelength over Generated X from 350 to 810 nm (black at both ends, outside the visible range)."""
+    def graph(tree, socket):
+        m = _node(tree, "ShaderNodeMapRange")
+        _link(tree, _x_of(tree).outputs["X"], m.inputs["Value"])
+        _set(m, "To Min", 350.0)
+        _set(m, "To Max", 810.0)
+        w = _node(tree, "ShaderNodeWavelength")
+        _link(tree, m.outputs["Result"], w.inputs[0])
+        _link(tree, w.outputs[0], socket)
+    return graph
+
+
 CONVERTERS = [
     *[(f"ramp {k.lower()}", ramp(k)) for k in ("LINEAR", "CONSTANT", "EASE", "CARDINAL", "B_SPLINE")],
     ("ramp hsv", ramp("LINEAR", "HSV", "FAR")), ("ramp hsl", ramp("LINEAR", "HSL", "CW")),
@@ -298,6 +311,7 @@ CONVERTERS = [
     ("rgb to bw", color_node("ShaderNodeRGBToBW")),
     ("separate combine hsv", separate_combine("HSV")), ("separate combine hsl", separate_combine("HSL")),
     ("rgb curves", curves("RGB")), ("float curve", curves("FLOAT")), ("vector curves", vector_curves()),
+    ("wavelength", wavelength_node()),
 ]
 
 

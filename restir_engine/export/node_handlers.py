@@ -413,6 +413,10 @@ def _blackbody(g, node, f):
     return {"Color": g.emit("blackbody", {}, [g.inp(node, "Temperature", "float", f)], ("color",))[0]}
 
 
+def _wavelength(g, node, f):
+    return {"Color": g.emit("wavelength", {}, [g.inp(node, "Wavelength", "float", f)], ("color",))[0]}
+
+
 def _light_falloff(g, node, f):
     """Every output is the Strength; the distance factor of the output used is recorded where the graph is a lamp's
     (``g.falloffs``, a list: the lamp applies it per receiver) and approximated by the physical one elsewhere."""
@@ -462,6 +466,6 @@ HANDLERS = {
     "TEX_ENVIRONMENT": _environment,
     "TEX_NOISE": _noise, "TEX_WHITE_NOISE": _white_noise, "TEX_CHECKER": _checker, "TEX_GRADIENT": _gradient,
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
-    "TEX_BRICK": _brick, "BLACKBODY": _blackbody, "LIGHT_FALLOFF": _light_falloff,
+    "TEX_BRICK": _brick, "BLACKBODY": _blackbody, "WAVELENGTH": _wavelength, "LIGHT_FALLOFF": _light_falloff,
     "AMBIENT_OCCLUSION": _ambient_occlusion, "BEVEL": _bevel, "WIREFRAME": _wireframe,
 }

@@ -368,8 +368,34 @@ def blackbody(attrs, params, temperature):
     return got.reshape(3, 1) if np.ndim(t) == 0 else got
 
 
+_WAVELENGTH = None
+
+
+def _wavelength_table():
+    """(nanometres (n,), rgb (n, 3)) float64: Blender's Wavelength node colours (data/wavelength.json, written by
+    scripts/make_wavelength_table.py), read on first use."""
+    global _WAVELENGTH
+    if _WAVELENGTH is None:
+        import json
+        import os
+        path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data", "wavelength.json")
+        with open(path) as f:
+            data = json.load(f)
+        _WAVELENGTH = np.asarray(data["nanometres"], np.float64), np.asarray(data["rgb"], np.float64)
+    return _WAVELENGTH
+
+
+def wavelength(attrs, params, nanometres):
+    """Wavelength node: the scene-linear Rec.709 colour Blender gives light of ``nanometres`` (its table, linear
+    between whole nanometres; black outside it)."""
+    nm_table, rgb = _wavelength_table()
+    x = np.asarray(nanometres, np.float64)
+    got = np.stack([np.interp(x, nm_table, rgb[:, c], left=0.0, right=0.0) for c in range(3)]).astype(np.float32)
+    return got.reshape(3, 1) if np.ndim(x) == 0 else got
+
+
 OPERATIONS = {
-    "blackbody": blackbody,
+    "blackbody": blackbody, "wavelength": wavelength,
     "math": math, "vector_math": vector_math, "mix_float": mix_float, "mix_vector": mix_vector,
     "mix_color": mix_color, "map_range": map_range, "clamp": clamp, "invert": invert, "gamma": gamma,
     "bright_contrast": bright_contrast, "hue_saturation": hue_saturation, "separate": separate, "combine": combine,
