@@ -467,6 +467,31 @@ def light_path_scene(size=(96, 64)):
     return scene
 
 
+def shadowless_veils_scene(size=(96, 64)):
+    """Principled sheets of Alpha 0.5 whose Material > Transparent Shadows is off (as the glTF importer leaves blended
+    materials), under an area light and a constant grey world: a sheet standing on the floor and an open box over
+    it, in front of a wall. Cycles blocks the lamp's shadow rays at them as if opaque but lights with the constant
+    world through rays that bounce off the surfaces, which pass them as transparent."""
+    scene = reset()
+    plane("Floor", 8, (0, 0, 0), material=diffuse("Floor", (0.7, 0.7, 0.7)))
+    plane("Wall", 8, (0, 2, 2), (math.pi / 2, 0, 0), material=diffuse("Wall", (0.6, 0.6, 0.5)))
+    veil = principled("Veil", (0.2, 0.4, 0.9), roughness=0.6)
+    veil.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = 0.5
+    veil.use_transparent_shadow = False
+    plane("Sheet", 1.4, (-1.0, 0.3, 0.9), (math.pi / 2, 0, 0.3), material=veil)
+    bpy.ops.mesh.primitive_cube_add(size=1.2, location=(1.0, 0.3, 0.6))
+    box = bpy.context.active_object
+    box.data.materials.append(veil)
+    light("AREA", (0, -1.5, 3.5), (math.radians(35), 0, 0), energy=300.0, size=1.5)
+    camera((0, -4, 1.2), (math.radians(85), 0, 0), lens=30)
+    world = bpy.data.worlds.new("Grey")
+    enable_nodes(world)
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.35, 0.35, 0.35, 1)
+    scene.world = world
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene
+
+
 def tinted_scene(size=(96, 64)):
     """Coloured transparency: a plane of a red Transparent BSDF alone, and a plane mixing a Diffuse (0.4) with a
     Transparent BSDF whose Color is a blue-to-yellow gradient along the plane (a per-hit tint), standing on a floor

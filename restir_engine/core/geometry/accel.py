@@ -194,15 +194,18 @@ class Accel:
         run_chunks(work, self._chunks(n))
         return hits
 
-    def occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+    def occluded(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray, shadow: bool = True
+                 ) -> np.ndarray:
         """True where something opaque lies on the segment origin + t*direction, 0 < t < tmax (rays as (3, n)
-        rows). Blocked rays are traced again through cut-out points when there are any."""
+        rows). Blocked rays are traced again through cut-out points when there are any, as shadow rays pass them
+        (``shadow``) or as rays that bounce off surfaces do (not ``shadow``: see :meth:`intersect`)."""
         out = self._occluded(origins, directions, tmax)
         if self.cutout is not None:
             rows = np.flatnonzero(out)
             if rows.size:
                 far = np.ascontiguousarray(tmax, dtype=np.float32)[rows]
-                out[rows] = self.intersect(cols(origins, rows), cols(directions, rows), far, shadow=True).prim >= 0
+                out[rows] = self.intersect(cols(origins, rows), cols(directions, rows), far,
+                                           shadow=shadow).prim >= 0
         return out
 
     @property
@@ -210,19 +213,36 @@ class Accel:
         """Whether rays passing cut-out points may change colour (then shadow rays need :meth:`transmittance`)."""
         return self.cutout is not None and self.cutout.tinted
 
-    def passed(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray):
+    def passed(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray, bounce=None):
         """(the indices of the shadow rays that reach their end, their transmittance (3, k) or None where no cut-out
-        tints light): :meth:`occluded` and :meth:`transmittance` in one, for light to be scaled by what passes."""
+        tints light): :meth:`occluded` and :meth:`transmittance` in one, for light to be scaled by what passes.
+        ``bounce`` (n,) bool or None: the rays that stand for light Cycles gathers with rays bouncing off the
+        surface rather than with shadow rays (a constant world: lights.world.World.lit_by_bounces); they pass
+        cut-outs as such rays do (not ``shadow`` in :meth:`intersect`)."""
+        if bounce is not None and self.cutout is not None and np.any(bounce):
+            sets = [np.flatnonzero(~bounce), np.flatnonzero(bounce)]
+            got = [self._passed(cols(origins, r), cols(directions, r), np.asarray(tmax)[r], shadow=k == 0)
+                   for k, r in enumerate(sets)]
+            keep = np.concatenate([r[kept] for r, (kept, _tr) in zip(sets, got)])
+            order = np.argsort(keep, kind="stable")
+            if all(tr is None for _k, tr in got):
+                return keep[order], None
+            tr = np.concatenate([np.ones((3, len(k)), np.float32) if t is None else t for k, t in got], axis=1)
+            return keep[order], tr[:, order]
+        return self._passed(origins, directions, tmax, True)
+
+    def _passed(self, origins, directions, tmax, shadow: bool):
         if not self.tinted:
-            return np.flatnonzero(~self.occluded(origins, directions, tmax)), None
-        tr = self.transmittance(origins, directions, tmax)
+            return np.flatnonzero(~self.occluded(origins, directions, tmax, shadow)), None
+        tr = self.transmittance(origins, directions, tmax, shadow)
         keep = np.flatnonzero(vmax(tr) > 0)
         return keep, tr[:, keep]
 
-    def transmittance(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray) -> np.ndarray:
+    def transmittance(self, origins: np.ndarray, directions: np.ndarray, tmax: np.ndarray, shadow: bool = True
+                      ) -> np.ndarray:
         """(3, n) float32: the light the segments origin + t*direction, 0 < t < tmax, let through: 0 where
         something opaque lies on them, else the product of the transparent tints of the cut-out points they pass
-        (1 without any)."""
+        (1 without any), passed as shadow rays pass them (``shadow``) or as bouncing rays do."""
         blocked = self._occluded(origins, directions, tmax)
         out = np.ones((3, len(blocked)), np.float32)
         rows = np.flatnonzero(blocked)
@@ -231,7 +251,7 @@ class Accel:
             if self.cutout is None:
                 out[:, rows] = 0.0
                 return out
-            hits = self.intersect(cols(origins, rows), cols(directions, rows), far, shadow=True)
+            hits = self.intersect(cols(origins, rows), cols(directions, rows), far, shadow=shadow)
             if hits.tint is not None:
                 out[:, rows] = hits.tint
             out[:, rows[hits.prim >= 0]] = 0.0

@@ -123,7 +123,7 @@ def world_event(ctx: TraceContext, s: Surface, rng: np.random.Generator, through
     if live.size:
         so, sd, far = shadow_rays(cols(s.p, live), cols(s.ng, live), np.zeros((3, live.size), np.float32),
                                   cols(wi, live), np.full(live.size, np.inf, np.float32))
-        keep, tr = ctx.geom_accel.passed(so, sd, far)
+        keep, tr = ctx.geom_accel.passed(so, sd, far, np.full(live.size, ctx.world.lit_by_bounces))
         live = live[keep]
         out[:, live] = finite(cols(contrib, live) if tr is None else cols(contrib, live) * tr)
     grouped = bool(taps or taps_d) and live.size > 0

@@ -34,6 +34,10 @@ class World:
             self.camera_view = World(camera_view[0], camera_view[1], rotation)
         self.color = np.asarray(color, np.float32).reshape(3)
         self.image = None if image is None else np.ascontiguousarray(image, np.float32)
+        # Cycles lights a surface with a constant world through the rays that bounce off it (its Auto sampling
+        # method does not light-sample such a world), so that light passes cut-outs as those rays do: also through
+        # materials whose Transparent Shadows setting is off (geometry/accel.Accel.passed)
+        self.lit_by_bounces = self.image is None
         self.rotation = None if rotation is None else np.asarray(rotation, np.float32)
         if self.image is None:
             self.mean = self.color

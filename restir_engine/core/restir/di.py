@@ -249,7 +249,7 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator, sums=None) -> 
     out = np.zeros((3, n), np.float32)
     lights = ctx.lights
     live = res.has_sample() & (res.W > 0)
-    rays = []  # (rows, contributions, origins, directions, tmax): one Embree call for both kinds
+    rays = []  # (rows, contributions, groups, bounce, origins, directions, tmax): one Embree call for both kinds
     if live.any():  # every row at once (empty reservoirs contribute zero): no row subsets to copy
         q, wi, dist, cos_l, le = lights.point_towards(np.maximum(res.light, 0), res.b1, res.b2, surf.p)
         _p, f, g, _pb = shading_value(surf, wi, le, dist, cos_l)
@@ -258,8 +258,11 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator, sums=None) -> 
         go = np.flatnonzero(vmax(np.abs(contrib)) > 0)
         if go.size:
             group = None if groups is None else groups.of_lights(res.light[go], reservoirs=True)
-            rays.append((go, cols(contrib, go), group, *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(q, go),
-                                                                    cols(wi, go), dist[go])))
+            bounce = np.zeros(go.size, bool)  # world points whose light passes cut-outs as bouncing rays do
+            if ctx.world.lit_by_bounces:
+                bounce[lights.env_rows(res.light[go])] = True
+            rays.append((go, cols(contrib, go), group, bounce, *shadow_rays(cols(surf.p, go), cols(surf.ng, go),
+                                                                            cols(q, go), cols(wi, go), dist[go])))
     if lights.sun_alias is not None:
         ls = lights.sample_suns(n, rng.random((4, n), dtype=np.float32))
         wi_l = to_local(ls.wi, surf.ns, surf.t, surf.bt)
@@ -270,13 +273,14 @@ def shade(ctx, surf, res: DIReservoirs, rng: np.random.Generator, sums=None) -> 
         go = np.flatnonzero(vmax(np.abs(contrib)) > 0)
         if go.size:
             group = None if groups is None else groups.of_lights(ls.light[go])
-            rays.append((go, cols(contrib, go), group, *shadow_rays(cols(surf.p, go), cols(surf.ng, go),
-                                                                    cols(ls.pos, go), cols(ls.wi, go), ls.dist[go])))
+            rays.append((go, cols(contrib, go), group, np.zeros(go.size, bool),
+                         *shadow_rays(cols(surf.p, go), cols(surf.ng, go), cols(ls.pos, go), cols(ls.wi, go),
+                                      ls.dist[go])))
     if rays:
-        o = np.concatenate([r[3] for r in rays], axis=1)
-        d = np.concatenate([r[4] for r in rays], axis=1)
-        far = np.concatenate([r[5] for r in rays])
-        keep, tr = ctx.geom_accel.passed(o, d, far)
+        o = np.concatenate([r[4] for r in rays], axis=1)
+        d = np.concatenate([r[5] for r in rays], axis=1)
+        far = np.concatenate([r[6] for r in rays])
+        keep, tr = ctx.geom_accel.passed(o, d, far, np.concatenate([r[3] for r in rays]))
         visible = np.zeros(len(far), bool)
         visible[keep] = True
         if tr is not None:  # coloured transparent surfaces on the way: the light they let through
