@@ -346,7 +346,25 @@ class MaterialRegistry(MixShaderReader, NormalReader, TextureReader):
         if "Alpha" in inp:
             self._alpha(material, inp["Alpha"], row, g, varying)
         self._normal(material, node, row, g, varying)
+        self._unmodelled_principled(material, node)
         return self._with_program(row, g, varying)
+
+    def _unmodelled_principled(self, material, node) -> None:
+        """Name the Principled BSDF's inputs that are set but not rendered: Thin Film (iridescence), Thin Wall,
+        Dispersion (where the Blender version has them)."""
+        inp = node.inputs
+
+        def set_(name, off=0.0):
+            sock = inp.get(name)
+            return sock is not None and (sock.is_linked or float(sock.default_value) != off)
+        if set_("Thin Film Thickness"):
+            self._warn(material, f"'{node.name}' (Principled) Thin Film is not supported and was ignored (no "
+                       "iridescence)")
+        if set_("Thin Wall"):
+            self._warn(material, f"'{node.name}' (Principled) Thin Wall is not supported: rendered as a solid")
+        if set_("Dispersion"):
+            self._warn(material, f"'{node.name}' (Principled) Dispersion is not supported: one IOR for every "
+                       "colour")
 
     def _anisotropy(self, material, node, row: dict, g: GraphCompiler, varying: dict, amount: str,
                     rotation: str) -> None:

@@ -255,3 +255,22 @@ def test_a_missing_image_reads_magenta_at_every_point(addon):
     image = render_passes(scene)["Combined"][..., :3]
     inner = image[3:-3].reshape(10, len(cases), 16, 3)[:, :, 3:-3]  # each plane's inside, away from its edges
     np.testing.assert_allclose(inner, np.broadcast_to([1.0, 0.0, 1.0], inner.shape), atol=1e-5)
+
+
+def test_principled_inputs_not_rendered_are_named(addon):
+    """Thin Film and Thin Wall (and Dispersion where the Blender version has it), set on a Principled BSDF, are named
+    in one warning each; left at their defaults they are not."""
+    def plain(tree, bsdf):
+        pass
+
+    def wire(tree, bsdf):
+        bsdf.inputs["Thin Film Thickness"].default_value = 400.0
+        if "Thin Wall" in bsdf.inputs:
+            bsdf.inputs["Thin Wall"].default_value = True
+    sc, _ = _principled_plane(plain)
+    assert not [w for w in sc.warnings if "Thin" in w]
+    sc, _ = _principled_plane(wire)
+    named = [w for w in sc.warnings if "Wired" in w and "Thin" in w]
+    assert any("Thin Film" in w for w in named), sc.warnings
+    assert any("Thin Wall" in w for w in named) or "Thin Wall" not in bpy.data.materials["Wired"].node_tree.nodes[
+        "Principled BSDF"].inputs
