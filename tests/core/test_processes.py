@@ -127,6 +127,9 @@ STILLS = {  # stills whose passes after the first render one per worker (pipelin
                             max_bounces=2, tile_pixels=TILE),
     "auto": RenderSettings(integrator="RESTIR", direct_method="AUTO", indirect_method="AUTO", samples=5,
                            max_bounces=2, tile_pixels=TILE),
+    # adaptive sampling: checks after samples 16 and 32 stop pixels; the passes between them render one per worker
+    "adaptive": RenderSettings(integrator="PATH", samples=40, max_bounces=1, tile_pixels=TILE,
+                               use_adaptive_sampling=True, adaptive_threshold=0.05, adaptive_min_samples=2),
 }
 
 
@@ -165,16 +168,25 @@ def test_the_order_of_the_film_sums_matters_to_the_test():
 
 
 def test_passes_that_change_the_next_one_are_not_rendered_one_per_worker():
-    """Adaptive sampling reads the film and Auto indirect measures every ReSTIR GI pass: their passes are shared
-    out pass by pass."""
+    """Auto indirect measures every ReSTIR GI pass and motion blur poses each pass from the last: their passes are
+    shared out pass by pass; adaptive sampling's check passes too (spread.samples_at_once)."""
+    from restir_engine.core.pipeline.frame import FrameRenderer
+    from restir_engine.core.pipeline.spread import samples_at_once
     scene = regression_room(*SIZE)
-    adaptive = dataclasses.replace(STILLS["path"], use_adaptive_sampling=True, adaptive_min_samples=2)
-    gi_auto = dataclasses.replace(STILLS["auto"], direct_method="RESTIR")
-    for settings in (adaptive, gi_auto):
-        result = render_frame(scene, settings, processes=2)
-        if settings is gi_auto and result.stats["indirect_method"] != "RESTIR_GI":
-            continue  # Auto chose path tracing: its later passes are independent
-        assert result.stats["passes_one_per_process"] == 0
+    fr = FrameRenderer(scene, dataclasses.replace(STILLS["auto"], direct_method="RESTIR"), keep_history=False)
+    assert not fr.passes_independent()  # before the first pass
+    assert fr.sample_pass() and fr.gi_auto
+    for method, independent in (("RESTIR_GI", False), ("PATH", True)):  # what Auto chose after the first pass
+        fr.indirect.method = method
+        assert fr.passes_independent() == independent
+    blurred = FrameRenderer(scene, STILLS["path"], keep_history=False)
+    assert blurred.sample_pass() and blurred.passes_independent()
+    blurred.blur = object()  # a scene whose objects move in the shutter
+    assert not blurred.passes_independent()
+    assert samples_at_once(39, 1, 1, None) == 39
+    assert samples_at_once(39, 1, 1, 16) == 14  # samples 1..14; sample 15 (the 16th) renders with the check
+    assert samples_at_once(39, 1, 4, 16) == 12  # whole passes of 4 that end before the check's pass
+    assert samples_at_once(39, 17, 1, 16) == 0
 
 
 def test_a_stop_among_passes_rendered_one_per_worker_keeps_the_first_ones():

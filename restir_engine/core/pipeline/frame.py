@@ -320,18 +320,23 @@ class FrameRenderer:
         return True
 
     def passes_independent(self) -> bool:
-        """Whether the frame's later passes render the same whatever rendered the passes before them, so that they
+        """Whether the frame's next passes render the same whatever rendered the passes before them, so that they
         may render at the same time, each by another process (pipeline/spread.py): the first pass is done (it may
-        reuse a history, probe and choose the methods) and no pass changes what the next one does: no adaptive
-        sampling (it reads the film), no motion blur (each pass poses the scene from the last pose), no Auto
-        indirect choice that measures every pass it runs ReSTIR GI in."""
-        return (self.samples_done > 0 and self.adaptive is None and self.blur is None
-                and not (self.gi_auto and self.gi_runs()))
+        reuse a history, probe and choose the methods) and no pass changes what the next one does: no motion blur
+        (each pass poses the scene from the last pose), no Auto indirect choice that measures every pass it runs
+        ReSTIR GI in. Adaptive sampling changes the passes only at its checks (:meth:`independent_until`)."""
+        return self.samples_done > 0 and self.blur is None and not (self.gi_auto and self.gi_runs())
+
+    def independent_until(self) -> int | None:
+        """The sample count after which adaptive sampling's next check reads the film (None: no check is left):
+        the independent passes end before the pass that reaches it, which renders with the check."""
+        return None if self.adaptive is None else self.adaptive.next_check(self.samples_done)
 
     def _settle(self) -> None:
-        """Fix the batch of the frame's later passes once they are independent (:meth:`batch_size`)."""
+        """Fix the batch of the frame's later passes once they are independent (:meth:`batch_size`; chosen again
+        after each adaptive check, whose active pixels fill the chunks otherwise)."""
         if self._settled_batch is None and self.passes_independent():
-            self._settled_batch = self.batch_size(ANY_BATCH)
+            self._settled_batch = self._uncapped_batch(ANY_BATCH) if self._can_batch() else 1
 
     def independent_pass(self, sample: int, batch: int, team, should_stop=None, progress=None) -> bool:
         """Render pass ``sample`` (``batch`` samples) alone, as ``team`` (parallel/team.Independent) orders it into
@@ -364,18 +369,21 @@ class FrameRenderer:
         chunk to about ``tile_pixels`` surfaces, judged by the last pass (1 before any pass), at most MAX_BATCH; once
         the passes are independent (:meth:`passes_independent`), the choice after the first such pass for the rest of
         the frame, so that its later passes are the same whatever renders them."""
-        st = self.settings
         if not self._can_batch():
             return 1
-        if self._settled_batch is not None:
-            batch = min(remaining, self._settled_batch)
-        elif st.sample_batch > 0:
-            batch = max(1, min(remaining, int(st.sample_batch)))
-        elif self._surfaces_per_chunk is None:
-            return 1
-        else:
-            batch = max(1, min(remaining, MAX_BATCH, int(st.tile_pixels // max(self._surfaces_per_chunk, 1.0))))
+        batch = self._uncapped_batch(remaining)
         return batch if self.adaptive is None else self.adaptive.cap(self.samples_done, batch)
+
+    def _uncapped_batch(self, remaining: int) -> int:
+        """:meth:`batch_size` before adaptive sampling cuts it at its next check."""
+        st = self.settings
+        if self._settled_batch is not None:
+            return min(remaining, self._settled_batch)
+        if st.sample_batch > 0:
+            return max(1, min(remaining, int(st.sample_batch)))
+        if self._surfaces_per_chunk is None:
+            return 1
+        return max(1, min(remaining, MAX_BATCH, int(st.tile_pixels // max(self._surfaces_per_chunk, 1.0))))
 
     def _can_batch(self) -> bool:
         """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
@@ -504,6 +512,7 @@ class FrameRenderer:
         if self.adaptive is not None and self.adaptive.due(plan.sample + plan.batch):
             team.barrier()  # every process's samples are in the film
             self.adaptive.check(self.film, plan.sample + plan.batch)
+            self._settled_batch = None  # the active pixels changed: the batch is chosen again
         return plan.batch
 
     def _gi_outcome(self, plan: PassPlan, chunks) -> bool:

@@ -75,21 +75,22 @@ def shared_film(team: WorkerTeam, scene, settings: RenderSettings) -> tuple[str,
     return name, Film(w, h, gi, settings.denoise_data, zeros, adaptive, group_names, catchers)
 
 
-def _spread(team: WorkerTeam, done: int, count: int, batch: int, samples: int, counts: dict, progress,
-            should_stop) -> tuple[int, bool]:
+def _spread(team: WorkerTeam, done: int, count: int, batch: int, end: int, counts: dict, progress,
+            should_stop, samples: int) -> tuple[int, bool]:
     """(samples rendered, whether stopped) of ``count`` independent passes of ``batch`` samples from sample ``done``
-    on, rendered at once, one per worker (spread.py); the workers' pass counts other than the leader's are added to
-    ``counts``. A stop keeps the passes already in the film (the first ones)."""
+    on (the last one ends at sample ``end`` at most; the frame has ``samples``), rendered at once, one per worker
+    (spread.py); the workers' pass counts other than the leader's are added to ``counts``. A stop keeps the passes
+    already in the film (the first ones)."""
     poll = None
     if progress:
         def poll():  # the passes in the film, and those in flight as far as the leader is through its own
             committed = team.committed()
             flying = min(team.size, count - committed) * team.progress.value
-            k = done + min(samples - done, committed * batch)
-            progress(min(samples, k + flying * batch) / samples, f"Sample {min(k + 1, samples)}/{samples}")
+            k = done + min(end - done, committed * batch)
+            progress(min(end, k + flying * batch) / samples, f"Sample {min(k + 1, samples)}/{samples}")
     team.start_order()
-    replies = team.run(("spread", done, count, batch, samples), should_stop, on_poll=poll)
-    rendered = min(samples, done + team.committed() * batch) - done
+    replies = team.run(("spread", done, count, batch, end), should_stop, on_poll=poll)
+    rendered = min(end, done + team.committed() * batch) - done
     if replies is None:
         return rendered, True
     for r in replies[1:]:
@@ -123,11 +124,12 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         done, cancelled, counts, settled, at_once = 0, False, {}, None, 0
         while done < settings.samples and not out_of_time(settings, t0, done):
             if settled is not None and settings.time_limit <= 0:
-                count = spread.passes_at_once(settings.samples - done, batch, team.size)
+                left = spread.samples_at_once(settings.samples - done, done, batch, settled["until"])
+                count = spread.passes_at_once(left, batch, team.size)
                 if count and spread.fits(scene, settings, settled["method"], settled["gi"], team.size,
                                          memory.available_memory()):
-                    rendered, stopped = _spread(team, done, count, batch, settings.samples, counts, progress,
-                                                should_stop)
+                    rendered, stopped = _spread(team, done, count, batch, done + left, counts, progress,
+                                                should_stop, settings.samples)
                     done += rendered
                     at_once += -(-rendered // batch)
                     if stopped:

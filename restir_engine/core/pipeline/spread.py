@@ -19,6 +19,15 @@ FILL = 0.75  # a last, partial round of passes is rendered one per worker only w
 MEMORY_SHARE = 0.75  # of the memory available, the share the workers' own pass working sets may take
 
 
+def samples_at_once(left: int, done: int, batch: int, until: int | None) -> int:
+    """Of the ``left`` samples after the ``done`` ones, those whose passes (``batch`` samples each) may render at
+    once: all of them, or with adaptive sampling's next check after sample ``until``, the whole passes that end
+    before the pass that reaches it (that one renders with the check, its batch cut to end there)."""
+    if until is None:
+        return int(left)
+    return max(0, min(int(left), (int(until) - 1 - int(done)) // max(1, int(batch)) * int(batch)))
+
+
 def passes_at_once(left: int, batch: int, workers: int) -> int:
     """How many of the passes that render the ``left`` samples (``batch`` each, the last one fewer) to render at
     once, one per worker in turn: whole rounds of ``workers`` passes, and a last partial round where it fills at

@@ -13,7 +13,8 @@ Messages (tuples from the rendering process; each is answered with ("ok", pickle
   ("pass", left[, batch, cap])  render the next sample pass (``batch`` samples, None: at most ``left`` as
                     FrameRenderer.batch_size chooses; at most ``cap`` light candidates); payload: (the samples it
                     rendered, whether adaptive sampling stopped every pixel, the batch the next pass may render,
-                    None or, where the frame's later passes are independent, the methods they render with)
+                    None or, where the frame's next passes are independent, the methods they render with and the
+                    sample count of adaptive sampling's next check, which ends them)
   ("spread", first, count, batch, end)  render ``count`` independent passes at once, one per worker in turn
                     (:meth:`_Worker.spread`); payload: the worker's pass counts
   ("data",)         the leader's payload: the data passes (Depth, Normal, Vector) of the current view
@@ -136,7 +137,8 @@ class _Worker:
                 self.progress.value = fraction
         if not fr.sample_pass(report, self.team.stopping, batch, cap):
             return None
-        settled = {"method": fr.method, "gi": fr.gi_runs()} if fr.passes_independent() else None
+        settled = {"method": fr.method, "gi": fr.gi_runs(), "until": fr.independent_until()} \
+            if fr.passes_independent() else None
         return batch, fr.converged, fr.batch_size(ANY_BATCH), settled
 
     def spread(self, first: int, count: int, batch: int, end: int):
