@@ -44,6 +44,8 @@ RUNS = [
     ("interior_gi DI+GI", "interior_gi", dict(integrator="RESTIR", direct_method="RESTIR",
                                               indirect_method="RESTIR_GI", max_bounces=4), 1, 4),
     ("demo F12 16 spp", "demo", {}, 16, 1),
+    ("many_lights F12 ReSTIR DI 8 spp", "many_lights", dict(integrator="RESTIR", direct_method="RESTIR",
+                                                             max_bounces=0), 8, 1),
     # the viewport's renderer (FrameRenderer in one process with N threads, SharedViewRenderer on N processes):
     # VIEW_MOVES full-resolution views panned one after the other (one pass each, the last view's history
     # reprojected, the navigation candidate cap), then VIEW_REFINE samples refining the last view
