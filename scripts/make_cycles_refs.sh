@@ -11,5 +11,7 @@ status=0
 for ver in "${versions[@]}"; do
   venv=$(scripts/setup_venv.sh "$ver")
   RESTIR_CYCLES_REFS=update "$venv/bin/python" -m pytest -q -m cycles tests "$@" || status=1
+  # tests outside tests/cycles that compare with a stored Cycles image
+  RESTIR_CYCLES_REFS=update "$venv/bin/python" -m pytest -q tests/blender/test_denoise.py "$@" || status=1
 done
 exit $status

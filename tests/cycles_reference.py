@@ -3,7 +3,8 @@
 A comparison reduces each of REPS independent Cycles renders (seeds 0..REPS-1) of a test scene to per-cell means
 ((REPS, cells): image blocks, spheres, floor cells); those per-seed cell means are all the statistics need (the
 Welch z-scores and standard errors in tests/stats.py), so they are what is stored: one JSON file per case in
-``tests/data/cycles/bpy-<major.minor>/``, with the seeds, samples, bounces, the bpy version that rendered them and a
+``tests/data/cycles/bpy-<major.minor>/`` (a test that needs Cycles' image itself, per pixel, stores it as float16 in
+an .npz beside them: :func:`cycles_image`), with the seeds, samples, bounces, the bpy version that rendered them and a
 fingerprint of the Blender scene Cycles was given (geometry, transforms, materials' node trees, lights, world,
 images, camera, resolution and Cycles' own settings). A test whose scene no longer has that fingerprint fails and
 says how to render the reference again, so stored data cannot silently go stale.
@@ -206,3 +207,32 @@ def cycles_cells(case: str, build, configure, render, reduce, reps: int, samples
             json.dump(data, f, indent=1)
             f.write("\n")
     return cells
+
+
+def cycles_image(case: str, scene, render, samples: int, bounces: int) -> np.ndarray:
+    """(h, w, 3) float32 image of ``scene`` (already set up for Cycles) that ``render(scene)`` gives, from the stored
+    reference of ``case`` (float16, ``tests/data/cycles/bpy-<series>/<case>.npz``, with the scene's fingerprint) or
+    rendered (see the module docstring). Float16 keeps a relative 5e-4 per pixel: for comparisons of image errors,
+    not of means to that precision."""
+    fingerprint = scene_fingerprint(scene)
+    how = mode()
+    path = _path(case)[:-len(".json")] + ".npz"
+    meta = {"case": case, "samples": samples, "bounces": bounces, "fingerprint": fingerprint}
+    if how == "stored":
+        if not os.path.exists(path):
+            raise StaleReference(f"no stored Cycles reference {os.path.relpath(path)}: render it with "
+                                 f"scripts/make_cycles_refs.sh (or run with RESTIR_CYCLES_REFS=render)")
+        with np.load(path) as data:
+            stored = json.loads(str(data["meta"]))
+            image = data["image"].astype(np.float32)
+        diff = sorted(k for k in meta if stored.get(k) != meta[k])
+        if diff:
+            raise StaleReference(f"the stored Cycles reference {os.path.relpath(path)} was rendered for another "
+                                 f"scene or settings ({', '.join(diff)} differ): render it again with "
+                                 f"scripts/make_cycles_refs.sh")
+        return image
+    image = np.asarray(render(scene), np.float32).astype(np.float16)
+    if how == "update":
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        np.savez_compressed(path, image=image, meta=json.dumps({**meta, "bpy": bpy.app.version_string}))
+    return image.astype(np.float32)

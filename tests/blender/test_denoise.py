@@ -2,7 +2,8 @@
 core/pipeline/denoiser.py) and files whose compositor an older version set up to denoise.
 
 The end-to-end test renders the built-in demo scene (scripts/make_demo_scene.py) at 4 samples with and without
-denoising and compares both with a Cycles reference at 256 samples (its own noise caps the measurable ratio near 60):
+denoising and compares both with a Cycles reference at 256 samples (its own noise caps the measurable ratio near 60;
+rendered once and stored per Blender series, tests/cycles_reference.cycles_image):
 the target is a denoised relMSE at least 5x below the raw one. One render each (a deterministic seed), so the ratio
 is a measurement of this image, not a statistical claim; the margin between the measured ratio and 5 is in the
 assertion message. The denoiser's own tests use synthetic images with a known clean image."""
@@ -12,6 +13,7 @@ import sys
 import bpy
 import numpy as np
 from bpy_scenes import configure_cycles, configure_restir
+from cycles_reference import cycles_image
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SIZE = (160, 90)
@@ -68,7 +70,7 @@ def test_a_new_scene_denoises_f12_without_touching_the_compositor(addon, tmp_pat
     assert bpy.data.scenes.new("fresh").restir.use_denoising  # Cycles' default too
     scene = demo_scene()
     configure_cycles(scene, 256, 4, 0)
-    ref = render_scene(scene)[0]["Combined"][..., :3]
+    ref = cycles_image("denoise_demo", scene, lambda sc: render_scene(sc)[0]["Combined"][..., :3], 256, 4)
     configure_restir(scene, 4, 4, 0)  # the raw estimate (denoising off)
     raw = render_scene(scene)[0]["Combined"]
     trees_before = len(bpy.data.node_groups)
