@@ -4,7 +4,8 @@ core/pipeline/ (plan.py lists its stages in order)."""
 from __future__ import annotations
 
 from .pipeline.coverage import coverage_samples
-from .pipeline.frame import MAX_BATCH, Cancelled, FrameRenderer, FrameResult
+from .pipeline.batches import MAX_BATCH
+from .pipeline.frame import Cancelled, FrameRenderer, FrameResult
 from .pipeline.frame_render import render_frame
 from .pipeline.settings import INTEGRATORS, RenderSettings
 from .pipeline.work import CHUNK_PIXELS

@@ -119,7 +119,7 @@ class Film:
 
         def add(c):
             if c.batch > 1:
-                return add_batch(c)
+                return _add_batch(flat, c, len(self.group_names), world_to_cam)
             # the (3, k) results are transposed into contiguous (k, 3) copies first: adding a transposed view
             # to (k, 3) rows runs NumPy's inner loop over 3 elements
             span = _pixels(c.pixels)  # a slice where the chunk is a contiguous pixel range (no scatter)
@@ -137,7 +137,7 @@ class Film:
                     if rgb is not None:
                         rgb[hit] += v
             if rgb is not None:
-                add_adaptive(c.pixels, rgb)
+                _add_adaptive(flat, c.pixels, rgb)
             if self.group_names:
                 add_groups(c, span, pix, chain)
             if c.catcher is not None and len(c.catcher):
@@ -163,53 +163,6 @@ class Film:
                 for value in (c.direct_g, c.indirect_g):
                     if value is not None:
                         acc[pix] += np.ascontiguousarray((value[k] if chain is None else value[k] * chain).T)
-
-        def add_adaptive(pixels, rgb):
-            """One more sample of ``pixels`` (unique) with RGB ``rgb`` (k, 3): the count, and twice the RGB
-            into aux where it is the pixel's sample in the half set."""
-            count = flat["count"][pixels]
-            half = in_half(count)
-            flat["count"][pixels] = count + 1.0
-            sel = pixels[half]
-            flat["aux"][sel] += 2.0 * rgb[half]
-
-        def add_batch(c):
-            """A chunk of ``batch`` samples per pixel (no reservoirs or glass chains: those passes do not batch;
-            a chain of coloured transparent surfaces in front may come): each result summed over the samples of its
-            pixel."""
-            n = len(c.pixels) // c.batch
-            chain = None if c.chain is None else c.chain.throughput
-            base = c.pixels[:n]
-            span = _pixels(base)
-            emitted = c.hits.emitted.reshape(3, c.batch, n)
-            flat["emit"][span] += emitted.sum(axis=1).T
-            flat["alpha"][span] += c.hits.alpha.reshape(c.batch, n).sum(axis=0)
-            rgb = np.ascontiguousarray(emitted.transpose(1, 2, 0), dtype=FILM_DTYPE) if "aux" in flat else None
-
-            def add_rows(key, value, light=False, tinted=True):  # (3, hits) values of the hit rows, per pixel
-                dense = np.zeros((len(c.pixels), 3), np.float32)
-                dense[c.hits.rows] = (value if chain is None or not tinted else value * chain).T
-                dense = dense.reshape(c.batch, n, 3)
-                flat[key][span] += dense.sum(axis=0)
-                if light and rgb is not None:
-                    rgb[...] += dense
-
-            for key, value in (("direct", c.direct), ("indirect", c.indirect)):
-                if value is not None:
-                    add_rows(key, value, light=True)
-            for k in range(len(self.group_names)):
-                key = f"lg{k}"
-                if c.hits.emitted_g is not None:
-                    flat[key][span] += c.hits.emitted_g[k].reshape(3, c.batch, n).sum(axis=1).T
-                for value in (c.direct_g, c.indirect_g):
-                    if value is not None:
-                        add_rows(key, value[k])
-            if rgb is not None:
-                for b in range(c.batch):  # the samples of the pass, in order
-                    add_adaptive(base, rgb[b])
-            if "albedo" in flat and len(c.hits.rows):
-                add_rows("albedo", denoising_albedo(c.hits.surf))
-                add_rows("dnormal", world_to_cam @ c.hits.surf.facing_normals()[1], tinted=False)
 
         map_tasks(add if in_order is None else in_order(add), chunks, stop)
 
@@ -280,3 +233,52 @@ class Film:
             jobs["Denoising Normal"] = lambda: mean("dnormal")
         run = map if in_worker() else pool().map  # one pass per pool task (inline inside a worker)
         return dict(zip(jobs, run(lambda job: job(), jobs.values())))
+
+
+def _add_adaptive(flat: dict, pixels, rgb) -> None:
+    """Into the film's flat sums ``flat``: one more sample of ``pixels`` (unique) with RGB ``rgb`` (k, 3): the
+    count, and twice the RGB into aux where it is the pixel's sample in the half set."""
+    count = flat["count"][pixels]
+    half = in_half(count)
+    flat["count"][pixels] = count + 1.0
+    sel = pixels[half]
+    flat["aux"][sel] += 2.0 * rgb[half]
+
+
+def _add_batch(flat: dict, c, groups: int, world_to_cam: np.ndarray) -> None:
+    """Into the film's flat sums ``flat`` (with ``groups`` light groups): a chunk of ``batch`` samples per pixel (no
+    reservoirs or glass chains: those passes do not batch; a chain of coloured transparent surfaces in front may
+    come): each result summed over the samples of its pixel."""
+    n = len(c.pixels) // c.batch
+    chain = None if c.chain is None else c.chain.throughput
+    base = c.pixels[:n]
+    span = _pixels(base)
+    emitted = c.hits.emitted.reshape(3, c.batch, n)
+    flat["emit"][span] += emitted.sum(axis=1).T
+    flat["alpha"][span] += c.hits.alpha.reshape(c.batch, n).sum(axis=0)
+    rgb = np.ascontiguousarray(emitted.transpose(1, 2, 0), dtype=FILM_DTYPE) if "aux" in flat else None
+
+    def add_rows(key, value, light=False, tinted=True):  # (3, hits) values of the hit rows, per pixel
+        dense = np.zeros((len(c.pixels), 3), np.float32)
+        dense[c.hits.rows] = (value if chain is None or not tinted else value * chain).T
+        dense = dense.reshape(c.batch, n, 3)
+        flat[key][span] += dense.sum(axis=0)
+        if light and rgb is not None:
+            rgb[...] += dense
+
+    for key, value in (("direct", c.direct), ("indirect", c.indirect)):
+        if value is not None:
+            add_rows(key, value, light=True)
+    for k in range(groups):
+        key = f"lg{k}"
+        if c.hits.emitted_g is not None:
+            flat[key][span] += c.hits.emitted_g[k].reshape(3, c.batch, n).sum(axis=1).T
+        for value in (c.direct_g, c.indirect_g):
+            if value is not None:
+                add_rows(key, value[k])
+    if rgb is not None:
+        for b in range(c.batch):  # the samples of the pass, in order
+            _add_adaptive(flat, base, rgb[b])
+    if "albedo" in flat and len(c.hits.rows):
+        add_rows("albedo", denoising_albedo(c.hits.surf))
+        add_rows("dnormal", world_to_cam @ c.hits.surf.facing_normals()[1], tinted=False)

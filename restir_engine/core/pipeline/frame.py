@@ -4,12 +4,7 @@ history, rendering sample passes through the stages the pass's plan names (plan.
 Images are (h, w, c) float32 with row 0 at the *bottom* (Blender's pass order), covering the camera window
 (border) only. Temporal reuse runs through the first sample pass of each frame: pass 0 reuses the previous frame's
 pass 0 (``prev_history``) and becomes the next frame's (``history``); the other passes of a frame are independent of
-each other, so a frame's average is not correlated.
-
-Sample batches: a pass that keeps no per-pixel state between its stages (no reservoirs, no ReSTIR GI, no
-measurement) may render several samples at once: its chunks then hold their pixel span once per sample, so every
-array of the pass is that many times longer, and a pass that would be bound by NumPy's per-call cost (few pixels
-see a surface) fills its chunks (:meth:`FrameRenderer.batch_size`).
+each other, so a frame's average is not correlated. A pass may render several samples at once (batches.py).
 """
 from __future__ import annotations
 
@@ -21,7 +16,6 @@ import numpy as np
 
 from ..integrators import pathtracer, trace_context
 from ..integrators.context_cache import context_for, fingerprint
-from ..integrators.method_choice import GI_MIN_SHARE
 from ..lights.groups import GroupMap
 from ..modes import DirectMethod, Integrator
 from ..parallel.pool import quiet_float_errors
@@ -37,16 +31,15 @@ from . import coverage as coverage_mod
 from .adaptive import AdaptiveSampling
 from . import direct, methods, paths, primary, reuse, shade
 from .data_passes import render_data_passes
+from .batches import BatchChoice
 from .film import Film
-from .indirect_choice import IndirectChoice, ratios
+from .indirect_choice import IndirectChoice
 from .plan import PassPlan
 from .runner import PassRunner
 from .settings import RenderSettings, validate
 from .shadow_catcher import Catchers, film_mode
 from .work import frame_reservoirs, hand_back, make_chunks, own, place
 
-MAX_BATCH = 8  # samples one pass renders at most (FrameRenderer.batch_size)
-ANY_BATCH = 1 << 30  # samples left when asking FrameRenderer.batch_size for its unbounded choice
 
 
 class Cancelled(Exception):
@@ -219,8 +212,7 @@ class FrameRenderer:
         # adaptive sampling: which pixels the next passes sample (pipeline/adaptive.py)
         self.adaptive = AdaptiveSampling(w, h, st.samples, st.adaptive_threshold, st.adaptive_min_samples) \
             if st.use_adaptive_sampling else None
-        self._surfaces_per_chunk = None  # surfaces per chunk and sample in the last pass (batch_size)
-        self._settled_batch = None  # the batch of every later pass, once the passes are independent (batch_size)
+        self.batches = BatchChoice(st)
         self._sample = None  # the pass to render where it is not the next one (independent_pass)
         self.boiling_dropped = 0  # reservoirs the boiling filter emptied since the camera was set
         self.gi_skipped = 0  # samples whose pass kept path-traced indirect light (GI_MIN_SHARE)
@@ -333,10 +325,10 @@ class FrameRenderer:
         return None if self.adaptive is None else self.adaptive.next_check(self.samples_done)
 
     def _settle(self) -> None:
-        """Fix the batch of the frame's later passes once they are independent (:meth:`batch_size`; chosen again
-        after each adaptive check, whose active pixels fill the chunks otherwise)."""
-        if self._settled_batch is None and self.passes_independent():
-            self._settled_batch = self._uncapped_batch(ANY_BATCH) if self._can_batch() else 1
+        """Fix the batch of the frame's later passes once they are independent (chosen again after each adaptive
+        check, whose active pixels fill the chunks otherwise)."""
+        if self.passes_independent():
+            self.batches.settle(self._can_batch())
 
     def independent_pass(self, sample: int, batch: int, team, should_stop=None, progress=None) -> bool:
         """Render pass ``sample`` (``batch`` samples) alone, as ``team`` (parallel/team.Independent) orders it into
@@ -353,37 +345,13 @@ class FrameRenderer:
             self.team, self._sample = saved, None
         return True
 
-    def counts(self) -> dict:
-        """The frame's pass counts that its stats report (frame_stats.py), which :meth:`add_counts` adds to."""
-        return {"gi_skipped": self.gi_skipped, "boiling_dropped": self.boiling_dropped,
-                "used_tiles": int(self.used_tiles)}
-
-    def add_counts(self, counts: dict) -> None:
-        """Add another process's :meth:`counts` (of the passes it rendered for this frame)."""
-        self.gi_skipped += int(counts.get("gi_skipped", 0))
-        self.boiling_dropped += int(counts.get("boiling_dropped", 0))
-        self.used_tiles = bool(self.used_tiles or counts.get("used_tiles", 0))
-
     def batch_size(self, remaining: int) -> int:
-        """Samples the next pass should render at once (at most ``remaining``): the setting, else as many as bring a
-        chunk to about ``tile_pixels`` surfaces, judged by the last pass (1 before any pass), at most MAX_BATCH; once
-        the passes are independent (:meth:`passes_independent`), the choice after the first such pass for the rest of
-        the frame, so that its later passes are the same whatever renders them."""
+        """Samples the next pass should render at once (at most ``remaining``; batches.BatchChoice), cut by adaptive
+        sampling to end at its next check."""
         if not self._can_batch():
             return 1
-        batch = self._uncapped_batch(remaining)
+        batch = self.batches.uncapped(remaining)
         return batch if self.adaptive is None else self.adaptive.cap(self.samples_done, batch)
-
-    def _uncapped_batch(self, remaining: int) -> int:
-        """:meth:`batch_size` before adaptive sampling cuts it at its next check."""
-        st = self.settings
-        if self._settled_batch is not None:
-            return min(remaining, self._settled_batch)
-        if st.sample_batch > 0:
-            return max(1, min(remaining, int(st.sample_batch)))
-        if self._surfaces_per_chunk is None:
-            return 1
-        return max(1, min(remaining, MAX_BATCH, int(st.tile_pixels // max(self._surfaces_per_chunk, 1.0))))
 
     def _can_batch(self) -> bool:
         """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
@@ -459,7 +427,7 @@ class FrameRenderer:
         with run.stage("primary"):
             run.map_chunks(lambda c: primary.primary(ctx, plan, self.masks, c, self.catchers), chunks, 0)
             n_surf = place(chunks, team)
-            self._surfaces_per_chunk = n_surf / (len(chunks) * plan.batch)
+            self.batches.measured(n_surf, len(chunks), plan.batch)
         candidates = plan.candidates
         if plan.resampled:
             self.reuse_stats["light_candidates"] = candidates.light_candidates
@@ -477,7 +445,8 @@ class FrameRenderer:
                 run.map_chunks(lambda c: direct.initial(ctx, plan, candidates, terms, c), chunks, 1)
         with run.stage("paths"):
             run.map_chunks(lambda c: paths.paths(ctx, plan, terms, gi_terms, self._make_gi, c), chunks, 1)
-        gi_reused = self._gi_outcome(plan, chunks)
+        gi_reused = paths.gi_outcome(plan, chunks, self.team, self.reuse_stats,
+                                     self._measured if self.gi_auto else None)
         if self.gi is not None and not gi_reused:
             self.gi_skipped += plan.batch
         gb = res = gi_res = gb_gi = gi_history = None
@@ -512,29 +481,8 @@ class FrameRenderer:
         if self.adaptive is not None and self.adaptive.due(plan.sample + plan.batch):
             team.barrier()  # every process's samples are in the film
             self.adaptive.check(self.film, plan.sample + plan.batch)
-            self._settled_batch = None  # the active pixels changed: the batch is chosen again
+            self.batches.unsettle()  # the active pixels changed: the batch is chosen again
         return plan.batch
-
-    def _gi_outcome(self, plan: PassPlan, chunks) -> bool:
-        """After the paths stage: whether this pass reuses GI. GI reuse only pays where its reservoirs carry the
-        indirect light: a scene with no bounce light to cache (the default cube) keeps the path-traced indirect
-        light as it is (GI_MIN_SHARE); Auto measures here for the next passes."""
-        gi_on = plan.gi
-        if not (plan.gi or plan.probe):
-            return gi_on
-        team = self.team
-        sums = team.table({c.index: c.gi_share for c in own(chunks, team)}, len(chunks), 4).sum(axis=0)
-        share, uncached = ratios(sums)
-        self.reuse_stats["gi_share"], self.reuse_stats["gi_uncached"] = share, uncached
-        if self.gi_auto:
-            self._measured(sums)  # for the next passes
-        elif share < GI_MIN_SHARE:
-            gi_on = False
-        if not gi_on:
-            paths.keep_path_traced(own(chunks, team))
-        for c in chunks:
-            c.path_indirect = c.path_indirect_g = None
-        return gi_on
 
     def _keep_history(self, gb, res, gb_gi, gi_history, gi_reused: bool) -> None:
         """The next frame's history from this first pass; confidence at most the cap, so no reused M exceeds it."""

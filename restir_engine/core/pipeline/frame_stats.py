@@ -29,3 +29,15 @@ def frame_stats(fr: FrameRenderer, scene: Scene, clock) -> dict:
     if clock is not None:
         stats["stages"] = clock.stages
     return stats
+
+
+def pass_counts(fr: FrameRenderer) -> dict:
+    """The frame's pass counts that its stats report, which :func:`add_pass_counts` adds to."""
+    return {"gi_skipped": fr.gi_skipped, "boiling_dropped": fr.boiling_dropped, "used_tiles": int(fr.used_tiles)}
+
+
+def add_pass_counts(fr: FrameRenderer, counts: dict) -> None:
+    """Add another process's :func:`pass_counts` (of the passes it rendered for this frame) to ``fr``'s."""
+    fr.gi_skipped += int(counts.get("gi_skipped", 0))
+    fr.boiling_dropped += int(counts.get("boiling_dropped", 0))
+    fr.used_tiles = bool(fr.used_tiles or counts.get("used_tiles", 0))

@@ -12,9 +12,10 @@ from ..integrators import pathtracer
 from ..restir import gi
 from ..restir.target import ShadingTerms
 from ..sampling import STREAM_PATH
-from .indirect_choice import PROBE_EVERY, share_sums
+from ..integrators.method_choice import GI_MIN_SHARE
+from .indirect_choice import PROBE_EVERY, ratios, share_sums
 from .plan import PassPlan
-from .work import Chunk
+from .work import Chunk, own
 
 
 def gi_initial(settings: gi.GISettings, space, surf, first, block: np.ndarray, filled: bool = False):
@@ -62,3 +63,26 @@ def keep_path_traced(chunks: list[Chunk]) -> None:
     for c in chunks:
         if c.path_indirect is not None:
             c.indirect, c.indirect_g, c.gi_res = c.path_indirect, c.path_indirect_g, None
+
+
+def gi_outcome(plan: PassPlan, chunks, team, reuse_stats: dict, measured=None) -> bool:
+    """After the paths stage: whether this pass reuses GI. GI reuse only pays where its reservoirs carry the indirect
+    light: a scene with no bounce light to cache (the default cube) keeps the path-traced indirect light as it is
+    (GI_MIN_SHARE); with Auto, ``measured(sums)`` takes the measurement for the next passes instead. The share
+    measured goes into ``reuse_stats``; the chunks' path-traced indirect light is dropped (or kept as their
+    indirect light where GI does not run)."""
+    gi_on = plan.gi
+    if not (plan.gi or plan.probe):
+        return gi_on
+    sums = team.table({c.index: c.gi_share for c in own(chunks, team)}, len(chunks), 4).sum(axis=0)
+    share, uncached = ratios(sums)
+    reuse_stats["gi_share"], reuse_stats["gi_uncached"] = share, uncached
+    if measured is not None:
+        measured(sums)  # for the next passes
+    elif share < GI_MIN_SHARE:
+        gi_on = False
+    if not gi_on:
+        keep_path_traced(own(chunks, team))
+    for c in chunks:
+        c.path_indirect = c.path_indirect_g = None
+    return gi_on

@@ -35,7 +35,8 @@ from ..parallel import wire
 from ..parallel.pool import set_thread_count
 from ..parallel.team import FAILED, Arena, Team, film_zeros
 from .film import FILM_DTYPE
-from .frame import ANY_BATCH
+from .batches import ANY_BATCH
+from .frame_stats import add_pass_counts, pass_counts
 
 KEEP_SCENES = 3  # scene segments a worker keeps attached (a context may still refer to the last frames' arrays)
 KEEP_HISTORIES = 1  # temporal histories a worker keeps by default: the last frame's (a banded frame: one per band)
@@ -145,10 +146,10 @@ class _Worker:
         """Render ``count`` independent passes of ``batch`` samples from sample ``first`` on (the last one ends at
         sample ``end`` at most) at the same time as the other workers: the ``j``-th pass by worker ``j`` mod team
         size, each whole and alone, added to the shared film in sample order (team.Independent). Payload: this
-        worker's pass counts for the frame's stats (FrameRenderer.counts); None when stopped."""
+        worker's pass counts for the frame's stats (frame_stats.pass_counts); None when stopped."""
         from ..parallel.team import Independent
         fr = self.fr
-        before = fr.counts()
+        before = pass_counts(fr)
         report = None
         if self.team.leader:
             def report(fraction):
@@ -161,7 +162,7 @@ class _Worker:
             if not fr.independent_pass(s, min(batch, end - s), member, self.team.stopping, report):
                 return None
         fr.film.samples = min(end, first + count * batch)
-        return {k: v - before[k] for k, v in fr.counts().items()}
+        return {k: v - before[k] for k, v in pass_counts(fr).items()}
 
     def finish(self, token: int, counts: dict | None = None):
         from .frame_stats import frame_stats
@@ -169,7 +170,7 @@ class _Worker:
         out = None
         if self.team.leader:
             if counts:  # what the other workers' independent passes counted (spread)
-                fr.add_counts(counts)
+                add_pass_counts(fr, counts)
             data = tuple(a for a in fr.data_passes()) if fr.settings.data_passes else None
             out = {"stats": frame_stats(fr, self.scene, self.clock), "data": data,
                    "reservoirs": fr.candidates is not None, "history": fr.history is not None}
