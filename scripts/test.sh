@@ -21,6 +21,13 @@ venvs=()
 for ver in "${versions[@]}"; do
   venvs+=("$(scripts/setup_venv.sh "$ver")")  # one at a time: the first set-up downloads
 done
+# the suites run at once: each renders with its share of the cores (tests/conftest.py, harness configure_restir),
+# not with every core as Blender's Auto would (two suites of worker processes and thread pools on the same cores
+# spend their time switching between each other)
+if [ -z "${RESTIR_TEST_THREADS:-}" ]; then
+  cores=$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)
+  export RESTIR_TEST_THREADS=$(( cores / ${#versions[@]} > 0 ? cores / ${#versions[@]} : 1 ))
+fi
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
 pids=()

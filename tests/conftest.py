@@ -31,6 +31,18 @@ def _core_renders_in_this_process():
     processes.set_process_count(None)
 
 
+@pytest.fixture(autouse=True)
+def _threads_of_this_suite():
+    """The core's threads: RESTIR_TEST_THREADS where set (scripts/test.sh runs the two Blenders' suites at once and
+    gives each its share of the cores; bpy renders take it from harness.render.configure_restir), else every
+    logical core."""
+    from restir_engine.core.parallel import pool
+    threads = int(os.environ.get("RESTIR_TEST_THREADS", "0"))
+    pool.set_thread_count(threads or None)
+    yield
+    pool.set_thread_count(threads or None)
+
+
 @pytest.fixture(scope="session", autouse=True)
 def _end_worker_processes():
     yield

@@ -51,6 +51,10 @@ def configure_restir(scene, samples: int, bounces: int, seed: int = 0, **setting
     scene.restir.pixel_filter = "BOX"  # the filter configure_cycles gives Cycles (a setting may change it)
     scene.restir.use_adaptive_sampling = False  # every pixel takes the samples asked for, as configure_cycles
     scene.restir.use_denoising = False  # the raw estimate, as configure_cycles
+    threads = int(os.environ.get("RESTIR_TEST_THREADS", "0"))
+    if threads > 0:  # the cores this suite may use (scripts/test.sh runs two suites at once)
+        scene.render.threads_mode = "FIXED"
+        scene.render.threads = threads
     for k, v in settings.items():
         setattr(scene.restir, k, v)
     scene.view_settings.view_transform = "Standard"

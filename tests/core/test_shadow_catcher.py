@@ -36,7 +36,8 @@ def render(scene, mode, **st):
     return render_frame(scene, settings).passes
 
 
-@pytest.mark.parametrize("integrator", [dict(integrator="PATH"), dict(integrator="RESTIR", direct_method="RESTIR")])
+@pytest.mark.parametrize("integrator", [dict(integrator="PATH"), dict(integrator="PATH", sample_batch=4),
+                                        dict(integrator="RESTIR", direct_method="RESTIR")])
 def test_no_occluder_means_no_shadow_exactly(integrator):
     """With nothing but catchers the two estimates share their random numbers and agree sample by sample: the
     Shadow Catcher pass is exactly 1, Combined is the matte (black and transparent over the floor), the transparent
@@ -53,18 +54,48 @@ def test_no_occluder_means_no_shadow_exactly(integrator):
     assert np.allclose(o[..., :3], WORLD, atol=1e-5) and np.allclose(o[..., 3], 1.0)
 
 
-def test_occluder_shadow_is_the_light_it_blocks():
+@pytest.mark.parametrize("batch", [1, 4])
+def test_occluder_shadow_is_the_light_it_blocks(batch):
     """Under the occluder (it hides the whole emitter from the floor's middle; a black world and max_bounces 0: only
     the emitter lights the floor) L_with = 0: the pass is 0 there, the transparent film's alpha 1, the opaque film's
     floor black; at the floor's corners, which see the whole emitter past the occluder, the pass stays 1 exactly."""
-    scene = catcher_scene(occluder=True, world=0.0)
-    p = render(scene, "PASS")["Shadow Catcher"]
+    scene = catcher_scene(occluder=True, world=0.0, width=64)  # the middle 2 x 2 pixels inside the umbra, |x| < 0.05
+    p = render(scene, "PASS", sample_batch=batch)["Shadow Catcher"]
     h, w = p.shape[:2]
     mid = p[h // 2 - 1:h // 2 + 1, w // 2 - 1:w // 2 + 1]
     assert np.all(mid == 0.0)
     assert np.abs(p[:2, :2] - 1).max() < 1e-6
-    t = render(scene, "TRANSPARENT")["Combined"]
+    t = render(scene, "TRANSPARENT", sample_batch=batch)["Combined"]
     assert np.allclose(t[h // 2 - 1:h // 2 + 1, w // 2 - 1:w // 2 + 1, 3], 1.0)
-    o = render(scene, "OPAQUE")["Combined"]
+    o = render(scene, "OPAQUE", sample_batch=batch)["Combined"]
     assert np.allclose(o[h // 2 - 1:h // 2 + 1, w // 2 - 1:w // 2 + 1, :3], 0.0)
     assert 0.0 < p.mean() < 1.0
+
+
+def test_a_batched_chunk_sums_each_pixels_samples():
+    """A chunk of 3 samples of 4 pixels (pixel list repeated per sample), catchers met by some of its camera hits:
+    each pixel's film sums are the sums over its own samples' catcher values, and its coverage the count of its
+    samples that met a catcher (a scatter that dropped repeated pixels would keep one sample of each)."""
+    from types import SimpleNamespace
+
+    from restir_engine.core.parallel.tasks import Progress
+    from restir_engine.core.pipeline.film import Film
+    batch, n, w = 3, 4, 4
+    pixels = np.tile(np.array([4, 5, 6, 7]), batch)  # the second row of a 4 x 2 film
+    hit_rows = np.array([0, 1, 2, 4, 5, 6, 8, 9, 11])  # positions in the chunk's pixel list that met a surface
+    catcher = np.array([0, 1, 3, 4, 6, 8])  # of those hits, the ones on a catcher
+    rng = np.random.default_rng(5)
+    values = {k: rng.random((3, len(catcher))).astype(np.float32) for k in ("sc_with", "sc_without", "sc_behind")}
+    hits = SimpleNamespace(rows=hit_rows, emitted=np.zeros((3, batch * n), np.float32),
+                           alpha=np.zeros(batch * n, np.float32), emitted_g=None, surf=None)
+    c = SimpleNamespace(pixels=pixels, batch=batch, hits=hits, chain=None, direct=None, indirect=None, direct_g=None,
+                        indirect_g=None, catcher=catcher, res=None, gi_res=None, **values)
+    film = Film(w, 2, gi=False, denoise_data=False, catcher_mode="PASS")
+    film.accumulate([c], False, np.eye(3, dtype=np.float32), Progress(None, None, 1))
+    where = pixels[hit_rows[catcher]]
+    for key, v in values.items():
+        want = np.zeros((2 * w, 3))
+        np.add.at(want, where, v.T)
+        assert np.allclose(film.acc[key].reshape(-1, 3), want, atol=1e-6), key
+    assert np.array_equal(film.acc["sc_cov"].reshape(-1), np.bincount(where, minlength=2 * w))
+    film.release()

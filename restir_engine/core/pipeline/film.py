@@ -276,9 +276,24 @@ def _add_batch(flat: dict, c, groups: int, world_to_cam: np.ndarray) -> None:
         for value in (c.direct_g, c.indirect_g):
             if value is not None:
                 add_rows(key, value[k])
+    if c.catcher is not None and len(c.catcher):
+        _add_batched_catchers(flat, c, span, n)
     if rgb is not None:
         for b in range(c.batch):  # the samples of the pass, in order
             _add_adaptive(flat, base, rgb[b])
     if "albedo" in flat and len(c.hits.rows):
         add_rows("albedo", denoising_albedo(c.hits.surf))
         add_rows("dnormal", world_to_cam @ c.hits.surf.facing_normals()[1], tinted=False)
+
+
+def _add_batched_catchers(flat: dict, c, span, n: int) -> None:
+    """A batched chunk's shadow catcher sums (pipeline/shadow_catcher.py) into the film's flat sums at ``span`` (its
+    ``n`` pixels): each summed over the samples of its pixel."""
+    rows = c.hits.rows[c.catcher]  # positions in the chunk's (batch * n) pixel list
+    for key, value in (("sc_with", c.sc_with), ("sc_without", c.sc_without), ("sc_behind", c.sc_behind)):
+        dense = np.zeros((len(c.pixels), 3), np.float32)
+        dense[rows] = value.T
+        flat[key][span] += dense.reshape(c.batch, n, 3).sum(axis=0)
+    covered = np.zeros(len(c.pixels), np.float32)
+    covered[rows] = 1.0
+    flat["sc_cov"][span] += covered.reshape(c.batch, n).sum(axis=0)

@@ -357,7 +357,7 @@ class FrameRenderer:
         """Whether the next pass may render several samples at once: it keeps no per-pixel state (no reservoirs, no
         ReSTIR GI), measures nothing for Auto indirect (no probe; the first pass without a measurement probes) and
         is not motion-blurred (each sample at its own shutter time)."""
-        if self.candidates is not None or self.gi_runs() or self.blur is not None or self.catchers is not None:
+        if self.candidates is not None or self.gi_runs() or self.blur is not None:
             return False
         if self.gi is None or self.samples_done > 0:
             return True
