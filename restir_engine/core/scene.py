@@ -66,6 +66,7 @@ class ObjectTable:
     shadow_catcher: np.ndarray = None  # (k,) bool: Object > Visibility > Mask > Shadow Catcher (pipeline/shadow_catcher.py)
     casts_shadow: np.ndarray = None  # (k,) bool: Object > Visibility > Ray Visibility > Shadow (off: shadow rays pass)
     camera_visible: np.ndarray = None  # (k,) bool: ... > Ray Visibility > Camera (off: camera rays pass)
+    properties: dict = None  # {"KIND:name": (k, 4) float32}: the Attribute node's Object / Instancer values (RGBA)
 
 
 @dataclass

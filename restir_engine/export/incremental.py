@@ -29,8 +29,10 @@ _GEOMETRY_DATA = (bpy.types.Mesh, bpy.types.Curve, bpy.types.MetaBall) + \
     tuple(getattr(bpy.types, n) for n in ("Curves", "PointCloud", "Volume", "TextCurve") if hasattr(bpy.types, n))
 
 
-def update_level(updates) -> str:
-    """The export level that a depsgraph's ``updates`` need (one of LEVELS)."""
+def update_level(updates, object_properties: bool = False) -> str:
+    """The export level that a depsgraph's ``updates`` need (one of LEVELS); ``object_properties``: the last
+    export's materials read objects' properties (the Attribute node's Object / Instancer types), which an object's
+    edit (a custom property) may change without moving it: the instances are then gathered again (TRANSFORM)."""
     level = 0
     for u in updates:
         idv = u.id
@@ -45,8 +47,8 @@ def update_level(updates) -> str:
                 need = 4
             elif u.is_updated_transform:
                 need = 3
-            else:  # shading flag: a material edit, or another material in a slot (checked by the exporter)
-                need = 2
+            else:  # shading flag: a material edit, another material in a slot (checked by the exporter), a property
+                need = 3 if object_properties else 2
         elif isinstance(idv, _GEOMETRY_DATA):
             need = 4 if u.is_updated_geometry else 2
         elif isinstance(idv, bpy.types.Scene):
@@ -55,6 +57,12 @@ def update_level(updates) -> str:
             need = 4
         level = max(level, need)
     return LEVELS[level]
+
+
+def reads_object_properties(scene) -> bool:
+    """Whether the exported ``scene``'s materials read objects' properties (ObjectTable.properties)."""
+    objs = getattr(getattr(scene, "geometry", None), "objects", None)
+    return getattr(objs, "properties", None) is not None
 
 
 class SceneExporter:

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..core.scene import DEFAULT_MATERIAL, MaterialTable
 from ..compat import uses_nodes
+from . import object_properties
 from .coat import coat_set
 from .flat_nodes import FlatTree, cycles_output, flat_output
 from .subsurface import principled_subsurface
@@ -102,6 +103,21 @@ class MaterialRegistry(MixShaderReader, NormalReader, TextureReader):
         for i in indices:
             collect(self.rows[i])
         return names
+
+    def object_property_keys(self, indices) -> frozenset:
+        """The Object / Instancer attribute keys ("KIND:name") the node programs of materials ``indices`` read
+        (export/object_properties.py)."""
+        keys: set = set()
+
+        def collect(row: dict) -> None:
+            for prog in (row.get("program"), row.get("aov_program")):
+                if prog is not None:
+                    keys.update(k for k in map(object_properties.key_of, prog.reads) if k is not None)
+            for comp, *_rest in row.get("mix", ()):
+                collect(self.rows[comp])
+        for i in indices:
+            collect(self.rows[i])
+        return frozenset(keys)
 
     def table(self) -> MaterialTable:
         for row in self.rows:

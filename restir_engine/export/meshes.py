@@ -13,6 +13,7 @@ import dataclasses
 import numpy as np
 
 from ..core.scene import ObjectTable, TriangleSet
+from . import object_properties
 from .mesh_attributes import TANGENT_PREFIX, read_attribute, read_tangents
 from .points import read_points
 
@@ -210,8 +211,9 @@ def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None
             index = np.array([registry.material_index(m) for m in materials] or [0], np.int32)
             # what the materials read of the mesh (objects sharing a mesh may link different materials)
             slot_cache[mats_key] = (index, (registry.uses_textures(index), registry.uses_normal_maps(index),
-                                            frozenset(registry.attribute_names(index))))
-        slot_index, wants = slot_cache[mats_key]
+                                            frozenset(registry.attribute_names(index))),
+                                    registry.object_property_keys(index))
+        slot_index, wants, property_keys = slot_cache[mats_key]
         slots_seen.append(mats_key[1])
         read_key = (key, wants)
         if read_key not in cache:
@@ -247,13 +249,20 @@ def _collect_blocks(depsgraph, registry, warnings: list, mesh_cache: dict | None
         arrays = cache[read_key]
         if arrays is None:
             continue
+        properties = object_properties.instance_values(inst, obj, property_keys)
+        for name in object_properties.unread_instance_attributes(inst, properties):
+            message = (f"Attribute '{name}' (Instancer) is not a property of the instancer or of '{obj.name}': "
+                       "instance attributes of Geometry Nodes instances cannot be read here, it reads 0")
+            if message not in warnings:
+                warnings.append(message)
         blocks.append((arrays, np.array(inst.matrix_world, np.float64), slot_index, obj.name,
                        instance_key(inst), (tuple(obj.color), object_random(inst), obj.name, asset_name(obj),
                                                          bool(getattr(obj, "is_holdout", False)),
                                                          float(getattr(obj, "pass_index", 0)),
                                                          bool(getattr(obj, "is_shadow_catcher", False)),
                                                          bool(getattr(obj, "visible_shadow", True)),
-                                                         bool(getattr(obj, "visible_camera", True)))))
+                                                         bool(getattr(obj, "visible_camera", True)),
+                                                         properties)))
         unseen = [f for f in ("glossy", "transmission") if not getattr(obj, f"visible_{f}", True)]
         if unseen and obj.name not in unsupported_visibility:
             unsupported_visibility[obj.name] = unseen
@@ -431,7 +440,18 @@ def _object_table(blocks) -> ObjectTable:
                        pass_index=np.array([b[5][5] for b in blocks], np.float32),
                        shadow_catcher=np.array([b[5][6] for b in blocks], bool),
                        casts_shadow=np.array([b[5][7] for b in blocks], bool),
-                       camera_visible=np.array([b[5][8] for b in blocks], bool))
+                       camera_visible=np.array([b[5][8] for b in blocks], bool),
+                       properties=_property_table(blocks))
+
+
+def _property_table(blocks) -> dict | None:
+    """{"KIND:name": (k, 4) float32} of the Object / Instancer attributes the instances' materials read (0 where an
+    instance's own materials do not read it), or None where none is read."""
+    keys = sorted({key for b in blocks for key in b[5][9]})
+    if not keys:
+        return None
+    return {key: np.array([b[5][9].get(key, object_properties.MISSING) for b in blocks], np.float32).reshape(-1, 4)
+            for key in keys}
 
 
 def asset_name(obj) -> str:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import object_properties
 from .derived_attributes import POINTINESS, RANDOM_PER_ISLAND
 from .node_graph import Reg
 from .node_space_handlers import camera_data, normal, vector_transform
@@ -81,16 +82,23 @@ def _color_attribute(g, node, f):
 
 
 def _attribute(g, node, f):
-    if node.attribute_type != "GEOMETRY":
+    """Geometry: a colour attribute of the mesh; Object / Instancer: a property of the object (or its instancer)
+    per instance (export/object_properties.py); View Layer is not read."""
+    kind = node.attribute_type
+    if kind not in ("GEOMETRY", "OBJECT", "INSTANCER"):
         return None
     name = node.attribute_name
     if not name:  # as Cycles: an Attribute node without a name finds nothing and gives 0 on every output
         zero = g.constant(0.0, "float")
         return {"Color": g.constant(0.0, "color"), "Vector": g.constant(0.0, "vector"), "Fac": zero, "Alpha": zero}
-    col = g.attribute(f"attr:{name}", "color")
+    if kind == "GEOMETRY":
+        rgb, alpha = f"attr:{name}", f"attr_alpha:{name}"
+    else:
+        rgb, alpha = object_properties.read_names(kind, name)
+    col = g.attribute(rgb, "color")
     return {"Color": col, "Vector": Reg(col.index, "vector", col.const), "Fac": g.convert(Reg(col.index, "vector"),
                                                                                           "float"),
-            "Alpha": g.attribute(f"attr_alpha:{name}", "float")}
+            "Alpha": g.attribute(alpha, "float")}
 
 
 def _fresnel(g, node, f):

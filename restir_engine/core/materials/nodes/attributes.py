@@ -6,7 +6,8 @@ exporter's programs read them): "position", "normal" (shading), "true_normal", "
 "object" (object-space position), "object_normal", "reflection", "parametric", "object_location",
 "object_color", "object_alpha", "object_random", "is_camera_ray" / "is_shadow_ray" (1 or 0: Light Path, as the
 ray that reached the point), "attr:<name>" / "attr_alpha:<name>" for a colour attribute
-(RGB and alpha, linear), "tangent_uv" / "tangent_sign" (the UV map's interpolated tangent and bitangent sign, or
+(RGB and alpha, linear), OBJECT_PROPERTY / OBJECT_PROPERTY_ALPHA + "<KIND>:<name>" for a property of the instance's
+object (the Attribute node's Object and Instancer types: ObjectTable.properties, (r, g, b, a) per instance), "tangent_uv" / "tangent_sign" (the UV map's interpolated tangent and bitangent sign, or
 None without tangents) and "footprint" (a pixel's width on the surface, scene units)."""
 from __future__ import annotations
 
@@ -15,6 +16,8 @@ import numpy as np
 from ...sampling import barycentric, dot, norm
 
 _F = np.float32
+OBJECT_PROPERTY = "object_property:"  # + "KIND:name": RGB (3, n)
+OBJECT_PROPERTY_ALPHA = "object_property_alpha:"  # + "KIND:name": alpha (n,)
 
 
 class HitAttributes:
@@ -194,6 +197,8 @@ class HitAttributes:
             inst, objs = self._instances()
             idx = None if inst is None else getattr(objs, "pass_index", None)
             return np.zeros(n, np.float32) if idx is None else np.ascontiguousarray(idx[inst], dtype=np.float32)
+        if name.startswith((OBJECT_PROPERTY, OBJECT_PROPERTY_ALPHA)):
+            return self._object_property(name)
         if name.startswith("attr:") or name.startswith("attr_alpha:"):
             key = name.split(":", 1)[1]
             data = (getattr(self.tris, "attributes", None) or {}).get(key)
@@ -202,6 +207,18 @@ class HitAttributes:
             vals = self._corners(data)  # (4, n)
             return np.ascontiguousarray(vals[:3]) if name.startswith("attr:") else np.ascontiguousarray(vals[3])
         raise KeyError(f"unknown hit attribute {name!r}")
+
+
+    def _object_property(self, name: str):
+        """An Object / Instancer attribute's RGB (3, n) or alpha (n,) at the points (0 without an object table)."""
+        alpha = name.startswith(OBJECT_PROPERTY_ALPHA)
+        key = name[len(OBJECT_PROPERTY_ALPHA if alpha else OBJECT_PROPERTY):]
+        inst, objs = self._instances()
+        table = None if inst is None else (getattr(objs, "properties", None) or {}).get(key)
+        n = len(self.prim)
+        if table is None:
+            return np.zeros(n if alpha else (3, n), np.float32)
+        return np.ascontiguousarray(table[inst, 3] if alpha else table[inst, :3].T, dtype=np.float32)
 
 
 class DirectionAttributes:
@@ -229,8 +246,11 @@ class DirectionAttributes:
             return -self.dirs
         if name == "reflection":
             return self.dirs
-        if name in {"uv", "parametric", "object_location", "object_color", "tangent"} or name.startswith("attr:"):
+        if name in {"uv", "parametric", "object_location", "object_color", "tangent"} or \
+                name.startswith(("attr:", OBJECT_PROPERTY)):
             return np.zeros((3, n), np.float32)
+        if name.startswith(OBJECT_PROPERTY_ALPHA):
+            return np.zeros(n, np.float32)
         if name == "footprint":
             return np.full(n, _F(1e-3), np.float32)
         if name == "is_camera_ray":
