@@ -46,6 +46,9 @@ RUNS = [
     ("demo F12 16 spp", "demo", {}, 16, 1),
     ("many_lights F12 ReSTIR DI 8 spp", "many_lights", dict(integrator="RESTIR", direct_method="RESTIR",
                                                              max_bounces=0), 8, 1),
+    # enough later passes for 16 workers to render them one per worker (pipeline/spread.py)
+    ("many_lights F12 ReSTIR DI 24 spp", "many_lights", dict(integrator="RESTIR", direct_method="RESTIR",
+                                                              max_bounces=0), 24, 1),
     # the viewport's renderer (FrameRenderer in one process with N threads, SharedViewRenderer on N processes):
     # VIEW_MOVES full-resolution views panned one after the other (one pass each, the last view's history
     # reprojected, the navigation candidate cap), then VIEW_REFINE samples refining the last view
@@ -111,6 +114,9 @@ def one(args) -> dict:
                                    data_passes=False)
     if spec.get("tile"):
         settings = dataclasses.replace(settings, tile_pixels=int(spec["tile"]))
+    if spec.get("no_spread"):  # a still's later passes shared out pass by pass (the leader decides: shared_frame)
+        from restir_core.pipeline import spread
+        spread.passes_at_once = lambda *_args: 0
     # the thread pool of the rendering process holds N threads either way, as the add-on's with Threads = N (it
     # turns the film into passes while the workers wait); the workers get N // processes threads each
     pool.set_thread_count(cores)
@@ -132,7 +138,8 @@ def one(args) -> dict:
         t = time.perf_counter()
         r = render_frame(scenes[0 if still else f % len(scenes)],
                          dataclasses.replace(settings, frame=1 if spec["frames"] == 1 else f + 1),
-                         history=hist if spec["frames"] > 1 else None, clock=clock, processes=procs)
+                         history=hist if spec["frames"] > 1 else None, clock=clock, processes=procs,
+                         bands=spec.get("bands") or None)
         wall = time.perf_counter() - t
         hist = r.history
         rows.append({"frame_s": wall, "stages": {k: v["wall"] for k, v in clock.stages.items()},
@@ -206,13 +213,15 @@ def run(args) -> None:
     modes = args.modes.split(",")
     results = {"meta": {"machine": platform.processor() or platform.machine(), "logical_cores": os.cpu_count(),
                         "python": platform.python_version(), "size": args.size, "tile": args.tile,
+                        "bands": args.bands, "no_spread": args.no_spread,
                         "date": time.strftime("%Y-%m-%d")},
                "runs": []}
     os.makedirs(args.out, exist_ok=True)
     for name, scene, settings, samples, frames in RUNS:
         if args.only and not any(o in name for o in args.only.split(",")):
             continue
-        spec = json.dumps({"settings": settings, "samples": samples, "frames": frames, "tile": args.tile})
+        spec = json.dumps({"settings": settings, "samples": samples, "frames": frames, "tile": args.tile,
+                           "bands": args.bands, "no_spread": args.no_spread})
         path = os.path.join(args.scenes, f"{scene}_{args.size}.pkl")
         entry = {"name": name, "scene": scene, "settings": settings, "samples": samples, "points": []}
         for mode in modes:
@@ -328,6 +337,9 @@ def main(argv=None):
     r.add_argument("--only", default=None, help="comma-separated parts of run names")
     r.add_argument("--timeout", type=float, default=600)
     r.add_argument("--tile", type=int, default=0, help="pixels per chunk (0: the settings')")
+    r.add_argument("--bands", type=int, default=0, help="bands per frame (0: as memory.band_budget plans them)")
+    r.add_argument("--no-spread", action="store_true",
+                   help="share a still's later passes out pass by pass (not one per worker)")
     r.add_argument("--out", default=os.path.join(ROOT, "docs", "results", "scaling"))
     o = sub.add_parser("one")
     o.add_argument("--scene")
