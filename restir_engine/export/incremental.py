@@ -59,10 +59,18 @@ def update_level(updates, object_properties: bool = False) -> str:
     return LEVELS[level]
 
 
+OBJECT_VALUES = frozenset({"object_color", "object_alpha", "object_index"})  # Object Info reads an edit may change
+
+
 def reads_object_properties(scene) -> bool:
-    """Whether the exported ``scene``'s materials read objects' properties (ObjectTable.properties)."""
+    """Whether the exported ``scene``'s materials read what an edit of an object may change without moving it:
+    its properties (ObjectTable.properties) or its Object Info Color, Alpha or Pass Index."""
     objs = getattr(getattr(scene, "geometry", None), "objects", None)
-    return getattr(objs, "properties", None) is not None
+    if getattr(objs, "properties", None) is not None:
+        return True
+    mats = getattr(scene, "materials", None)
+    programs = list(getattr(mats, "programs", None) or []) + list(getattr(mats, "aov_programs", None) or [])
+    return any(OBJECT_VALUES & set(prog.reads) for prog in programs)
 
 
 class SceneExporter:

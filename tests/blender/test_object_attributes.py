@@ -156,3 +156,40 @@ def test_an_instancer_attribute_found_nowhere_is_named(addon):
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     assert [w for w in sc.warnings if "Attribute 'nowhere' (Instancer)" in w]
     assert not sc.geometry.objects.properties["INSTANCER:nowhere"].any()
+
+
+def test_an_object_colour_edit_reaches_the_viewports_export(addon):
+    """A material reading Object Info's Color: an edit of the object's Color exports the instances again with it
+    (before, the viewport kept the last export's object table until a full export)."""
+    from restir_engine.export import export_scene
+    from restir_engine.export.incremental import SceneExporter, reads_object_properties, update_level
+    object_attribute_scene()
+    ob = bpy.data.objects["attr_plane0"]
+    mat = ob.data.materials[0]
+    tree = mat.node_tree
+    info = tree.nodes.new("ShaderNodeObjectInfo")
+    tree.links.new(info.outputs["Color"], tree.nodes["Emission"].inputs["Color"])
+    for other in bpy.data.materials:  # no material reads properties: Object Info alone decides
+        if other != mat:
+            node = other.node_tree.nodes["Attribute"]
+            node.attribute_type, node.attribute_name = "GEOMETRY", "none"
+    dg = bpy.context.evaluated_depsgraph_get()
+    exporter = SceneExporter()
+    cam = export_scene(dg).camera
+    first = exporter.export(dg, cam, "FULL")
+    assert first.geometry.objects.properties is None and reads_object_properties(first)
+    seen = []
+
+    def on_update(_scene, depsgraph):
+        level = update_level(depsgraph.updates, reads_object_properties(exporter.last))
+        seen.append((level, exporter.export(depsgraph, cam, level)))
+
+    bpy.app.handlers.depsgraph_update_post.append(on_update)
+    try:
+        ob.color = (0.2, 0.7, 0.1, 1.0)
+        bpy.context.view_layer.update()
+    finally:
+        bpy.app.handlers.depsgraph_update_post.remove(on_update)
+    level, out = seen[-1]
+    k = out.geometry.objects.names.index("attr_plane0")
+    assert level == "TRANSFORM" and np.allclose(out.geometry.objects.color[k], (0.2, 0.7, 0.1, 1.0))
