@@ -21,6 +21,7 @@ import bpy
 from . import export_scene, export_shading
 from .materials import MaterialRegistry
 from .meshes import slot_signature
+from .object_properties import view_layer_places
 
 LEVELS = ("NONE", "SETTINGS", "SHADING", "TRANSFORM", "FULL")
 _SHADING_TYPES = (bpy.types.Material, bpy.types.World, bpy.types.NodeTree, bpy.types.Image, bpy.types.Light,
@@ -116,6 +117,8 @@ class SceneExporter:
             return None
         warnings = list(stats.get("geometry_warnings", []))
         registry = MaterialRegistry(warnings)
+        registry.camera = camera
+        registry.view_layer = view_layer_places(depsgraph.view_layer_eval, depsgraph.scene_eval)
         for name in stats["material_index"]:  # the previous order gives the previous indices
             mat = bpy.data.materials.get(name)
             if mat is None:

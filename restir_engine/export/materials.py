@@ -201,6 +201,7 @@ class MaterialRegistry(MixShaderReader, NormalReader, TextureReader):
         g = GraphCompiler(lambda image, alpha: self._texture(material, image, alpha=alpha),
                           lambda reason: self._warn(material, reason))
         g.camera = getattr(self, "camera", None)
+        g.view_layer = getattr(self, "view_layer", None)  # where View Layer attributes are looked up
         g.material_index = float(getattr(material, "pass_index", 0))
         return g
 

@@ -83,14 +83,20 @@ def _color_attribute(g, node, f):
 
 def _attribute(g, node, f):
     """Geometry: a colour attribute of the mesh; Object / Instancer: a property of the object (or its instancer)
-    per instance (export/object_properties.py); View Layer is not read."""
+    per instance; View Layer: a property of the view layer, scene or world (export/object_properties.py; where the
+    compiler knows them: materials and the world)."""
     kind = node.attribute_type
-    if kind not in ("GEOMETRY", "OBJECT", "INSTANCER"):
+    places = getattr(g, "view_layer", None)
+    if kind not in ("GEOMETRY", "OBJECT", "INSTANCER") and not (kind == "VIEW_LAYER" and places is not None):
         return None
     name = node.attribute_name
     if not name:  # as Cycles: an Attribute node without a name finds nothing and gives 0 on every output
         zero = g.constant(0.0, "float")
         return {"Color": g.constant(0.0, "color"), "Vector": g.constant(0.0, "vector"), "Fac": zero, "Alpha": zero}
+    if kind == "VIEW_LAYER":  # one value for the whole render: a constant
+        r, gr, b, a = object_properties.first_value(places, name)
+        return {"Color": g.constant((r, gr, b), "color"), "Vector": g.constant((r, gr, b), "vector"),
+                "Fac": g.constant((r + gr + b) / 3.0, "float"), "Alpha": g.constant(a, "float")}
     if kind == "GEOMETRY":
         rgb, alpha = f"attr:{name}", f"attr_alpha:{name}"
     else:

@@ -1,5 +1,7 @@
-"""Object and Instancer attributes (the Attribute node's Object and Instancer types): a property of each instance's
-object, read once per instance at export and looked up per hit by its instance (core ObjectTable.properties).
+"""Object, Instancer and View Layer attributes (the Attribute node's types other than Geometry): a property of each
+instance's object, read once per instance at export and looked up per hit by its instance (core
+ObjectTable.properties); a View Layer attribute is one value for the whole render (a constant of the graph), looked
+up on the view layer, then the scene, then its world.
 
 As Cycles reads them: the attribute name is an RNA path (``color``, ``location``) or a custom property's name
 (``prop`` or ``["prop"]``), looked up on the object, then on its data (the mesh); the Instancer type looks first on
@@ -86,3 +88,17 @@ def unread_instance_attributes(inst, values: dict) -> list[str]:
     if not getattr(inst, "is_instance", False):
         return []
     return [key.split(":", 1)[1] for key, v in values.items() if key.startswith("INSTANCER:") and v == MISSING]
+
+
+def view_layer_places(view_layer, scene) -> tuple:
+    """Where a View Layer attribute is looked up, in order: the view layer, the scene, the scene's world."""
+    return tuple(p for p in (view_layer, scene, getattr(scene, "world", None)) if p is not None)
+
+
+def first_value(places, name: str) -> tuple:
+    """(r, g, b, a) of ``name`` on the first of ``places`` that has it (MISSING where none does)."""
+    for place in places:
+        value = _lookup(place, name)
+        if value is not None:
+            return value
+    return MISSING

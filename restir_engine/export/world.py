@@ -20,14 +20,15 @@ MAX_BAKE_WIDTH = 2048
 _BAKE_CHUNK = 1 << 18
 
 
-def export_world(scene, warnings: list):
+def export_world(scene, warnings: list, view_layer=None):
     """(constant radiance (3,), image (h, w, 3) radiance or None, rotation world -> texture (3, 3) or None, what
-    camera rays see instead: (radiance, image) or None)."""
-    got = _export_world(scene, warnings)
+    camera rays see instead: (radiance, image) or None). ``view_layer``: where View Layer attributes are looked up
+    (object_properties.view_layer_places; None: not read)."""
+    got = _export_world(scene, warnings, view_layer)
     return got if len(got) == 4 else (*got, None)
 
 
-def _export_world(scene, warnings: list):
+def _export_world(scene, warnings: list, view_layer=None):
     world = scene.world
     none = (np.zeros(3, np.float32), None, None)
     if world is None:
@@ -54,13 +55,14 @@ def _export_world(scene, warnings: list):
                 strength = float(strength_in.default_value)
                 image = registry.textures[registry._texture(world, src.image)] * np.float32(strength)
                 return np.zeros(3, np.float32), np.asarray(image, np.float32), rotation
-    return _baked(world, registry, color_in, strength_in, warnings)
+    return _baked(world, registry, color_in, strength_in, warnings, view_layer)
 
 
-def _baked(world, registry, color_in, strength_in, warnings: list):
+def _baked(world, registry, color_in, strength_in, warnings: list, view_layer=None):
     """The Background's Color x Strength through their node graph: a constant, or an image over directions."""
     notes = []
     g = GraphCompiler(lambda image, alpha: registry._texture(world, image, alpha=alpha), notes.append)
+    g.view_layer = view_layer
     color, strength = g.value(color_in, "color"), g.value(strength_in, "float")
     warnings.extend(f"World '{world.name}': {n}" for n in dict.fromkeys(notes))
     if color.const is not None and strength.const is not None:

@@ -1,9 +1,10 @@
-"""The Attribute node's Object and Instancer types (export/object_properties.py) against Cycles, pixel by pixel:
+"""The Attribute node's Object, Instancer and View Layer types (export/object_properties.py) against Cycles, pixel by
+pixel:
 a grid of emissive planes seen by an orthographic camera, each plane's Emission driven by one Attribute node (its
 Color into the Emission colour, or its Fac or Alpha into the Strength), read from custom properties of the object
 (a number, an integer, a boolean, a 2-, 3- and 4-array, a string), of its mesh, RNA paths (``color``,
-``location``), and through a collection instance whose empty holds its own value (Instancer) over the instanced
-object's (Object). Emission alone has no noise: inside each plane both engines give the same value to float32
+``location``), through a collection instance whose empty holds its own value (Instancer) over the instanced
+object's (Object), and of the view layer, scene and world (View Layer, in that order; an RNA path of the scene). Emission alone has no noise: inside each plane both engines give the same value to float32
 precision."""
 import bpy
 import numpy as np
@@ -16,9 +17,11 @@ CASES = [("OBJECT", "fprop", "Color"), ("OBJECT", '["vprop"]', "Color"), ("OBJEC
          ("OBJECT", "flag", "Color"), ("OBJECT", "sprop", "Alpha"), ("OBJECT", "location", "Color"),
          ("OBJECT", "missing", "Alpha"), ("INSTANCER", "fprop", "Color"),
          ("INSTANCER", "inst", "Color"), ("OBJECT", "inst", "Color"), ("INSTANCER", "both", "Fac"),
-         ("INSTANCER", "location", "Color")]
-INSTANCED = 14  # the last four planes are instanced by an empty
-COLS, ROWS, CELL = 6, 3, 8  # grid of planes; pixels per plane
+         ("INSTANCER", "location", "Color"),
+         ("VIEW_LAYER", "a", "Color"), ("VIEW_LAYER", "b", "Color"), ("VIEW_LAYER", "c", "Fac"),
+         ("VIEW_LAYER", "d", "Alpha"), ("VIEW_LAYER", "render.resolution_x", "Fac"), ("VIEW_LAYER", "fprop", "Color")]
+INSTANCED = range(14, 18)  # these planes are instanced by an empty
+COLS, ROWS, CELL = 6, 4, 8  # grid of planes; pixels per plane
 
 
 def _material(kind, name, output):
@@ -69,7 +72,7 @@ def object_attribute_scene():
     coll = bpy.data.collections.new("attr_instanced")
     for k, case in enumerate(CASES):
         ob = _plane(k, _material(*case))
-        (coll if k >= INSTANCED else scene.collection).objects.link(ob)
+        (coll if k in INSTANCED else scene.collection).objects.link(ob)
     empty = bpy.data.objects.new("attr_instancer", None)
     empty.instance_type, empty.instance_collection = "COLLECTION", coll
     empty["inst"], empty["fprop"] = 0.9, 0.15
@@ -78,6 +81,9 @@ def object_attribute_scene():
     world = bpy.data.worlds.new("attr_world")
     world.color = (0, 0, 0)
     scene.world = world
+    # View Layer attributes: the view layer's, else the scene's, else the world's
+    scene.view_layers[0]["a"], scene["a"], world["a"] = 0.1, 0.2, 0.3
+    scene["b"], world["b"], world["c"], scene["d"] = 0.45, 0.5, (0.6, 0.7, 0.8), [0.1, 0.2, 0.3, 0.4]
     return scene
 
 
@@ -108,6 +114,8 @@ def test_object_and_instancer_attributes_match_cycles(addon):
     assert np.allclose(values[13], 0.25)  # Instancer on an object nothing instances: the object's own
     assert np.allclose(values[14], 0.9) and np.allclose(values[15], 0.4)  # the empty's; the instanced object's
     assert np.allclose(values[16], 0.35) and np.allclose(values[17], (0, 0, -0.5))  # the empty has no "both"
+    assert np.allclose(values[18:21, 0], (0.1, 0.45, 0.7)) and np.allclose(values[22], COLS * CELL)  # render.resolution_x
+    assert np.allclose(values[23], 0.0)  # an object's property is not the view layer's
     assert np.allclose(values[10], 0.0) and np.allclose(values[12], 0.0)  # a string, a missing name: alpha 0
 
 
@@ -193,3 +201,17 @@ def test_an_object_colour_edit_reaches_the_viewports_export(addon):
     level, out = seen[-1]
     k = out.geometry.objects.names.index("attr_plane0")
     assert level == "TRANSFORM" and np.allclose(out.geometry.objects.color[k], (0.2, 0.7, 0.1, 1.0))
+
+
+def test_a_world_reads_view_layer_attributes(addon):
+    """A world whose Background Color is a View Layer attribute: the scene's value over the world's (one constant
+    radiance); before, the node was approximated by its socket's value with a warning."""
+    from restir_engine.export import export_scene
+    scene = object_attribute_scene()
+    tree = scene.world.node_tree
+    att = tree.nodes.new("ShaderNodeAttribute")
+    att.attribute_type, att.attribute_name = "VIEW_LAYER", "b"
+    tree.links.new(att.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    tree.nodes["Background"].inputs["Strength"].default_value = 2.0
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    assert np.allclose(sc.world_radiance, 0.9) and not [w for w in sc.warnings if "Attribute" in w]
