@@ -37,10 +37,7 @@ def _threads_of_this_suite():
     gives each its share of the cores; bpy renders take it from harness.render.configure_restir), else every
     logical core."""
     from restir_engine.core.parallel import pool
-    threads = int(os.environ.get("RESTIR_TEST_THREADS", "0"))
-    pool.set_thread_count(threads or None)
-    yield
-    pool.set_thread_count(threads or None)
+    pool.set_thread_count(int(os.environ.get("RESTIR_TEST_THREADS", "0")) or None)
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -61,9 +61,7 @@ def export_scene(depsgraph, camera_override=None, camera=None, mesh_cache: dict 
     warnings: list[str] = []
     if camera is None:
         camera = export_camera(depsgraph, camera_override, warnings)
-    registry = MaterialRegistry(warnings)
-    registry.camera = camera  # what Texture Coordinate's Camera and Window outputs are relative to
-    registry.view_layer = view_layer_places(depsgraph.view_layer_eval, depsgraph.scene_eval)
+    registry = MaterialRegistry(warnings, camera, view_layer_places(depsgraph.view_layer_eval, depsgraph.scene_eval))
     geometry, stats = export_geometry(depsgraph, registry, warnings, mesh_cache,
                                       None if last is None else (last.geometry, last.export_stats))
     geometry_warnings = list(warnings)
@@ -78,8 +76,7 @@ def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warn
     ``registry``) around ``geometry``."""
     groups = group_index(depsgraph)
     lamps = export_lamps(depsgraph, registry, warnings, groups)
-    world, world_image, world_rotation, camera_view = export_world(
-        depsgraph.scene, warnings, view_layer_places(depsgraph.view_layer_eval, depsgraph.scene_eval))
+    world, world_image, world_rotation, camera_view = export_world(depsgraph.scene, warnings, registry.view_layer)
     world = clamped_radiance(world, "World", warnings).astype(np.float32)
     if world_image is not None:
         world_image = clamped_radiance(world_image, "World texture", warnings).astype(np.float32)

@@ -116,9 +116,8 @@ class SceneExporter:
         if slot_signature(depsgraph) != stats["slot_signature"]:
             return None
         warnings = list(stats.get("geometry_warnings", []))
-        registry = MaterialRegistry(warnings)
-        registry.camera = camera
-        registry.view_layer = view_layer_places(depsgraph.view_layer_eval, depsgraph.scene_eval)
+        registry = MaterialRegistry(warnings, camera,
+                                    view_layer_places(depsgraph.view_layer_eval, depsgraph.scene_eval))
         for name in stats["material_index"]:  # the previous order gives the previous indices
             mat = bpy.data.materials.get(name)
             if mat is None:

@@ -33,8 +33,10 @@ class MaterialRegistry(MixShaderReader, NormalReader, TextureReader):
     """Assigns table indices to Blender materials (index 0 is Blender's default grey) and
     collects textures; reports approximations through ``warnings``."""
 
-    def __init__(self, warnings: list):
+    def __init__(self, warnings: list, camera=None, view_layer=None):
         self.warnings = warnings
+        self.camera = camera  # what Texture Coordinate's Camera and Window outputs are relative to (None: unknown)
+        self.view_layer = view_layer  # where View Layer attributes are looked up (object_properties.view_layer_places)
         self.rows: list[dict] = [dict(DEFAULT_MATERIAL)]
         self.index: dict = {}
         self.textures: list[np.ndarray] = []
@@ -90,34 +92,29 @@ class MaterialRegistry(MixShaderReader, NormalReader, TextureReader):
             return any(reads(self.rows[comp]) for comp, *_r in row.get("mix", ()))
         return any(reads(self.rows[i]) for i in indices)
 
-    def attribute_names(self, indices) -> set:
-        """The colour / geometry attributes the node programs of materials ``indices`` read."""
-        names: set = set()
+    def _program_reads(self, indices) -> set:
+        """What the node programs (surface and AOV) of materials ``indices`` and their mix components read."""
+        reads: set = set()
 
         def collect(row: dict) -> None:
             for prog in (row.get("program"), row.get("aov_program")):
                 if prog is not None:
-                    names.update(r.split(":", 1)[1] for r in prog.reads if r.startswith("attr"))
+                    reads.update(prog.reads)
             for comp, *_rest in row.get("mix", ()):
                 collect(self.rows[comp])
         for i in indices:
             collect(self.rows[i])
-        return names
+        return reads
+
+    def attribute_names(self, indices) -> set:
+        """The colour / geometry attributes the node programs of materials ``indices`` read."""
+        return {r.split(":", 1)[1] for r in self._program_reads(indices) if r.startswith("attr")}
 
     def object_property_keys(self, indices) -> frozenset:
         """The Object / Instancer attribute keys ("KIND:name") the node programs of materials ``indices`` read
         (export/object_properties.py)."""
-        keys: set = set()
-
-        def collect(row: dict) -> None:
-            for prog in (row.get("program"), row.get("aov_program")):
-                if prog is not None:
-                    keys.update(k for k in map(object_properties.key_of, prog.reads) if k is not None)
-            for comp, *_rest in row.get("mix", ()):
-                collect(self.rows[comp])
-        for i in indices:
-            collect(self.rows[i])
-        return frozenset(keys)
+        keys = map(object_properties.key_of, self._program_reads(indices))
+        return frozenset(k for k in keys if k is not None)
 
     def table(self) -> MaterialTable:
         for row in self.rows:
@@ -200,8 +197,8 @@ class MaterialRegistry(MixShaderReader, NormalReader, TextureReader):
         """A node-graph compiler for one row of ``material`` (images go to this registry's texture list)."""
         g = GraphCompiler(lambda image, alpha: self._texture(material, image, alpha=alpha),
                           lambda reason: self._warn(material, reason))
-        g.camera = getattr(self, "camera", None)
-        g.view_layer = getattr(self, "view_layer", None)  # where View Layer attributes are looked up
+        g.camera = self.camera
+        g.view_layer = self.view_layer
         g.material_index = float(getattr(material, "pass_index", 0))
         return g
 

@@ -86,8 +86,8 @@ def _attribute(g, node, f):
     per instance; View Layer: a property of the view layer, scene or world (export/object_properties.py; where the
     compiler knows them: materials and the world)."""
     kind = node.attribute_type
-    places = getattr(g, "view_layer", None)
-    if kind not in ("GEOMETRY", "OBJECT", "INSTANCER") and not (kind == "VIEW_LAYER" and places is not None):
+    places = getattr(g, "view_layer", None)  # None: a compiler that does not know them (a lamp's)
+    if kind not in ("GEOMETRY", "OBJECT", "INSTANCER", "VIEW_LAYER") or (kind == "VIEW_LAYER" and places is None):
         return None
     name = node.attribute_name
     if not name:  # as Cycles: an Attribute node without a name finds nothing and gives 0 on every output

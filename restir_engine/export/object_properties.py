@@ -15,7 +15,6 @@ from numbers import Real
 
 from ..core.materials.nodes.attributes import OBJECT_PROPERTY, OBJECT_PROPERTY_ALPHA
 
-KINDS = ("OBJECT", "INSTANCER")
 MISSING = (0.0, 0.0, 0.0, 0.0)
 
 
@@ -34,7 +33,7 @@ def key_of(read: str) -> str | None:
 
 
 def _as_rgba(value) -> tuple | None:
-    if isinstance(value, bool) or isinstance(value, Real):
+    if isinstance(value, Real):  # bool and int too
         v = float(value)
         return (v, v, v, 1.0)
     if isinstance(value, str):
@@ -71,13 +70,8 @@ def instance_values(inst, obj, keys) -> dict:
     parent = getattr(inst, "parent", None) if getattr(inst, "is_instance", False) else None
     for key in keys:
         kind, name = key.split(":", 1)
-        places = ([parent] if kind == "INSTANCER" and parent is not None else []) + [obj, getattr(obj, "data", None)]
-        value = None
-        for idb in places:
-            value = _lookup(idb, name)
-            if value is not None:
-                break
-        out[key] = value if value is not None else MISSING
+        places = ([parent] if kind == "INSTANCER" else []) + [obj, getattr(obj, "data", None)]
+        out[key] = first_value(places, name)
     return out
 
 
@@ -96,7 +90,8 @@ def view_layer_places(view_layer, scene) -> tuple:
 
 
 def first_value(places, name: str) -> tuple:
-    """(r, g, b, a) of ``name`` on the first of ``places`` that has it (MISSING where none does)."""
+    """(r, g, b, a) of ``name`` on the first of ``places`` (None entries skipped) that has it (MISSING where none
+    does)."""
     for place in places:
         value = _lookup(place, name)
         if value is not None:

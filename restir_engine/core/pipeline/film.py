@@ -259,9 +259,7 @@ def _add_batch(flat: dict, c, groups: int, world_to_cam: np.ndarray) -> None:
     rgb = np.ascontiguousarray(emitted.transpose(1, 2, 0), dtype=FILM_DTYPE) if "aux" in flat else None
 
     def add_rows(key, value, light=False, tinted=True):  # (3, hits) values of the hit rows, per pixel
-        dense = np.zeros((len(c.pixels), 3), np.float32)
-        dense[c.hits.rows] = (value if chain is None or not tinted else value * chain).T
-        dense = dense.reshape(c.batch, n, 3)
+        dense = _by_sample(c, n, c.hits.rows, (value if chain is None or not tinted else value * chain).T)
         flat[key][span] += dense.sum(axis=0)
         if light and rgb is not None:
             rgb[...] += dense
@@ -286,14 +284,18 @@ def _add_batch(flat: dict, c, groups: int, world_to_cam: np.ndarray) -> None:
         add_rows("dnormal", world_to_cam @ c.hits.surf.facing_normals()[1], tinted=False)
 
 
+def _by_sample(c, n: int, rows: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """(batch, n, ...) float32: ``values`` (k, ...) placed at positions ``rows`` of a batched chunk's pixel list (its
+    ``n`` pixels once per sample), zero elsewhere; summed over axis 0 it is each pixel's sum over its samples."""
+    dense = np.zeros((len(c.pixels),) + values.shape[1:], np.float32)
+    dense[rows] = values
+    return dense.reshape((c.batch, n) + values.shape[1:])
+
+
 def _add_batched_catchers(flat: dict, c, span, n: int) -> None:
     """A batched chunk's shadow catcher sums (pipeline/shadow_catcher.py) into the film's flat sums at ``span`` (its
     ``n`` pixels): each summed over the samples of its pixel."""
     rows = c.hits.rows[c.catcher]  # positions in the chunk's (batch * n) pixel list
     for key, value in (("sc_with", c.sc_with), ("sc_without", c.sc_without), ("sc_behind", c.sc_behind)):
-        dense = np.zeros((len(c.pixels), 3), np.float32)
-        dense[rows] = value.T
-        flat[key][span] += dense.reshape(c.batch, n, 3).sum(axis=0)
-    covered = np.zeros(len(c.pixels), np.float32)
-    covered[rows] = 1.0
-    flat["sc_cov"][span] += covered.reshape(c.batch, n).sum(axis=0)
+        flat[key][span] += _by_sample(c, n, rows, value.T).sum(axis=0)
+    flat["sc_cov"][span] += _by_sample(c, n, rows, np.ones(len(rows), np.float32)).sum(axis=0)

@@ -208,7 +208,6 @@ class HitAttributes:
             return np.ascontiguousarray(vals[:3]) if name.startswith("attr:") else np.ascontiguousarray(vals[3])
         raise KeyError(f"unknown hit attribute {name!r}")
 
-
     def _object_property(self, name: str):
         """An Object / Instancer attribute's RGB (3, n) or alpha (n,) at the points (0 without an object table)."""
         alpha = name.startswith(OBJECT_PROPERTY_ALPHA)
@@ -249,8 +248,6 @@ class DirectionAttributes:
         if name in {"uv", "parametric", "object_location", "object_color", "tangent"} or \
                 name.startswith(("attr:", OBJECT_PROPERTY)):
             return np.zeros((3, n), np.float32)
-        if name.startswith(OBJECT_PROPERTY_ALPHA):
-            return np.zeros(n, np.float32)
         if name == "footprint":
             return np.full(n, _F(1e-3), np.float32)
         if name == "is_camera_ray":
@@ -261,4 +258,4 @@ class DirectionAttributes:
             return np.full(n, _F(3.4e38), np.float32)
         if name in {"tangent_uv", "tangent_sign"}:
             return None
-        return np.zeros(n, np.float32)  # backfacing, object alpha / random, attribute alphas
+        return np.zeros(n, np.float32)  # backfacing, object alpha / random, attribute and property alphas
