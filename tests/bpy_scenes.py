@@ -1206,3 +1206,86 @@ def shadow_catcher_scene(size=(64, 48), transparent=False, catcher_pass=False):
     layer.cycles.use_pass_shadow_catcher = catcher_pass
     layer.restir.use_pass_shadow_catcher = catcher_pass
     return scene
+
+
+def _lamp_tree(lamp_obj):
+    """(node tree, its Emission node) of a lamp, nodes on."""
+    data = lamp_obj.data
+    data.use_nodes = True
+    tree = data.node_tree
+    return tree, next(n for n in tree.nodes if n.type == "EMISSION")
+
+
+#: the lamps of :func:`textured_lamp_scene`
+TEXTURED_LAMPS = ("point", "spot", "area", "rotated")
+
+
+def textured_lamp_scene(kind: str, size=(64, 64)):
+    """A white diffuse floor seen from above (orthographic) lit by one lamp whose Emission comes from a node graph
+    that varies over it, as artists texture lamps: ``point`` a tiny point lamp whose Color is a Checker of Texture
+    Coordinate Normal (an IES-like pattern) and whose Strength grows along the Normal's X; ``spot`` a spot lamp
+    projecting a 16 x 16 image of colour ramps and squares through Texture Coordinate UV (a gobo); ``area`` a rectangular area lamp
+    whose Color is its UV and whose Strength is a Checker of Object coordinates; ``rotated`` a turned, scaled
+    point lamp whose Color is a Gradient of Normal (object space) and Strength its UV's Y."""
+    import node_graphs as ng
+    scene = reset()
+    black_world(scene)
+    plane("Floor", 8.0, (0, 0, 0), material=diffuse("Floor", (0.8, 0.8, 0.8)))
+    camera((0, 0, 10), (0, 0, 0), ortho_scale=4.0)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    if kind in ("point", "rotated"):
+        lamp = light("POINT", (0.2, -0.1, 1.0), energy=60.0, shadow_soft_size=0.0)
+    elif kind == "spot":
+        lamp = light("SPOT", (0.0, 0.0, 2.0), energy=150.0, shadow_soft_size=0.0, spot_size=1.3, spot_blend=0.1)
+        lamp.rotation_euler = (0.0, 0.15, 0.4)
+    else:
+        lamp = light("AREA", (0.1, 0.0, 0.8), energy=40.0, shape="RECTANGLE", size=1.2, size_y=0.7)
+        lamp.rotation_euler = (0.0, 0.0, 0.5)
+    t, em = _lamp_tree(lamp)
+    tc = ng._node(t, "ShaderNodeTexCoord")
+    if kind == "point":
+        chk = ng._node(t, "ShaderNodeTexChecker")
+        ng._set(chk, "Scale", 3.0)
+        chk.inputs["Color1"].default_value = (1.0, 0.3, 0.1, 1.0)
+        chk.inputs["Color2"].default_value = (0.1, 0.4, 1.0, 1.0)
+        t.links.new(tc.outputs["Normal"], chk.inputs["Vector"])
+        t.links.new(chk.outputs["Color"], em.inputs["Color"])
+        sep = ng._node(t, "ShaderNodeSeparateXYZ")
+        t.links.new(tc.outputs["Normal"], sep.inputs[0])
+        mad = ng._node(t, "ShaderNodeMath", operation="MULTIPLY_ADD")
+        mad.inputs[1].default_value, mad.inputs[2].default_value = 0.5, 1.0
+        t.links.new(sep.outputs["X"], mad.inputs[0])
+        t.links.new(mad.outputs[0], em.inputs["Strength"])
+    elif kind == "spot":
+        i, j = np.meshgrid(np.arange(16), np.arange(16))
+        gobo = np.stack([i / 15, j / 15, ((i // 4 + j // 4) % 2) * 0.8 + 0.1], axis=2).astype(np.float32)
+        tex = ng._node(t, "ShaderNodeTexImage")
+        tex.image = packed_image("Gobo", gobo)
+        t.links.new(tc.outputs["UV"], tex.inputs["Vector"])
+        t.links.new(tex.outputs["Color"], em.inputs["Color"])
+    elif kind == "area":
+        t.links.new(tc.outputs["UV"], em.inputs["Color"])
+        chk = ng._node(t, "ShaderNodeTexChecker")
+        ng._set(chk, "Scale", 2.0)
+        t.links.new(tc.outputs["Object"], chk.inputs["Vector"])
+        mad = ng._node(t, "ShaderNodeMath", operation="ADD")
+        mad.inputs[1].default_value = 0.3
+        t.links.new(chk.outputs["Fac"], mad.inputs[0])
+        t.links.new(mad.outputs[0], em.inputs["Strength"])
+    else:
+        lamp.rotation_euler = (0.3, -0.2, 0.7)
+        lamp.scale = (1.0, 1.5, 1.0)
+        grad = ng._node(t, "ShaderNodeTexGradient")
+        t.links.new(tc.outputs["Normal"], grad.inputs["Vector"])
+        ramp = ng._node(t, "ShaderNodeValToRGB")
+        ramp.color_ramp.elements[0].color = (0.1, 0.2, 1.0, 1.0)
+        ramp.color_ramp.elements[1].color = (1.0, 0.6, 0.1, 1.0)
+        t.links.new(grad.outputs["Fac"], ramp.inputs["Fac"])
+        t.links.new(ramp.outputs["Color"], em.inputs["Color"])
+        sep = ng._node(t, "ShaderNodeSeparateXYZ")
+        t.links.new(tc.outputs["UV"], sep.inputs[0])
+        mad = ng._node(t, "ShaderNodeMath", operation="ADD")
+        mad.inputs[1].default_value = 0.25
+        t.links.new(sep.outputs["Y"], mad.inputs[0])
+        t.links.new(mad.outputs[0], em.inputs["Strength"])
+    return scene

@@ -280,6 +280,8 @@ class Lamps:
     itself emits), sphere_first (n,) int32 the first proxy triangle of that lamp (-1 = not a sphere).
     Suns (distant lights): sun_dir (s, 3) unit direction *towards* the sun,
     sun_cos (s,) cos of the half angle (1 = delta), sun_irradiance (s, 3) W·m⁻² on a surface facing it.
+    textured: the lamps whose colour comes from a node graph that varies over them (lights/lamp_textures.py), a
+    colour factor on their triangles' constant radiance that depends on the receiver.
     """
 
     tris: TriangleSet
@@ -297,6 +299,7 @@ class Lamps:
     sun_group: np.ndarray = None  # (s,) int16 each sun's
     falloff: np.ndarray = None
     falloff_smooth: np.ndarray = None
+    textured: object = None  # lights.lamp_textures.LampTextures: lamps coloured by node programs; None: none
 
     def __post_init__(self):
         n = len(self.spot_cos)
@@ -315,7 +318,10 @@ class Lamps:
     def receiver_dependent(self) -> np.ndarray:
         """(n,) bool: lamp triangles whose radiance depends on where the receiver is (a spot cone, a falloff)."""
         k, s = self.falloff_terms()
-        return (self.spot_cos > -1.5) | (k != 0) | (s > 0)
+        out = (self.spot_cos > -1.5) | (k != 0) | (s > 0)
+        if self.textured is not None:
+            out = out | (self.textured.program >= 0)
+        return out
 
     @staticmethod
     def empty() -> Lamps:

@@ -80,6 +80,9 @@ def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warn
     world = clamped_radiance(world, "World", warnings).astype(np.float32)
     if world_image is not None:
         world_image = clamped_radiance(world_image, "World texture", warnings).astype(np.float32)
-    return Scene(geometry=geometry, materials=registry.table(), lamps=lamps, camera=camera,
+    materials = registry.table()
+    if lamps.textured is not None:  # the lamps' programs read the table's images
+        lamps.textured.textures = materials.textures
+    return Scene(geometry=geometry, materials=materials, lamps=lamps, camera=camera,
                  world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings,
                  world_camera_view=camera_view, light_groups=export_light_groups(depsgraph, geometry, groups))

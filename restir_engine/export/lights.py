@@ -84,11 +84,14 @@ def _falloff(found: list, name: str, warnings: list) -> tuple:
     return first
 
 
-def _light_node_scale(light, warnings: list, name: str, falloff: list | None = None):
+def _light_node_scale(light, warnings: list, name: str, falloff: list | None = None, registry=None,
+                      program: list | None = None):
     """RGB factor of a light's node tree: its Emission node's Color x Strength, each folded to a constant through
     whatever nodes feed it (RGB, Math, Mix, Blackbody, Light Falloff ...; core/materials/nodes); 1 without nodes.
-    A graph that varies over the light (a texture) is named in a warning and its sockets' own values are used.
-    ``falloff`` (a list of two) receives the (k, smooth) of a Light Falloff node the Emission reads (scene.Lamps)."""
+    ``falloff`` (a list of two) receives the (k, smooth) of a Light Falloff node the Emission reads (scene.Lamps).
+    A graph that varies over the light (a texture) is compiled into a node program (core/lights/lamp_textures.py)
+    appended to ``program`` (with the material ``registry`` its images go to), and the factor is 1; without
+    ``program`` (a sun) it is named in a warning and its sockets' own values are used."""
     falloff = [0, 0.0] if falloff is None else falloff
     tree = light.node_tree
     if tree is None or not getattr(light, "use_nodes", True):
@@ -105,36 +108,132 @@ def _light_node_scale(light, warnings: list, name: str, falloff: list | None = N
         return np.ones(3)
     from .node_graph import GraphCompiler
     notes = []
-    g = GraphCompiler(lambda image, alpha: 0, notes.append)
+    images = (lambda image, alpha: registry._texture(light, image, alpha=alpha)) if registry is not None else \
+        (lambda image, alpha: 0)
+    g = GraphCompiler(images, notes.append)
+    if registry is not None:
+        g.camera, g.view_layer = registry.camera, registry.view_layer
     g.falloffs = []
     color, strength = g.value(node.inputs["Color"], "color"), g.value(node.inputs["Strength"], "float")
     warnings.extend(f"Light '{name}': {n}" for n in dict.fromkeys(notes))
     falloff[:] = _falloff(g.falloffs, name, warnings)
+    if (color.const is None or strength.const is None) and program is not None:
+        from ..core.lights.lamp_textures import OUTPUT
+        program.append(g.program({OUTPUT: g.emit("scale", {}, [color, strength], ("color",))[0]}))
+        return np.ones(3)
     out = []
     for reg, sock in ((color, node.inputs["Color"]), (strength, node.inputs["Strength"])):
         if reg.const is not None:
             out.append(np.asarray(reg.constant_value(), np.float64))
             continue
-        warnings.append(f"Light '{name}': its {sock.name} varies over the light (a texture?), which lights do not "
+        warnings.append(f"Light '{name}': its {sock.name} varies over the light (a texture?), which suns do not "
                         "support; the socket's own value is used")
         v = sock.default_value
         out.append(np.array(v[:3] if sock.name == "Color" else v, np.float64))
     return out[0] * out[1]
 
 
-def _lamp_power(light, name: str, warnings: list, falloff: list | None = None) -> np.ndarray:
+def _lamp_power(light, name: str, warnings: list, falloff: list | None = None, registry=None,
+                program: list | None = None) -> np.ndarray:
     """Colour x Power (W) x 2^Exposure, times the Temperature's colour where the light uses one and its node
-    tree's factor (``falloff``: see :func:`_light_node_scale`)."""
+    tree's factor (``falloff``, ``registry``, ``program``: see :func:`_light_node_scale`)."""
     power = np.array(light.color[:3], np.float64) * float(light.energy)
     power *= 2.0 ** float(getattr(light, "exposure", 0.0))
     if getattr(light, "use_temperature", False):
         from ..core.lights.blackbody import blackbody_rgb
         power *= blackbody_rgb(float(light.temperature)).astype(np.float64).reshape(3)
-    return power * _light_node_scale(light, warnings, name, falloff)
+    return power * _light_node_scale(light, warnings, name, falloff, registry, program)
 
 
 def _area(tris: np.ndarray) -> float:
     return float(0.5 * np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1).sum())
+
+
+def _texture_record(program, light, inst, m: np.ndarray) -> tuple:
+    """What lights/lamp_textures.LampTextures keeps of a textured lamp: (program, kind, world -> object (3, 4),
+    object -> world (3, 3), uv scale (2,), location, colour (4,), random, pass index, sphere normal)."""
+    from ..core.lights import lamp_textures as lt
+    from .meshes import object_random
+    obj = inst.object
+    if light.type == "AREA":
+        sx = float(light.size)
+        sy = float(light.size_y) if light.shape in {"RECTANGLE", "ELLIPSE"} else sx
+        kind, uv_scale = lt.AREA, (1.0 / max(sx, 1e-12), 1.0 / max(sy, 1e-12))
+    elif light.type == "SPOT":
+        kind, uv_scale = lt.SPOT, (0.5 / max(np.tan(float(light.spot_size) / 2), 1e-12), 0.0)
+    else:
+        kind, uv_scale = lt.POINT, (0.0, 0.0)
+    try:
+        inv = np.linalg.inv(m)
+    except np.linalg.LinAlgError:
+        inv = np.linalg.pinv(m)
+    return (program, kind, inv[:3, :4], m[:3, :3], uv_scale, m[:3, 3], tuple(obj.color), object_random(inst),
+            float(getattr(obj, "pass_index", 0)), not getattr(light, "use_soft_falloff", True))
+
+
+def _lamp_textures(records: list, counts: list, textures: list):
+    """lights/lamp_textures.LampTextures per lamp triangle from each lamp's :func:`_texture_record` (None: a
+    constant lamp) and its triangle count."""
+    from ..core.lights.lamp_textures import LampTextures
+    blank = (None, 0, np.zeros((3, 4)), np.eye(3), (0.0, 0.0), np.zeros(3), (0.0, 0.0, 0.0, 1.0), 0.0, 0.0, False)
+    programs, index = [], []
+    for r in records:
+        index.append(-1 if r is None else len(programs))
+        if r is not None:
+            programs.append(r[0])
+    full = [blank if r is None else r for r in records]
+
+    def rep(k, dtype):
+        return np.repeat(np.array([r[k] for r in full], dtype), counts, axis=0)
+    return LampTextures(programs, np.repeat(np.array(index, np.int32), counts), rep(1, np.int8), rep(2, np.float32),
+                        rep(3, np.float32), rep(4, np.float32), rep(5, np.float32), rep(6, np.float32),
+                        rep(7, np.float32), rep(8, np.float32), rep(9, bool), textures=textures)
+
+
+#: points at which a textured lamp's graph is averaged for its share of the lamps' power
+_POWER_DIRECTIONS = 256
+
+
+def _power_scales(lamps) -> np.ndarray:
+    """(n,) float32 per lamp triangle: the mean luminance of a textured lamp's colour factor over the directions it
+    shines in (point and spot lamps, spots within their cone) or over its surface along its normal (area lamps), at
+    least 1e-3 (a lamp dark where it was probed is still picked); 1 for constant lamps."""
+    from ..core.lights.lamp_textures import AREA, lamp_texture_factor
+    from ..core.materials.params import luminance
+    from ..core.sampling import orthonormal_basis
+    lt = lamps.textured
+    out = np.ones(len(lt.program), np.float32)
+    k = _POWER_DIRECTIONS
+    i = np.arange(k) + 0.5
+    for prog in np.unique(lt.program[lt.program >= 0]):
+        rows = np.flatnonzero(lt.program == prog)
+        tri = rows[0]
+        if lt.kind[tri] == AREA:
+            first, count = rows[0], len(rows)
+            pick = first + (np.arange(k) % count)
+            b1 = (i % 16) / 16
+            b2 = (i // 16) / 16
+            b1, b2 = np.where(b1 + b2 > 1, 1 - b1, b1), np.where(b1 + b2 > 1, 1 - b2, b2)
+            v = lamps.tris.verts[pick].astype(np.float64)
+            q = (v[:, 0] + (v[:, 1] - v[:, 0]) * b1[:, None] + (v[:, 2] - v[:, 0]) * b2[:, None]).T
+            n = lamps.tris.normals[pick, 0].T
+            p = q + n
+        else:
+            pick = np.full(k, tri)
+            z = 1 - 2 * i / k
+            if lamps.spot_cos[tri] > -1.5:  # within the cone only
+                z = 1 - (1 - float(lamps.spot_cos[tri])) * i / k
+            phi = i * np.pi * (3 - np.sqrt(5))
+            r = np.sqrt(np.maximum(1 - z * z, 0))
+            local = np.stack([r * np.cos(phi), r * np.sin(phi), z])
+            axis = lamps.spot_axis[tri] if lamps.spot_cos[tri] > -1.5 else np.array([0.0, 0.0, 1.0])
+            t, b = orthonormal_basis(np.asarray(axis, np.float32).reshape(3, 1))
+            d = t * local[0] + b * local[1] + np.asarray(axis, np.float64).reshape(3, 1) * local[2]
+            q = np.repeat(lt.location[tri].reshape(3, 1), k, axis=1)
+            p, n = q + d, d
+        f = lamp_texture_factor(lt, pick, p.astype(np.float32), q.astype(np.float32), n.astype(np.float32))
+        out[rows] = max(float(np.abs(luminance(f.T)).mean()), 1e-3)
+    return out
 
 
 def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None) -> Lamps:
@@ -150,7 +249,8 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
         light = obj.data
         m = np.array(inst.matrix_world, np.float64)
         falloff = [0, 0.0]
-        power = _lamp_power(light, obj.name, warnings, falloff)
+        program = [] if light.type != "SUN" else None
+        power = _lamp_power(light, obj.name, warnings, falloff, registry, program)
         if not np.isfinite(m).all() or not np.isfinite(power).all():
             warnings.append(f"Light '{obj.name}' has a non-finite transform or power and was skipped")
             continue
@@ -197,8 +297,9 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
             radiance = power / np.pi
         mat = registry.add_row({"name": f"(light {obj.name})", "base_color": (0, 0, 0), "f0": 0.0,
                                 "emission": tuple(radiance), "two_sided_emission": False})
+        textured = _texture_record(program[0], light, inst, m) if program else None
         parts.append((world.astype(np.float32), mat, spot, visible, sphere,
-                      groups.get(getattr(obj, "lightgroup", ""), -1), tuple(falloff)))
+                      groups.get(getattr(obj, "lightgroup", ""), -1), tuple(falloff), textured))
 
     lamps = Lamps.empty()
     if parts:
@@ -221,6 +322,9 @@ def export_lamps(depsgraph, registry, warnings: list, groups: dict | None = None
         lamps.falloff_smooth = rep([p[6][1] for p in parts], np.float32)
         first = np.repeat(np.cumsum([0] + counts[:-1]), counts)
         lamps.sphere_first = np.where(lamps.sphere_radius > 0, first, -1).astype(np.int32)
+        if any(p[7] is not None for p in parts):
+            lamps.textured = _lamp_textures([p[7] for p in parts], counts, registry.textures)
+            lamps.textured.power_scale = _power_scales(lamps)
     if suns:
         lamps.sun_dir = np.array([s[0] for s in suns], np.float32)
         lamps.sun_cos = np.array([s[1] for s in suns], np.float32)

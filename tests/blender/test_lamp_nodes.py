@@ -64,6 +64,14 @@ def test_exposure_temperature_and_node_tree(addon):
     np.testing.assert_allclose(_power(light)[0], want, rtol=3e-3)
     tex = tree.nodes.new("ShaderNodeTexNoise")
     tree.links.new(tex.outputs["Color"], em.inputs["Color"])
+    # a graph that varies over the lamp: a node program (core/lights/lamp_textures.py, tests/cycles
+    # test_lamp_textures_cycles), the constant factor 1; without a program to give it to (a sun) it is named
+    from restir_engine.core.lights.lamp_textures import OUTPUT
+    from restir_engine.export.lights import _lamp_power
+    warns, program = [], []
+    got = _lamp_power(light, light.name, warns, None, None, program)
+    assert not warns and len(program) == 1 and program[0].has(OUTPUT) and "generated" in program[0].reads
+    np.testing.assert_allclose(got, base, rtol=1e-6)
     got, warns = _power(light)
     assert any("varies over the light" in w for w in warns)
     np.testing.assert_allclose(got, base * np.array(em.inputs["Color"].default_value[:3]) * 6.0, rtol=1e-5)

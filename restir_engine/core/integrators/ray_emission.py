@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..lights.table import emitted_radiance, spot_factor
+from ..lights.table import emitted_radiance, receiver_factor
 from ..materials.glass import DELTA_PDF
 from ..sampling import cols, dot, norm
 from .trace_context import TraceContext
@@ -62,7 +62,7 @@ def _lamp_emission(ctx: TraceContext, lh, o, d, sel):
     lamps = ctx.scene.lamps
     le = emitted_radiance(lamps.tris, ctx.scene.materials, prim, lh.u[sel], lh.v[sel])
     os, ds = cols(o, sel), cols(d, sel)
-    le *= spot_factor(lamps, prim, os, os + ds * np.where(np.isfinite(t), t, 0).astype(np.float32)) * (cos_l > 0)
+    le *= receiver_factor(lamps, prim, os, os + ds * np.where(np.isfinite(t), t, 0).astype(np.float32)) * (cos_l > 0)
     light = ctx.lights.lamp_to_light[prim]
     pdf = np.where(light >= 0, ctx.lights.pdf_solid_angle(np.maximum(light, 0), cols(o, sel), t, cos_l), 0.0)
     return le, pdf.astype(np.float32)

@@ -22,6 +22,7 @@ from ..materials.params import luminance
 from ..materials.textures import apply_texture, mean_color
 from ..sampling import AliasTable, barycentric, cols, dot, norm, orthonormal_basis, uniform_triangle, vmax
 from ..scene import Lamps, MaterialTable, Scene, TriangleSet
+from .lamp_textures import lamp_texture_factor
 from .sphere import one_minus_cos_cone, sphere_coords, sphere_direction
 
 EMPTY = np.zeros(0, np.int64)
@@ -112,6 +113,30 @@ def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray, q: np.ndarray
     return out
 
 
+def texture_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray | None:
+    """Colour factor (3, n) of lamp triangles ``lamp_tri`` whose node graph varies over the lamp
+    (lights/lamp_textures.py) at light points q seen from receivers p ((3, n) rows), 1 for the others; None where
+    none of them is textured."""
+    lt = lamps.textured
+    if lt is None or not len(lamp_tri):
+        return None
+    sel = np.flatnonzero(lt.program[lamp_tri] >= 0)
+    if not sel.size:
+        return None
+    out = np.ones((3, len(lamp_tri)), np.float32)
+    t = lamp_tri[sel]
+    out[:, sel] = lamp_texture_factor(lt, t, cols(p, sel), cols(q, sel), np.ascontiguousarray(lamps.tris.normals[t, 0].T))
+    return out
+
+
+def receiver_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """What the radiance of lamp triangles ``lamp_tri`` at light points q is multiplied by towards receivers p
+    ((3, n) rows): :func:`spot_factor` (n,), times :func:`texture_factor` (then (3, n)) where a lamp is textured."""
+    f = spot_factor(lamps, lamp_tri, p, q)
+    tex = texture_factor(lamps, lamp_tri, p, q)
+    return f if tex is None else tex * f
+
+
 @dataclass
 class LightSample:
     """Per shading point (n): unit direction wi (3, n), distance (n,) (inf for suns), radiance Le (3, n)
@@ -185,8 +210,10 @@ class LightTable:
         self.rows_le = np.ascontiguousarray(self.tri_le.T)
         self.any_spots = bool(len(lamps.tris) and lamps.receiver_dependent()[l_idx].any())
         # power (W, luminance-weighted) decides selection; zero-area triangles get zero power
-        tri_density = np.concatenate([geom_density[g_idx], mat_power_density[lamps.tris.material[l_idx]]]) \
-            if len(tri_mat) else np.zeros(0)
+        lamp_density = mat_power_density[lamps.tris.material[l_idx]]
+        if lamps.textured is not None:  # a textured lamp's graph scales its power (lights/lamp_textures.py)
+            lamp_density = lamp_density * lamps.textured.power_scale[l_idx]
+        tri_density = np.concatenate([geom_density[g_idx], lamp_density]) if len(tri_mat) else np.zeros(0)
         tri_power = tri_density * self.tri_area if len(tri_mat) else np.zeros(0, np.float32)
         sun_power = np.abs(luminance(lamps.sun_irradiance)) * np.pi * scene_radius ** 2 if len(lamps.sun_dir) \
             else np.zeros(0)
@@ -381,8 +408,8 @@ class LightTable:
             lm = np.flatnonzero(light >= self.n_geom)
             if lm.size:
                 t = self.lamp_ids[light[lm] - self.n_geom]
-                out[:, lm] *= spot_factor(scene.lamps, t, np.take(p_receiver, lm, axis=1),
-                                          self.positions(light[lm], b1[lm], b2[lm]))
+                out[:, lm] *= receiver_factor(scene.lamps, t, np.take(p_receiver, lm, axis=1),
+                                              self.positions(light[lm], b1[lm], b2[lm]))
         return out
 
     def spot_lamp_tri(self, light: np.ndarray) -> np.ndarray:

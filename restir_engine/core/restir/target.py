@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..lights.table import spot_factor
+from ..lights.table import receiver_factor
 from ..lights.tiles import PackedPoints, light_points
 from ..materials.anisotropy import AnisoWorld
 from ..materials.bsdf import view_terms
@@ -343,7 +343,7 @@ class ShadingTerms:
 
 def with_spots(pts: PackedPoints, spot_tri: np.ndarray, lamps, receivers: np.ndarray) -> PackedPoints:
     """``pts`` with the receiver-dependent factor of lamp triangles ``spot_tri`` (same shape as the points, -1 =
-    none: lights/table.spot_factor, a spot cone and a Light Falloff) towards ``receivers`` ((3, n), broadcasting
+    none: lights/table.receiver_factor, a spot cone, a Light Falloff, a node texture) towards ``receivers`` ((3, n), broadcasting
     like the points) applied to the radiance."""
     spot = np.nonzero(spot_tri >= 0)
     if spot[0].size == 0:
@@ -351,10 +351,10 @@ def with_spots(pts: PackedPoints, spot_tri: np.ndarray, lamps, receivers: np.nda
     rec = np.broadcast_to(receivers, (3,) + spot_tri.shape)
     at = np.broadcast_to(pts.pos, (3,) + spot_tri.shape)
     le = pts.le.copy()
-    f = spot_factor(lamps, spot_tri[spot], np.stack([rec[i][spot] for i in range(3)]),
-                    np.stack([at[i][spot] for i in range(3)]))
+    f = receiver_factor(lamps, spot_tri[spot], np.stack([rec[i][spot] for i in range(3)]),
+                        np.stack([at[i][spot] for i in range(3)]))
     for i in range(3):
-        le[i][spot] *= f
+        le[i][spot] *= f[i] if f.ndim == 2 else f
     return PackedPoints(pts.pos, pts.normal, le, pts.pdf, pts.two_sided)
 
 

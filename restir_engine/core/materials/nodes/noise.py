@@ -69,8 +69,11 @@ _TABLES = (None,) + tuple(_gradient_tables(d) for d in (1, 2, 3, 4))
 
 def perlin(*coords) -> np.ndarray:
     """Raw (unscaled) Perlin noise at points of 1-4 coordinates: gradients at the lattice corners hashed from their
-    integer coordinates, blended multilinearly (first axis innermost) with the quintic fade."""
+    integer coordinates, blended multilinearly (first axis innermost) with the quintic fade. Every corner is hashed
+    and weighed in one pass over a leading axis of the 2ᵈ corners (corner c has bit k of c set where it lies one
+    cell up along axis k)."""
     dim = len(coords)
+    corners = 1 << dim
     cells, fracs, fades = [], [], []
     for c in coords:
         c = np.asarray(c, np.float32)
@@ -79,24 +82,23 @@ def perlin(*coords) -> np.ndarray:
         fr = (c - f).astype(np.float32)
         fracs.append(fr)
         fades.append(_fade(fr))
+    shape = np.broadcast_shapes(*[f.shape for f in fracs])
+    up = ((np.arange(corners)[:, None] >> np.arange(dim)[None]) & 1).reshape((corners, dim) + (1,) * len(shape))
     table, mask = _TABLES[dim], np.uint32(_MASK[dim])
-    values = {}
-    for corner in range(1 << dim):
-        bits = [(corner >> k) & 1 for k in range(dim)]
-        with np.errstate(over="ignore"):
-            keys = [cells[k] + np.uint32(bits[k]) for k in range(dim)]
-        h = (hash_uint(*keys) & mask).astype(np.intp)
-        v = None
-        for k in range(dim):
-            term = np.take(table[k], h) * (fracs[k] - _F(bits[k]) if bits[k] else fracs[k])
-            v = term if v is None else v + term
-        values[corner] = v
-    # blend along axis 0 first (pairs of corners differing in bit 0), then axis 1, ...
-    level = [values[c] for c in range(1 << dim)]
+    with np.errstate(over="ignore"):
+        keys = [cells[k] + up[:, k].astype(np.uint32) for k in range(dim)]  # (corners, ...)
+    h = (hash_uint(*keys) & mask).astype(np.intp)
+    v = None
     for k in range(dim):
-        t = fades[k]
-        level = [level[2 * i] + t * (level[2 * i + 1] - level[2 * i]) for i in range(len(level) // 2)]
-    return level[0].astype(np.float32)
+        term = np.take(table[k], h) * (fracs[k] - up[:, k].astype(np.float32))
+        v = term if v is None else v + term
+    # blend along axis 0 first (pairs of corners differing in bit 0), then axis 1, ...: bit 0 is the last of the
+    # corner axes once they are split into (2,) * dim
+    v = v.reshape((2,) * dim + shape)
+    for k in range(dim):
+        lo, hi = v[(slice(None),) * (dim - 1 - k) + (0,)], v[(slice(None),) * (dim - 1 - k) + (1,)]
+        v = lo + fades[k] * (hi - lo)
+    return np.asarray(v, np.float32)
 
 
 def snoise(*coords) -> np.ndarray:

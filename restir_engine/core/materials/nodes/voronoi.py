@@ -35,6 +35,14 @@ class _Cells:
             return [hash_floats(self.cell_f[0] + _F(off[0]))]
         return pcg(*[c + np.int32(o) if np.ndim(o) == 0 else c + o for c, o in zip(self.cell_i, off)])[:self.dims]
 
+    def jitter_all(self, offs: np.ndarray) -> list:
+        """The hashed point offsets of the cells at every offset of ``offs`` (m, dims) int32 at once: ``dims``
+        arrays (m, ...) (the offsets along a new leading axis)."""
+        lead = (len(offs),) + (1,) * np.ndim(self.local[0])
+        if self.dims == 1:
+            return [hash_floats(self.cell_f[0] + offs[:, 0].astype(np.float32).reshape(lead))]
+        return pcg(*[c + offs[:, k].reshape(lead) for k, c in enumerate(self.cell_i)])[:self.dims]
+
     def color(self, off) -> np.ndarray:
         """(3, ...) the colours of the cells at ``off``."""
         if self.dims == 1:
@@ -61,52 +69,69 @@ def _smoothstep(x):
     return t * t * (_F(3) - _F(2) * t)
 
 
+def _points(cells: _Cells, offs: np.ndarray, metric: str, exponent, rand):
+    """The feature points of the cells at offsets ``offs`` (m, dims) relative to each point's cell (``dims``
+    arrays (m, ...)) and their distances (m, ...) from the point, every offset at once."""
+    lead = (len(offs),) + (1,) * np.ndim(cells.local[0])
+    point = [offs[:, k].astype(np.float32).reshape(lead) + j * rand for k, j in enumerate(cells.jitter_all(offs))]
+    return point, metric_distance([p - q for p, q in zip(point, cells.local)], metric, exponent)
+
+
+def _nearest(to: np.ndarray, skip: np.ndarray | None = None):
+    """Index (...) along the leading axis of the first of the least distances ``to`` (m, ...) that are below
+    float32's largest (NaN never is), leaving out index ``skip``, and whether there is one: what a scan in order
+    keeping a strictly smaller distance finds (Cycles' search)."""
+    clean = np.where(np.isnan(to), np.inf, to)
+    if skip is not None:
+        clean = clean.copy()
+        np.put_along_axis(clean, skip[None], np.inf, axis=0)
+    i = np.argmin(clean, axis=0)
+    found = np.take_along_axis(clean, i[None], axis=0)[0] < np.finfo(np.float32).max
+    return i, found
+
+
 def _octave(feature: str, metric: str, coords, exponent, randomness, smoothness):
-    """One octave: (distance, colour (3, ...), position (list of ``dims`` arrays)) for F1, F2 or Smooth F1."""
+    """One octave: (distance, colour (3, ...), position (list of ``dims`` arrays)) for F1, F2 or Smooth F1. The
+    neighbour cells are hashed and measured all at once along a leading axis; F1 is the first nearest in Cycles'
+    order, F2 the first nearest of the others."""
     cells = _Cells(coords)
     d, shape = cells.dims, np.shape(cells.local[0])
     rand = np.asarray(randomness, np.float32)
     if feature == "SMOOTH_F1":
         k = np.asarray(smoothness, np.float32)
+        offs = np.array(list(_offsets(d, 2)), np.int32)
         dist = np.zeros(shape, np.float32)
         color = np.zeros((3, *shape), np.float32)
         pos = [np.zeros(shape, np.float32) for _ in range(d)]
-        first = True
-        for off in _offsets(d, 2):
-            point = [_F(o) + j * rand for o, j in zip(off, cells.jitter(off))]
-            to = metric_distance([p - q for p, q in zip(point, cells.local)], metric, exponent)
-            if first:
-                h = np.ones(shape, np.float32)
-                first = False
-            else:
-                h = _smoothstep(_F(0.5) + _F(0.5) * (dist - to) / k)
-            corr = k * h * (1 - h)
-            dist = dist + (to - dist) * h - corr
-            corr = corr / (1 + 3 * k)
-            color = color + (cells.color(off) - color) * h - corr
-            pos = [p + (q - p) * h - corr for p, q in zip(pos, point)]
+        group = max(1, (1 << 18) // max(int(np.prod(shape)), 1))  # offsets per batch: about 256k points each
+        for lo in range(0, len(offs), group):
+            part = offs[lo:lo + group]
+            points, tos = _points(cells, part, metric, exponent, rand)
+            colors = cells.color([part[:, j].reshape((len(part),) + (1,) * len(shape)) for j in range(d)])
+            for m in range(len(part)):
+                to, point = tos[m], [p[m] for p in points]
+                if lo + m == 0:
+                    h = np.ones(shape, np.float32)
+                else:
+                    h = _smoothstep(_F(0.5) + _F(0.5) * (dist - to) / k)
+                corr = k * h * (1 - h)
+                dist = dist + (to - dist) * h - corr
+                corr = corr / (1 + 3 * k)
+                color = color + (colors[:, m] - color) * h - corr
+                pos = [p + (q - p) * h - corr for p, q in zip(pos, point)]
         return dist, color, [p + f for p, f in zip(pos, cells.cell_f)]
     inf = np.float32(np.finfo(np.float32).max)
-    d1 = np.full(shape, inf, np.float32)
-    p1 = [np.zeros(shape, np.float32) for _ in range(d)]
-    o1 = [np.zeros(shape, np.int32) for _ in range(d)]
+    offs = np.array(list(_offsets(d, 1)), np.int32)
+    points, to = _points(cells, offs, metric, exponent, rand)
+    best, found = _nearest(to)
     if feature == "F2":
-        d2, p2, o2 = d1.copy(), [x.copy() for x in p1], [x.copy() for x in o1]
-    for off in _offsets(d, 1):
-        point = [_F(o) + j * rand for o, j in zip(off, cells.jitter(off))]
-        to = metric_distance([p - q for p, q in zip(point, cells.local)], metric, exponent)
-        near = to < d1
-        if feature == "F2":
-            second = ~near & (to < d2)
-            d2 = np.where(near, d1, np.where(second, to, d2))
-            p2 = [np.where(near, a, np.where(second, b, c)) for a, b, c in zip(p1, point, p2)]
-            o2 = [np.where(near, a, np.where(second, np.int32(o), c)) for a, o, c in zip(o1, off, o2)]
-        d1 = np.where(near, to, d1)
-        p1 = [np.where(near, b, a) for a, b in zip(p1, point)]
-        o1 = [np.where(near, np.int32(o), a) for a, o in zip(o1, off)]
-    if feature == "F2":
-        d1, p1, o1 = d2, p2, o2
-    return d1, cells.color(o1), [p + f for p, f in zip(p1, cells.cell_f)]
+        best, found2 = _nearest(to, best)
+        found = found & found2
+    dist = np.where(found, np.take_along_axis(to, best[None], axis=0)[0], inf)
+    pos = [np.where(found, np.take_along_axis(np.broadcast_to(p, to.shape), best[None], axis=0)[0], _F(0))
+           for p in points]
+    cell = [np.where(found, offs[best, j], np.int32(0)) for j in range(d)]
+    return dist, cells.color(cell), [p + f for p, f in zip(pos, cells.cell_f)]
 
 
 def _distance_to_edge(coords, randomness):
