@@ -1289,3 +1289,50 @@ def textured_lamp_scene(kind: str, size=(64, 64)):
         t.links.new(sep.outputs["Y"], mad.inputs[0])
         t.links.new(mad.outputs[0], em.inputs["Strength"])
     return scene
+
+
+def srgb_byte_image(name="Texels", n=8):
+    """An n x n 8-bit image in the sRGB colour space (as a PNG or JPEG from disk is), packed: saturated colours and
+    greys side by side, so a magnified edge between two texels shows where the interpolation happens (sRGB values, as
+    Cycles interpolates such images, or linear ones)."""
+    i, j = np.meshgrid(np.arange(n), np.arange(n))
+    rng = np.random.default_rng(11)
+    px = np.ones((n, n, 4), np.float32)
+    px[..., :3] = rng.choice([0.0, 0.1, 0.5, 0.9, 1.0], size=(n, n, 3))
+    px[(i + j) % 3 == 0, :3] = 0.0
+    img = bpy.data.images.new(name, n, n)
+    img.colorspace_settings.name = "sRGB"
+    img.pixels.foreach_set(px.ravel())
+    img.pack()
+    return img
+
+
+#: how :func:`srgb_texture_planes` reads its image, one plane each
+SRGB_READS = ("linear", "cubic", "closest", "mapped", "strength")
+
+
+def srgb_texture_planes(px: int = 32):
+    """Emission planes (:func:`node_planes`, one per :data:`SRGB_READS` entry) each showing :func:`srgb_byte_image`
+    magnified (4 pixels per texel at ``px`` 32): its Color straight into the Emission (Linear: the material's image
+    path), with Cubic or Closest interpolation, through a Mapping node (the node program's lookup), and as the
+    Emission Strength (the colour read as a float, white emission)."""
+    import node_graphs as ng
+
+    def graph(kind):
+        def wire(tree, color_socket):  # called after node_planes resets the file: the image made on first use
+            img = bpy.data.images.get("Texels") or srgb_byte_image("Texels")
+            tex = ng._node(tree, "ShaderNodeTexImage")
+            tex.image = img
+            tex.interpolation = {"cubic": "Cubic", "closest": "Closest"}.get(kind, "Linear")
+            if kind == "mapped":
+                tc = ng._node(tree, "ShaderNodeTexCoord")
+                mp = ng._node(tree, "ShaderNodeMapping")
+                mp.inputs["Scale"].default_value = (0.75, 0.75, 1.0)
+                tree.links.new(tc.outputs["UV"], mp.inputs["Vector"])
+                tree.links.new(mp.outputs["Vector"], tex.inputs["Vector"])
+            if kind == "strength":
+                tree.links.new(tex.outputs["Color"], color_socket.node.inputs["Strength"])
+            else:
+                tree.links.new(tex.outputs["Color"], color_socket)
+        return wire
+    return node_planes([graph(k) for k in SRGB_READS], 3, px, name="Srgb")

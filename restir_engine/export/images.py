@@ -1,5 +1,5 @@
-"""Image files for textures: sRGB decoding, whether a file can be opened, and the cache that keeps textures
-read from unchanged files across exports."""
+"""Image files for textures: whether a file can be opened, and the cache that keeps textures read from unchanged
+files across exports."""
 from __future__ import annotations
 
 import os
@@ -8,18 +8,6 @@ import stat
 import numpy as np
 
 from ..core.materials.textures import texture_bytes
-
-
-def srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
-
-
-_SRGB_BYTE_TABLE = srgb_to_linear(np.arange(256, dtype=np.float64) / 255.0)
-
-
-def srgb_bytes_to_linear(c: np.ndarray) -> np.ndarray:
-    """srgb_to_linear of an 8-bit image's pixels (Blender hands them over as k/255): one table lookup each."""
-    return _SRGB_BYTE_TABLE[np.rint(np.clip(c, 0.0, 1.0) * 255.0).astype(np.uint8)]
 
 
 class TextureCache:

@@ -1,12 +1,14 @@
-"""Blender images -> the material table's textures: read once into scene-linear float32 (sRGB bytes decoded, alpha or
-luminance replicated to three channels), kept across renders while unchanged (export/images.py), magenta where a
+"""Blender images -> the material table's textures: read once into float32, scene-linear or (8-bit sRGB images)
+sRGB-encoded and decoded after interpolation (core/materials/textures.SrgbImage), alpha or luminance replicated to
+three channels, kept across renders while unchanged (export/images.py), magenta where a
 file cannot be read. A mixin of MaterialRegistry (export/materials.py)."""
 from __future__ import annotations
 
 import numpy as np
 
-from ..core.materials.textures import MissingImage, NearestImage, UdimImage
-from .images import TEXTURES, srgb_bytes_to_linear, unreadable_file
+from ..core.materials.textures import (MissingImage, NearestImage, SrgbImage, SrgbLuminanceImage, UdimImage,
+                                       linear_texels)
+from .images import TEXTURES, unreadable_file
 from .udim import read_tile, tile_path, unreadable_set
 
 MAGENTA = (1.0, 0.0, 1.0)
@@ -69,7 +71,8 @@ class TextureReader:
             data = self._read_texture(material, image, alpha, luminance)
             TEXTURES.put(kept, data)
         self.texture_index[key] = len(self.textures)
-        self.textures.append(data.view(NearestImage) if closest and not isinstance(data, MissingImage) else data)
+        self.textures.append(linear_texels(data).view(NearestImage) if closest and not isinstance(data, MissingImage)
+                             else data)
         return self.texture_index[key]
 
     def _read_udim(self, material, image, alpha: bool, luminance: bool, closest: bool) -> UdimImage | None:
@@ -96,7 +99,7 @@ class TextureReader:
                 data = np.array(MAGENTA, np.float32).reshape(1, 1, 3)
             else:
                 data = self._converted(material, image, got[0], alpha, luminance, got[1])
-            tiles.append((int(tile.number), data.view(NearestImage) if closest else data))
+            tiles.append((int(tile.number), linear_texels(data).view(NearestImage) if closest else data))
         out = UdimImage(tiles)
         TEXTURES.put(kept, out)
         return out
@@ -135,12 +138,14 @@ class TextureReader:
             ch = data.shape[2]
             rgb = data[..., :3] if ch >= 3 else np.repeat(data[..., :1], 3, axis=2)
             space = image.colorspace_settings.name
-            if not is_float and space in {"sRGB", "sRGB EOTF"}:
-                rgb = srgb_bytes_to_linear(rgb)
-            elif space not in {"sRGB", "sRGB EOTF", "Linear Rec.709", "Linear", "Non-Color", "Raw", "Linear CIE-XYZ E"} \
-                    and not is_float:
+            srgb = not is_float and space in {"sRGB", "sRGB EOTF"}
+            if not is_float and not srgb and space not in {"Linear Rec.709", "Linear", "Non-Color", "Raw",
+                                                           "Linear CIE-XYZ E"}:
                 self._warn(material, f"image '{image.name}' colour space '{space}' treated as sRGB")
-                rgb = srgb_bytes_to_linear(rgb)
+                srgb = True
+            if srgb:  # kept sRGB-encoded (the bytes), decoded after each lookup's interpolation, as Cycles does
+                data = np.ascontiguousarray(np.rint(np.clip(rgb, 0.0, 1.0) * 255.0) / 255.0, dtype=np.float32)
+                return data.view(SrgbLuminanceImage if luminance else SrgbImage)
             if luminance:  # Blender's implicit colour -> float conversion
                 rgb = np.repeat((rgb @ np.array([0.2126, 0.7152, 0.0722], np.float32))[..., None], 3, axis=2)
             data = np.ascontiguousarray(rgb, dtype=np.float32)

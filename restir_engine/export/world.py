@@ -12,6 +12,7 @@ import numpy as np
 
 from ..compat import uses_nodes
 from ..core.materials.nodes.ops_texture import euler_matrix
+from ..core.materials.textures import linear_texels
 from .materials import MaterialRegistry
 from .node_graph import GraphCompiler
 
@@ -53,7 +54,7 @@ def _export_world(scene, warnings: list, view_layer=None):
             plain, rotation = _plain_rotation(world, src, warnings)
             if plain:
                 strength = float(strength_in.default_value)
-                image = registry.textures[registry._texture(world, src.image)] * np.float32(strength)
+                image = linear_texels(registry.textures[registry._texture(world, src.image)]) * np.float32(strength)
                 return np.zeros(3, np.float32), np.asarray(image, np.float32), rotation
     return _baked(world, registry, color_in, strength_in, warnings, view_layer)
 

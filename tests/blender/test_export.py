@@ -165,12 +165,18 @@ def test_image_texture_feeds_base_color(scene):
     assert s.geometry.uvs.min() >= 0 and s.geometry.uvs.max() <= 1
 
 
-def test_srgb_byte_image_is_linearized(scene):
+def test_srgb_byte_image_is_kept_encoded_and_decoded_by_its_lookups(scene):
+    """An 8-bit sRGB image keeps its bytes (as Cycles keeps them) and reads scene-linear through every lookup."""
+    from restir_engine.core.materials.textures import SrgbImage, linear_texels, sample
     img = bpy.data.images.new("grey", 1, 1)
     img.pixels.foreach_set(np.array([0.5, 0.5, 0.5, 1], np.float32))
     textured_plane(img, "Base Color")
     s = export()
-    assert np.allclose(s.materials.textures[0], ((0.5 + 0.055) / 1.055) ** 2.4, atol=0.01)
+    tex = s.materials.textures[0]
+    assert isinstance(tex, SrgbImage) and np.allclose(np.asarray(tex), 128 / 255, atol=1e-7)
+    want = ((128 / 255 + 0.055) / 1.055) ** 2.4
+    assert np.allclose(linear_texels(tex), want, rtol=1e-5)
+    assert np.allclose(sample(tex, np.array([[0.3, 0.7]], np.float32)), want, rtol=1e-5)
 
 
 def test_light_table_power_conventions(scene):

@@ -42,6 +42,18 @@ def test_fbm_is_a_normalized_sum_and_detail_fraction_blends():
     np.testing.assert_allclose(half, 0.5 * (one + two), atol=1e-6)
 
 
+@pytest.mark.parametrize("kind", ["FBM", "MULTIFRACTAL", "HETERO_TERRAIN", "HYBRID_MULTIFRACTAL",
+                                  "RIDGED_MULTIFRACTAL"])
+def test_every_noise_type_at_a_constant_point_is_its_value_in_a_batch(kind):
+    """A Noise Texture fed constant coordinates is folded at export (0-d arrays); every type gives there what it
+    gives in a batch (the hybrid and ridged types once recursed without end on 0-d points)."""
+    p = [F(0.3), F(-1.7), F(2.2)]
+    at = noise.fractal(kind, p, 3.5, 0.6, 2.0, 0.4, 1.1, True)
+    batch = noise.fractal(kind, [np.full(4, v, F) for v in p], 3.5, 0.6, 2.0, 0.4, 1.1, True)
+    assert np.ndim(at) == 0
+    np.testing.assert_allclose(batch, at, rtol=1e-6)  # numpy 1.x computes 0-d float32 arithmetic in float64
+
+
 def test_safe_math_follows_cycles():
     m = ops_math.MATH
     a, b, c = F(np.array([-2.0, 0.0, 3.0])), F(np.array([0.0, 0.0, 2.0])), F(np.array([0.1, 0.1, 0.1]))

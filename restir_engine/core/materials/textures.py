@@ -2,7 +2,9 @@
 :class:`NearestImage` (an Image Texture node's "Closest" interpolation); UDIM sets (:class:`UdimImage`) per tile.
 
 Images are (h, w, 3) float32 scene-linear, row 0 at the bottom as Blender stores them,
-so uv (0, 0) is the bottom-left corner and texel (i, j) is centred at ((j+0.5)/w, (i+0.5)/h).
+so uv (0, 0) is the bottom-left corner and texel (i, j) is centred at ((j+0.5)/w, (i+0.5)/h). An 8-bit sRGB image
+(:class:`SrgbImage`) keeps its sRGB-encoded texels and is decoded after interpolation, as Cycles keeps and samples
+such images (so a magnified edge between two texels blends their sRGB values).
 """
 from __future__ import annotations
 
@@ -14,6 +16,54 @@ MISSING_TILE = (1.0, 0.0, 1.0)  # the colour Cycles gives UVs outside every tile
 
 class NearestImage(np.ndarray):
     """An image sampled with nearest-texel lookups (``array.view(NearestImage)``)."""
+
+
+class SrgbImage(np.ndarray):
+    """An image whose texels are sRGB-encoded values in [0, 1] (an 8-bit image in the sRGB colour space): every
+    lookup interpolates them and then decodes the result to scene-linear RGB (:func:`decoded`)."""
+
+
+class SrgbLuminanceImage(SrgbImage):
+    """An :class:`SrgbImage` read as a float (a Color output wired into a float socket): the luminance of the decoded
+    colour, replicated to three channels."""
+
+
+def srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    """The sRGB transfer function decoded: sRGB-encoded values -> scene-linear, float32 (negative values -> 0)."""
+    c = np.asarray(c, np.float32)
+    return np.where(c < np.float32(0.04045), np.maximum(c, np.float32(0)) * np.float32(1 / 12.92),
+                    ((np.maximum(c, np.float32(0.04045)) + np.float32(0.055)) * np.float32(1 / 1.055))
+                    ** np.float32(2.4)).astype(np.float32)
+
+
+def _srgb_slope(c: np.ndarray) -> np.ndarray:
+    """d srgb_to_linear / dc."""
+    c = np.asarray(c, np.float32)
+    return np.where(c < np.float32(0.04045), np.float32(1 / 12.92),
+                    np.float32(2.4 / 1.055) * ((np.maximum(c, np.float32(0.04045)) + np.float32(0.055))
+                                              * np.float32(1 / 1.055)) ** np.float32(1.4)).astype(np.float32)
+
+
+_LUMINANCE = np.array([0.2126, 0.7152, 0.0722], np.float32)
+
+
+def decoded(image: np.ndarray, texels: np.ndarray) -> np.ndarray:
+    """(n, c) interpolated ``texels`` of ``image`` as scene-linear values: sRGB-decoded for an :class:`SrgbImage`
+    (the luminance replicated for an :class:`SrgbLuminanceImage`), unchanged for any other image."""
+    if not isinstance(image, SrgbImage):
+        return texels
+    rgb = srgb_to_linear(np.asarray(texels))
+    if isinstance(image, SrgbLuminanceImage):
+        return np.repeat((rgb[:, :3] @ _LUMINANCE)[:, None], rgb.shape[1], axis=1).astype(np.float32)
+    return rgb
+
+
+def linear_texels(image: np.ndarray) -> np.ndarray:
+    """The image's texels as scene-linear float32 (h, w, c) (decoded per texel for an :class:`SrgbImage`)."""
+    if not isinstance(image, SrgbImage):
+        return image
+    h, w, c = image.shape
+    return decoded(image, np.asarray(image).reshape(-1, c)).reshape(h, w, c)
 
 
 class MissingImage(np.ndarray):
@@ -79,7 +129,7 @@ def sample(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
         return missing_lookup(image, len(uv))
     if isinstance(image, NearestImage):
         return sample_nearest(np.asarray(image), uv)
-    return sample_bilinear(image, uv)
+    return decoded(image, sample_bilinear(np.asarray(image), uv))
 
 
 def sample_nearest(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
@@ -124,11 +174,21 @@ def gradient(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
         return np.zeros((len(uv), 2), np.float32)
     h, w = image.shape[:2]
     x0, x1, y0, y1, fx, fy = _bilinear_cell(image, uv)
-    c = image[..., 0]
-    a, b, cc, d = c[y0, x0], c[y0, x1], c[y1, x0], c[y1, x1]
-    du = ((b - a) * (1 - fy) + (d - cc) * fy) * w
-    dv = ((cc - a) * (1 - fx) + (d - b) * fx) * h
-    return np.stack([du, dv], axis=1).astype(np.float32)
+    channels = 3 if isinstance(image, SrgbLuminanceImage) else 1
+    grads = []
+    for k in range(channels):
+        c = np.asarray(image)[..., k]
+        a, b, cc, d = c[y0, x0], c[y0, x1], c[y1, x0], c[y1, x1]
+        du = ((b - a) * (1 - fy) + (d - cc) * fy) * w
+        dv = ((cc - a) * (1 - fx) + (d - b) * fx) * h
+        if isinstance(image, SrgbImage):  # the chain rule through the decoding at the interpolated value
+            top, bot = a + (b - a) * fx, cc + (d - cc) * fx
+            slope = _srgb_slope(top + (bot - top) * fy)
+            du, dv = du * slope, dv * slope
+        grads.append(np.stack([du, dv], axis=1))
+    if channels == 3:
+        return sum(g * wk for g, wk in zip(grads, _LUMINANCE)).astype(np.float32)
+    return grads[0].astype(np.float32)
 
 
 def apply_texture(values: np.ndarray, tex_index: np.ndarray, uv: np.ndarray | None, textures: list) -> np.ndarray:
@@ -146,8 +206,8 @@ def apply_texture(values: np.ndarray, tex_index: np.ndarray, uv: np.ndarray | No
 def mean_color(image: np.ndarray) -> np.ndarray:
     """The mean texel (c,) over the image's UV area (a UDIM set: each tile's mean, equally weighted)."""
     if isinstance(image, UdimImage):
-        return np.mean([mean_color(np.asarray(t)) for _n, t in image.tiles], axis=0).astype(np.float32)
-    return np.asarray(image).reshape(-1, image.shape[-1]).mean(axis=0).astype(np.float32)
+        return np.mean([mean_color(t) for _n, t in image.tiles], axis=0).astype(np.float32)
+    return np.asarray(linear_texels(image)).reshape(-1, image.shape[-1]).mean(axis=0).astype(np.float32)
 
 
 def texture_bytes(image: np.ndarray) -> int:

@@ -131,6 +131,11 @@ def fractal(kind: str, coords: list, detail, roughness, lacunarity, off, gain, n
     if all(np.ndim(x) == 0 for x in (detail, roughness, lacunarity, off, gain)):
         return _fractal_uniform(kind, coords, float(detail), float(roughness), float(lacunarity), float(off),
                                 float(gain), normalize)
+    return _fractal_masked(kind, coords, detail, roughness, lacunarity, off, gain, normalize)
+
+
+def _fractal_masked(kind, coords, detail, roughness, lacunarity, off, gain, normalize):
+    """:func:`fractal` with per-point parameters: the octave loop with a mask of the points still summing."""
     shape = np.broadcast_shapes(*[c.shape for c in coords], *[np.shape(x) for x in (detail, roughness, lacunarity,
                                                                                       off, gain)])
     coords = [np.broadcast_to(c, shape) for c in coords]
@@ -232,41 +237,48 @@ def _fractal_uniform(kind, coords, detail, roughness, lacunarity, off, gain, nor
     rmd = _F(detail - np.floor(detail))
     scale, amp = _F(1.0), _F(1.0)
 
-    def octave(sc):
-        return snoise(*[c * sc for c in coords])
+    if kind in {"FBM", "MULTIFRACTAL", "HETERO_TERRAIN"}:
+        # every octave's noise in one pass: the octaves' scales 1, lac, lac², ... (float32, in sequence), the
+        # fraction's octave included, along a new leading axis
+        scales = [scale]
+        for _i in range(n + (1 if rmd != 0 else 0)):
+            scales.append(scales[-1] * lac)
+        lead = (len(scales),) + (1,) * max(np.ndim(c) for c in coords)
+        sc = np.array(scales, np.float32).reshape(lead)
+        noise = snoise(*[c * sc for c in coords])
+        octave = iter(noise).__next__
     if kind == "FBM":
         total, maxamp = _F(0.0), _F(0.0)
         for _i in range(n + 1):
-            total = total + octave(scale) * amp
+            total = total + octave() * amp
             maxamp = maxamp + amp
-            amp, scale = amp * rough, scale * lac
+            amp = amp * rough
         if normalize:
             a = _F(0.5) * total / maxamp + _F(0.5)
         else:
             a = total
         if rmd != 0:
-            total2 = total + octave(scale) * amp
+            total2 = total + octave() * amp
             b = _F(0.5) * total2 / (maxamp + amp) + _F(0.5) if normalize else total2
             a = a + rmd * (b - a)
         return np.asarray(a, np.float32)
     if kind == "MULTIFRACTAL":
         value = _F(1.0)
         for _i in range(n + 1):
-            value = value * (amp * octave(scale) + _F(1.0))
-            amp, scale = amp * rough, scale * lac
+            value = value * (amp * octave() + _F(1.0))
+            amp = amp * rough
         if rmd != 0:
-            value = value * (rmd * amp * octave(scale) + _F(1.0))
+            value = value * (rmd * amp * octave() + _F(1.0))
         return np.asarray(value, np.float32)
     if kind == "HETERO_TERRAIN":
-        value = off + octave(scale)
-        scale = scale * lac
+        value = off + octave()
         for _i in range(1, n + 1):
             amp = amp * rough
-            value = value + (octave(scale) + off) * amp * value
-            scale = scale * lac
+            value = value + (octave() + off) * amp * value
         if rmd != 0:
-            value = value + rmd * (octave(scale) + off) * (amp * rough) * value
+            value = value + rmd * (octave() + off) * (amp * rough) * value
         return np.asarray(value, np.float32)
     # hybrid and ridged keep per-point state (a weight): the masked loop
     shape = np.broadcast_shapes(*[c.shape for c in coords])
-    return fractal(kind, coords, np.full(shape, detail, np.float32), roughness, lacunarity, off, gain, normalize)
+    return _fractal_masked(kind, coords, np.full(shape, detail, np.float32), roughness, lacunarity, off, gain,
+                           normalize)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import noise
-from ..textures import MissingImage, UdimImage, missing_lookup, per_tile
+from ..textures import MissingImage, UdimImage, decoded, missing_lookup, per_tile
 from .hashing import hash_floats, hash_floats_to_color
 from .ops_math import _dot, _normalize, f32, safe_div
 
@@ -173,9 +173,14 @@ def sample_image(image: np.ndarray, u, v, interpolation: str, extension: str) ->
     (textures.UdimImage) per tile, each tile with ``extension``."""
     if isinstance(image, UdimImage):
         return per_tile(image, np.asarray(u, np.float64), np.asarray(v, np.float64),
-                        lambda t, tu, tv: sample_image(np.asarray(t), tu, tv, interpolation, extension), image.shape[2])
+                        lambda t, tu, tv: sample_image(t, tu, tv, interpolation, extension), image.shape[2])
     if isinstance(image, MissingImage):
         return missing_lookup(image, len(np.atleast_1d(u)))
+    return decoded(image, _sample_texels(np.asarray(image), u, v, interpolation, extension))
+
+
+def _sample_texels(image: np.ndarray, u, v, interpolation: str, extension: str) -> np.ndarray:
+    """(n, c) texels of a plain (h, w, c) array at (u, v), interpolated as they are stored."""
     h, w = image.shape[:2]
     u = np.where(np.isfinite(u), u, 0).astype(np.float64)
     v = np.where(np.isfinite(v), v, 0).astype(np.float64)
