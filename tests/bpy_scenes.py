@@ -1336,3 +1336,50 @@ def srgb_texture_planes(px: int = 32):
                 tree.links.new(tex.outputs["Color"], color_socket)
         return wire
     return node_planes([graph(k) for k in SRGB_READS], 3, px, name="Srgb")
+
+
+def ies_text(kind: str) -> str:
+    """An LM-63 profile (photometric type C): ``full`` 0-180° vertical by 0-360° horizontal, lopsided (brighter
+    towards +X, a lobe at 30° from straight down); ``quadrant`` a downlight given over 0-90° in both, which Cycles
+    mirrors to the four quadrants."""
+    if kind == "full":
+        v = np.arange(0.0, 181.0, 15.0)
+        h = np.arange(0.0, 361.0, 45.0)
+        cd = [[(400 + 300 * np.cos(np.radians(a))) * np.exp(-((b - 30) / 35) ** 2) + 20 for b in v] for a in h]
+    else:
+        v = np.arange(0.0, 91.0, 10.0)
+        h = np.array([0.0, 30.0, 60.0, 90.0])
+        cd = [[(900 - 300 * a / 90) * np.cos(np.radians(b)) ** 2 + 50 for b in v] for a in h]
+    rows = ["IESNA:LM-63-2002", "[TEST] restir_engine", "[MANUFAC] none", "TILT=NONE",
+            f"1 1000 1.5 {len(v)} {len(h)} 1 2 0.3 0.3 0.1", "1.0 1.0 60"]
+    rows.append(" ".join(f"{x:g}" for x in v))
+    rows.append(" ".join(f"{x:g}" for x in h))
+    rows += [" ".join(f"{x:.3f}" for x in col) for col in cd]
+    return "\n".join(rows) + "\n"
+
+
+#: the lamps of :func:`ies_lamp_scene`
+IES_LAMPS = ("full", "quadrant", "turned")
+
+
+def ies_lamp_scene(kind: str, size=(64, 64)):
+    """A white floor seen from above lit by a small point lamp 1 m up whose Emission Strength is an IES Texture
+    (:func:`ies_text`, internal text, unlinked vector): ``full`` the lopsided profile, ``quadrant`` the mirrored
+    downlight, ``turned`` the lopsided profile on a lamp turned about Z and tilted."""
+    import node_graphs as ng
+    scene = reset()
+    black_world(scene)
+    plane("Floor", 8.0, (0, 0, 0), material=diffuse("Floor", (0.8, 0.8, 0.8)))
+    camera((0, 0, 10), (0, 0, 0), ortho_scale=4.0)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    lamp = light("POINT", (0.1, 0.2, 1.0), energy=20.0, shadow_soft_size=0.0)
+    if kind == "turned":
+        lamp.rotation_euler = (0.25, 0.0, 0.9)
+    t, em = _lamp_tree(lamp)
+    text = bpy.data.texts.new(f"profile_{kind}.ies")
+    text.write(ies_text("quadrant" if kind == "quadrant" else "full"))
+    node = ng._node(t, "ShaderNodeTexIES")
+    node.mode = "INTERNAL"
+    node.ies = text
+    t.links.new(node.outputs["Fac"], em.inputs["Strength"])
+    return scene

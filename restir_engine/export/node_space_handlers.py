@@ -1,8 +1,11 @@
-"""Shader-node handlers for the view and space nodes: Camera Data, Vector Transform and Normal (each returns its
-outputs as registers of the graph compiler, export/node_graph.py; the vector operations are core/materials/nodes/)."""
+"""Shader-node handlers for the view, space and light-profile nodes: Camera Data, Vector Transform, Normal and IES
+Texture (each returns its outputs as registers of the graph compiler, export/node_graph.py; the vector operations are
+core/materials/nodes/)."""
 from __future__ import annotations
 
 import numpy as np
+
+from ..core.lights import ies
 
 
 def camera_data(g, node, f):
@@ -39,3 +42,40 @@ def normal(g, node, f):
     unit = g.emit("vector_math", {"op": "NORMALIZE"}, [inp, zero_v, zero_v, zero_f], ("vector", "float"))[0]
     dot = g.emit("vector_math", {"op": "DOT_PRODUCT"}, [direction, unit, zero_v, zero_f], ("vector", "float"))[1]
     return {"Normal": direction, "Dot": dot}
+
+
+def _ies_text(node) -> tuple:
+    """(the IES Texture's LM-63 text or None, where it was looked for)."""
+    if node.mode == "INTERNAL":
+        text = node.ies
+        return (None if text is None else text.as_string()), "its internal text"
+    import bpy
+    path = bpy.path.abspath(node.filepath)
+    try:
+        with open(path, encoding="latin-1") as fh:
+            return fh.read(), f"'{path}'"
+    except OSError:
+        return None, f"'{path}'"
+
+
+def ies_texture(g, node, f):
+    """IES Texture: Strength x the light profile of its internal text or external file (core/lights/ies.py) towards
+    its Vector (unlinked: the incoming direction in object space, the direction from a lamp to the lit point); a
+    profile that cannot be read is named and reads 100 everywhere, as Cycles gives it."""
+    text, where = _ies_text(node)
+    table = None
+    if not text:
+        g.warn(f"'{node.name}' (IES Texture): no profile in {where}; it reads {ies.UNREADABLE:g} everywhere")
+    else:
+        try:
+            table = ies.parse(text)
+        except ies.IesError as err:
+            g.warn(f"'{node.name}' (IES Texture): {where} is not a readable IES profile ({err}); it reads "
+                   f"{ies.UNREADABLE:g} everywhere")
+    if node.inputs["Vector"].is_linked:
+        vec = g.inp(node, "Vector", "vector", f)
+    else:
+        vec = g.emit("vector_transform", {"type": "NORMAL", "from": "WORLD", "to": "OBJECT", "camera": g.camera},
+                     [g.attribute("incoming", "vector")], ("vector",))[0]
+    strength = g.inp(node, "Strength", "float", f)
+    return {"Fac": g.emit("ies_texture", {"table": table}, [vec, strength], ("float",))[0]}

@@ -136,3 +136,30 @@ def test_normalize_off_does_not_spread_the_power_over_the_light(addon, kind):
         sc = export_scene(bpy.context.evaluated_depsgraph_get())
         radiance.append(sc.materials.emission[sc.materials.names.index("(light Probe)")])
     np.testing.assert_allclose(radiance[1], radiance[0] * area, rtol=1e-4)
+
+
+def test_ies_texture_on_a_lamp_is_a_program_and_a_missing_file_is_named(addon, tmp_path):
+    """An IES Texture on a lamp's Strength: a node program of the profile (its images against Cycles:
+    tests/cycles test_ies_lamps_match_cycles); an external file that is not there is named, and reads 100 as in
+    Cycles."""
+    from bpy_scenes import ies_text
+
+    from restir_engine.core.lights.lamp_textures import OUTPUT
+    from restir_engine.export.lights import _lamp_power
+    light = _lamp("IES probe")
+    light.use_nodes = True
+    tree = light.node_tree
+    em = next(n for n in tree.nodes if n.type == "EMISSION")
+    node = tree.nodes.new("ShaderNodeTexIES")
+    tree.links.new(node.outputs["Fac"], em.inputs["Strength"])
+    path = tmp_path / "profile.ies"
+    path.write_text(ies_text("full"))
+    node.mode, node.filepath = "EXTERNAL", str(path)
+    warns, program = [], []
+    _lamp_power(light, light.name, warns, None, None, program)
+    assert not warns and len(program) == 1 and program[0].has(OUTPUT)
+    node.filepath = str(tmp_path / "missing.ies")
+    warns, program = [], []
+    _lamp_power(light, light.name, warns, None, None, program)
+    assert any("IES Texture" in w and "missing.ies" in w for w in warns)
+    assert len(program) == 1  # the lookup reads 100 everywhere, folded into the lamp's program

@@ -8,10 +8,14 @@ Per 8 x 8 cells of 8 x 8 pixels and colour channel, from 4 seeds a side: a cell 
 |ours - Cycles| <= 5 SE + 0.5 % of Cycles + 1e-3 (as the node pattern tests); lit cells, with ours scaled by 1.03,
 must fail somewhere (power). The path tracer and ReSTIR DI unbiased (the lamp's pattern in its target and shading).
 Before, these lamps rendered with their sockets' own values (one flat colour) and a warning.
+
+IES Texture (bpy_scenes.ies_lamp_scene): a point lamp whose Strength is an LM-63 profile (internal text, the
+node's default vector), lopsided over 0-360°, a one-quadrant downlight Cycles mirrors, and the lopsided one on a
+turned lamp; the same cells and bounds. Before, the node was unsupported (its socket value, a flat lamp).
 """
 import numpy as np
 import pytest
-from bpy_scenes import TEXTURED_LAMPS, textured_lamp_scene
+from bpy_scenes import IES_LAMPS, TEXTURED_LAMPS, ies_lamp_scene, textured_lamp_scene
 from cycles_compare import cycles_reference, ours_cells
 from stats import MARGIN, POWER_ERROR, Z_MAX
 
@@ -37,13 +41,31 @@ def within(ours, ref):
     return np.abs(ma - mb) <= Z_MAX * se + MARGIN * np.abs(mb) + FLOAT_TOL
 
 
+def _compare(case, build, samples, settings):
+    ours = ours_cells(build, 0, samples, cells, reps=REPS, **settings)
+    ref = cycles_reference(case, build, 0, 64, cells, reps=REPS)
+    return ours, ref
+
+
 @pytest.mark.parametrize("method", ["PATH", "RESTIR"])
 @pytest.mark.parametrize("kind", TEXTURED_LAMPS)
 def test_textured_lamps_match_cycles(addon, kind, method):
     settings = {"integrator": "PATH"} if method == "PATH" else RESTIR
     samples = SAMPLES.get((method, kind), 16 if method == "PATH" else 4)
-    ours = ours_cells(lambda: textured_lamp_scene(kind, SIZE), 0, samples, cells, reps=REPS, **settings)
-    ref = cycles_reference(f"lamp_texture_{kind}", lambda: textured_lamp_scene(kind, SIZE), 0, 64, cells, reps=REPS)
+    ours, ref = _compare(f"lamp_texture_{kind}", lambda: textured_lamp_scene(kind, SIZE), samples, settings)
+    _assert_agree(kind, ours, ref)
+
+
+@pytest.mark.parametrize("method", ["PATH", "RESTIR"])
+@pytest.mark.parametrize("kind", IES_LAMPS)
+def test_ies_lamps_match_cycles(addon, kind, method):
+    settings = {"integrator": "PATH"} if method == "PATH" else RESTIR
+    ours, ref = _compare(f"lamp_ies_{kind}", lambda: ies_lamp_scene(kind, SIZE), 16 if method == "PATH" else 4,
+                         settings)
+    _assert_agree(f"IES {kind}", ours, ref)
+
+
+def _assert_agree(kind, ours, ref):
     ok = within(ours, ref)
     worst = int(np.argmin(ok))
     assert ok.all(), (f"{kind}: {int((~ok).sum())} of {ok.size} cells disagree; cell {worst // 3} channel "
