@@ -690,5 +690,24 @@ PATTERNS = [
 ]
 
 
+def gabor(kind="2D", output="Value", scale=5.0, frequency=2.0, anisotropy=1.0, orientation=0.6,
+          orientation_3d=(1.0, 0.5, 0.3)):
+    def graph(tree, socket):
+        n = _node(tree, "ShaderNodeTexGabor", gabor_type=kind)
+        for ident, v in (("Scale", scale), ("Frequency", frequency), ("Anisotropy", anisotropy),
+                         ("Orientation 2D", orientation), ("Orientation 3D", orientation_3d)):
+            _set(n, ident, v)
+        _link(tree, n.outputs[output], socket)
+    return graph
+
+
+GABOR = [
+    ("gabor 2D value", gabor()), ("gabor 2D isotropic value", gabor(anisotropy=0.2, frequency=3.0)),
+    ("gabor 2D phase", gabor(output="Phase", scale=2.0, frequency=1.0)),
+    ("gabor 2D intensity", gabor(output="Intensity")),
+    ("gabor 3D value", gabor("3D")), ("gabor 3D isotropic value", gabor("3D", anisotropy=0.4)),
+    ("gabor 3D intensity", gabor("3D", output="Intensity", frequency=1.5)),
+]
+
 FAMILIES = {"noise": NOISE, "textures": TEXTURES, "converters": CONVERTERS, "mixes": MIXES, "inputs": INPUTS,
-            "voronoi": VORONOI, "patterns": PATTERNS}
+            "voronoi": VORONOI, "patterns": PATTERNS, "gabor": GABOR}

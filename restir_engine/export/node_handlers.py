@@ -338,6 +338,16 @@ def _white_noise(g, node, f):
     return {"Value": value, "Color": color}
 
 
+def _gabor(g, node, f):
+    """Gabor Texture (core/materials/nodes/gabor.py): Value, Phase, Intensity."""
+    ins = [g.inp(node, "Vector", "vector", f, default="generated"), g.inp(node, "Scale", "float", f),
+           g.inp(node, "Frequency", "float", f), g.inp(node, "Anisotropy", "float", f),
+           g.inp(node, "Orientation 2D", "float", f), g.inp(node, "Orientation 3D", "vector", f)]
+    value, phase, intensity = g.emit("gabor_texture", {"dims": 3 if node.gabor_type == "3D" else 2}, ins,
+                                     ("float", "float", "float"))
+    return {"Value": value, "Phase": phase, "Intensity": intensity}
+
+
 def _checker(g, node, f):
     ins = [g.inp(node, "Vector", "vector", f, default="generated"), g.inp(node, "Color1", "color", f),
            g.inp(node, "Color2", "color", f), g.inp(node, "Scale", "float", f)]
@@ -482,4 +492,5 @@ HANDLERS = {
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
     "TEX_BRICK": _brick, "BLACKBODY": _blackbody, "WAVELENGTH": _wavelength, "LIGHT_FALLOFF": _light_falloff,
     "AMBIENT_OCCLUSION": _ambient_occlusion, "BEVEL": _bevel, "WIREFRAME": _wireframe, "TEX_IES": ies_texture,
+    "TEX_GABOR": _gabor,
 }

@@ -124,3 +124,25 @@ def test_wireframe_marks_points_within_half_the_size_of_an_edge_line():
         assert 0 < got.sum() < len(b1)
     world = DirectionAttributes(np.tile(F([[0], [0], [1]]), (1, 4)), [])
     np.testing.assert_array_equal(ops_texture.wireframe(world, {}, F(1.0)), np.zeros(4, F))
+
+
+@pytest.mark.parametrize("dims", [2, 3])
+def test_gabor_is_pointwise_across_chunks_and_constants(dims):
+    """The Gabor Texture's value at a point does not depend on the batch around it (chunks of gabor.CHUNK points, a
+    constant folded at export); its patterns against Cycles: tests/cycles test_node_patterns_match_cycles[gabor]."""
+    from restir_engine.core.materials.nodes import gabor
+    from restir_engine.core.materials.nodes.program import evaluate_constant
+    rng = np.random.default_rng(9)
+    n = gabor.CHUNK + 37
+    vec = rng.uniform(-3, 3, (3, n)).astype(F)
+    params = {"dims": dims}
+    args = (F(4.0), F(2.0), F(0.3), F(0.7), np.array([[0.3], [0.8], [0.1]], F))
+
+    class Batch:
+        def __len__(self):
+            return n
+    whole = gabor.gabor_texture(Batch(), params, vec, *args)
+    assert all(np.isfinite(o).all() for o in whole) and whole[0].std() > 0.05
+    for k in (5, gabor.CHUNK + 10):  # in the first chunk and in the second
+        one = evaluate_constant("gabor_texture", params, vec[:, k:k + 1], *args)
+        np.testing.assert_allclose([float(o) for o in one], [o[k] for o in whole], rtol=1e-6, atol=1e-7)
