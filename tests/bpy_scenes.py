@@ -1217,7 +1217,7 @@ def _lamp_tree(lamp_obj):
 
 
 #: the lamps of :func:`textured_lamp_scene`
-TEXTURED_LAMPS = ("point", "spot", "area", "rotated")
+TEXTURED_LAMPS = ("point", "spot", "area", "rotated", "attributes")
 
 
 def textured_lamp_scene(kind: str, size=(64, 64)):
@@ -1226,14 +1226,16 @@ def textured_lamp_scene(kind: str, size=(64, 64)):
     Coordinate Normal (an IES-like pattern) and whose Strength grows along the Normal's X; ``spot`` a spot lamp
     projecting a 16 x 16 image of colour ramps and squares through Texture Coordinate UV (a gobo); ``area`` a rectangular area lamp
     whose Color is its UV and whose Strength is a Checker of Object coordinates; ``rotated`` a turned, scaled
-    point lamp whose Color is a Gradient of Normal (object space) and Strength its UV's Y."""
+    point lamp whose Color is a Gradient of Normal (object space) and Strength its UV's Y; ``attributes`` a point
+    lamp whose Color is an Attribute node of Object type (a custom property of the lamp object) times a Checker of
+    its Normal, and whose Strength is a View Layer attribute (a custom property of the scene)."""
     import node_graphs as ng
     scene = reset()
     black_world(scene)
     plane("Floor", 8.0, (0, 0, 0), material=diffuse("Floor", (0.8, 0.8, 0.8)))
     camera((0, 0, 10), (0, 0, 0), ortho_scale=4.0)
     scene.render.resolution_x, scene.render.resolution_y = size
-    if kind in ("point", "rotated"):
+    if kind in ("point", "rotated", "attributes"):
         lamp = light("POINT", (0.2, -0.1, 1.0), energy=60.0, shadow_soft_size=0.0)
     elif kind == "spot":
         lamp = light("SPOT", (0.0, 0.0, 2.0), energy=150.0, shadow_soft_size=0.0, spot_size=1.3, spot_blend=0.1)
@@ -1272,6 +1274,18 @@ def textured_lamp_scene(kind: str, size=(64, 64)):
         mad.inputs[1].default_value = 0.3
         t.links.new(chk.outputs["Fac"], mad.inputs[0])
         t.links.new(mad.outputs[0], em.inputs["Strength"])
+    elif kind == "attributes":
+        lamp["tint"] = (1.0, 0.45, 0.2)
+        scene["glow"] = 1.7
+        obj_attr = ng._node(t, "ShaderNodeAttribute", attribute_type="OBJECT", attribute_name="tint")
+        chk = ng._node(t, "ShaderNodeTexChecker")
+        ng._set(chk, "Scale", 2.5)
+        chk.inputs["Color2"].default_value = (0.3, 0.6, 1.0, 1.0)
+        t.links.new(tc.outputs["Normal"], chk.inputs["Vector"])
+        t.links.new(obj_attr.outputs["Color"], chk.inputs["Color1"])
+        t.links.new(chk.outputs["Color"], em.inputs["Color"])
+        layer_attr = ng._node(t, "ShaderNodeAttribute", attribute_type="VIEW_LAYER", attribute_name="glow")
+        t.links.new(layer_attr.outputs["Fac"], em.inputs["Strength"])
     else:
         lamp.rotation_euler = (0.3, -0.2, 0.7)
         lamp.scale = (1.0, 1.5, 1.0)

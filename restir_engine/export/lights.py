@@ -151,8 +151,10 @@ def _area(tris: np.ndarray) -> float:
 
 def _texture_record(program, light, inst, m: np.ndarray) -> tuple:
     """What lights/lamp_textures.LampTextures keeps of a textured lamp: (program, kind, world -> object (3, 4),
-    object -> world (3, 3), uv scale (2,), location, colour (4,), random, pass index, sphere normal)."""
+    object -> world (3, 3), uv scale (2,), location, colour (4,), random, pass index, sphere normal, the Object /
+    Instancer attribute values its program reads ({key: rgba}, export/object_properties.py))."""
     from ..core.lights import lamp_textures as lt
+    from . import object_properties
     from .meshes import object_random
     obj = inst.object
     if light.type == "AREA":
@@ -167,15 +169,18 @@ def _texture_record(program, light, inst, m: np.ndarray) -> tuple:
         inv = np.linalg.inv(m)
     except np.linalg.LinAlgError:
         inv = np.linalg.pinv(m)
+    keys = {k for k in map(object_properties.key_of, program.reads) if k is not None}
     return (program, kind, inv[:3, :4], m[:3, :3], uv_scale, m[:3, 3], tuple(obj.color), object_random(inst),
-            float(getattr(obj, "pass_index", 0)), not getattr(light, "use_soft_falloff", True))
+            float(getattr(obj, "pass_index", 0)), not getattr(light, "use_soft_falloff", True),
+            object_properties.instance_values(inst, obj, keys))
 
 
 def _lamp_textures(records: list, counts: list, textures: list):
     """lights/lamp_textures.LampTextures per lamp triangle from each lamp's :func:`_texture_record` (None: a
     constant lamp) and its triangle count."""
     from ..core.lights.lamp_textures import LampTextures
-    blank = (None, 0, np.zeros((3, 4)), np.eye(3), (0.0, 0.0), np.zeros(3), (0.0, 0.0, 0.0, 1.0), 0.0, 0.0, False)
+    from .object_properties import MISSING
+    blank = (None, 0, np.zeros((3, 4)), np.eye(3), (0.0, 0.0), np.zeros(3), (0.0, 0.0, 0.0, 1.0), 0.0, 0.0, False, {})
     programs, index = [], []
     for r in records:
         index.append(-1 if r is None else len(programs))
@@ -185,9 +190,12 @@ def _lamp_textures(records: list, counts: list, textures: list):
 
     def rep(k, dtype):
         return np.repeat(np.array([r[k] for r in full], dtype), counts, axis=0)
+    keys = sorted({k for r in full for k in r[10]})
+    properties = {k: np.repeat(np.array([r[10].get(k, MISSING) for r in full], np.float32), counts, axis=0)
+                  for k in keys}
     return LampTextures(programs, np.repeat(np.array(index, np.int32), counts), rep(1, np.int8), rep(2, np.float32),
                         rep(3, np.float32), rep(4, np.float32), rep(5, np.float32), rep(6, np.float32),
-                        rep(7, np.float32), rep(8, np.float32), rep(9, bool), textures=textures)
+                        rep(7, np.float32), rep(8, np.float32), rep(9, bool), textures=textures, properties=properties)
 
 
 #: points at which a textured lamp's graph is averaged for its share of the lamps' power

@@ -2,7 +2,8 @@
 a white floor seen from above lit by one lamp: a point lamp patterned by its Normal (Checker colour, Strength along
 X), a spot projecting an image through its UV (a gobo), an area lamp coloured by its UV with a Checker of Object
 coordinates as Strength, a turned and scaled point lamp with a Gradient of its Normal through a Color Ramp and its
-UV as Strength. Direct light only (each floor pixel sees the pattern where the lamp shines on it).
+UV as Strength, a point lamp coloured by an Object attribute (a property of the lamp object) through a Checker and
+with a View Layer attribute as Strength. Direct light only (each floor pixel sees the pattern where the lamp shines on it).
 
 Per 8 x 8 cells of 8 x 8 pixels and colour channel, from 4 seeds a side: a cell agrees when
 |ours - Cycles| <= 5 SE + 0.5 % of Cycles + 1e-3 (as the node pattern tests); lit cells, with ours scaled by 1.03,

@@ -13,7 +13,8 @@ receiver p (``wo`` = the unit direction from q to p), as Cycles sets up a lamp's
   sphere mapping of the object-space normal (u = (1 - atan2(x, y) / π) / 2, v = 1 - acos(z) / π); spot lamps the
   image projected over the cone: (1/2 + x f, 1/2 + y f) of the object-space direction to the receiver (z towards
   the cone's axis) with f = cot(spot size / 2) / (2 z);
-- Object Info of the lamp object (Location, Color, Alpha, Random, Pass Index); Light Path's ray flags 0 (a lamp's
+- Object Info of the lamp object (Location, Color, Alpha, Random, Pass Index) and its Object / Instancer attributes
+  (the Attribute node's types: a property of the lamp object or its data); Light Path's ray flags 0 (a lamp's
   shader is evaluated as emission, not by a camera or shadow ray); Ray Length the distance to the receiver.
 """
 from __future__ import annotations
@@ -22,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..materials.nodes.attributes import OBJECT_PROPERTY, OBJECT_PROPERTY_ALPHA
 from ..sampling import dot, norm
 
 _F = np.float32
@@ -37,7 +39,8 @@ class LampTextures:
     in object space; spot: cot(spot size / 2) / 2, 0), ``location`` (n, 3), ``color`` (n, 4), ``random`` (n,),
     ``pass_index`` (n,) float32 of the lamp object, ``sphere_normal`` (n,) bool (Soft Falloff off: the normal is
     the sphere's), ``power_scale`` (n,) float32 the graph's mean luminance factor (for picking lamps by power).
-    ``textures``: the material table's images the programs read."""
+    ``textures``: the material table's images the programs read; ``properties`` the Object / Instancer attributes
+    they read, per lamp triangle (as ObjectTable.properties per instance)."""
 
     programs: list
     program: np.ndarray
@@ -52,6 +55,7 @@ class LampTextures:
     sphere_normal: np.ndarray
     power_scale: np.ndarray = None
     textures: list = field(default_factory=list)
+    properties: dict = field(default_factory=dict)  # {"KIND:name": (n, 4) rgba}: Object / Instancer attributes
 
     def __post_init__(self):
         if self.power_scale is None:
@@ -171,7 +175,13 @@ class LampAttributes:
             return np.full(k, _F(1e-3), np.float32)
         if name in {"tangent_uv", "tangent_sign"}:
             return None
-        if name in {"tangent"} or name.startswith(("attr:", "object_property:")):
+        if name.startswith((OBJECT_PROPERTY, OBJECT_PROPERTY_ALPHA)):
+            alpha = name.startswith(OBJECT_PROPERTY_ALPHA)
+            table = lt.properties.get(name[len(OBJECT_PROPERTY_ALPHA if alpha else OBJECT_PROPERTY):])
+            if table is None:
+                return np.zeros(k if alpha else (3, k), np.float32)
+            return np.ascontiguousarray(table[tri, 3] if alpha else table[tri, :3].T, dtype=np.float32)
+        if name == "tangent" or name.startswith("attr:"):
             return np.zeros((3, k), np.float32)
         return np.zeros(k, np.float32)  # backfacing, Light Path flags, attribute and property alphas
 
