@@ -317,7 +317,7 @@ class RestirRenderEngine(bpy.types.RenderEngine):
     # -- viewport (Rendered shading) ----------------------------------------------------------
     def view_update(self, context, depsgraph):
         """Blender's thread: export what the edit changed (export.incremental); the worker renders it."""
-        from .export.incremental import SceneExporter, reads_object_properties, update_level
+        from .export.incremental import SceneExporter, reads_object_properties, reads_view_layer, update_level
         from .viewport import ViewportSession
         scene = depsgraph.scene
         apply_threads(scene)
@@ -325,8 +325,8 @@ class RestirRenderEngine(bpy.types.RenderEngine):
             self._viewport = ViewportSession(self.tag_redraw)
             self._exporter = SceneExporter()
         exporter = self._exporter
-        level = update_level(depsgraph.updates, reads_object_properties(exporter.last)) \
-            if exporter.last is not None else "FULL"
+        level = update_level(depsgraph.updates, reads_object_properties(exporter.last),
+                             reads_view_layer(exporter.last)) if exporter.last is not None else "FULL"
         cam, key = self._view(context)
         settings = self._viewport_settings(scene, context)
         session = self._viewport

@@ -30,10 +30,12 @@ _GEOMETRY_DATA = (bpy.types.Mesh, bpy.types.Curve, bpy.types.MetaBall) + \
     tuple(getattr(bpy.types, n) for n in ("Curves", "PointCloud", "Volume", "TextCurve") if hasattr(bpy.types, n))
 
 
-def update_level(updates, object_properties: bool = False) -> str:
+def update_level(updates, object_properties: bool = False, view_layer: bool = False) -> str:
     """The export level that a depsgraph's ``updates`` need (one of LEVELS); ``object_properties``: the last
     export's materials read objects' properties (the Attribute node's Object / Instancer types), which an object's
-    edit (a custom property) may change without moving it: the instances are then gathered again (TRANSFORM)."""
+    edit (a custom property) may change without moving it: the instances are then gathered again (TRANSFORM);
+    ``view_layer``: its graphs read View Layer attributes (folded into them), which an edit of the scene's or the
+    view layer's properties may change: the graphs are compiled again (SHADING)."""
     level = 0
     for u in updates:
         idv = u.id
@@ -53,7 +55,7 @@ def update_level(updates, object_properties: bool = False) -> str:
         elif isinstance(idv, _GEOMETRY_DATA):
             need = 4 if u.is_updated_geometry else 2
         elif isinstance(idv, bpy.types.Scene):
-            need = 1
+            need = 2 if view_layer else 1
         else:  # collections (visibility, objects added or removed), anything else
             need = 4
         level = max(level, need)
@@ -72,6 +74,11 @@ def reads_object_properties(scene) -> bool:
     mats = getattr(scene, "materials", None)
     programs = list(getattr(mats, "programs", None) or []) + list(getattr(mats, "aov_programs", None) or [])
     return any(OBJECT_VALUES & set(prog.reads) for prog in programs)
+
+
+def reads_view_layer(scene) -> bool:
+    """Whether the exported ``scene``'s node graphs (materials, lamps, world) read View Layer attributes."""
+    return bool(getattr(scene, "export_stats", {}).get("reads_view_layer", False))
 
 
 class SceneExporter:
@@ -126,7 +133,7 @@ class SceneExporter:
         if registry.index != stats["material_index"]:  # a mix gained or lost a component: rows moved
             return None
         out = export_shading(depsgraph, registry, last.geometry, camera, warnings)
-        out.export_stats = dict(stats, material_index=dict(registry.index))
+        out.export_stats = dict(stats, material_index=dict(registry.index), reads_view_layer=getattr(registry.view_layer, "read", False))
         if _needs(out) != stats["material_needs"]:
             return None
         out.export_stats["material_needs"] = stats["material_needs"]

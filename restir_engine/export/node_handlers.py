@@ -86,7 +86,7 @@ def _attribute(g, node, f):
     per instance; View Layer: a property of the view layer, scene or world (export/object_properties.py; where the
     compiler knows them: materials and the world)."""
     kind = node.attribute_type
-    places = getattr(g, "view_layer", None)  # None: a compiler that does not know them (a lamp's)
+    places = getattr(g, "view_layer", None)  # None: a compiler that does not know them
     if kind not in ("GEOMETRY", "OBJECT", "INSTANCER", "VIEW_LAYER") or (kind == "VIEW_LAYER" and places is None):
         return None
     name = node.attribute_name
@@ -94,6 +94,8 @@ def _attribute(g, node, f):
         zero = g.constant(0.0, "float")
         return {"Color": g.constant(0.0, "color"), "Vector": g.constant(0.0, "vector"), "Fac": zero, "Alpha": zero}
     if kind == "VIEW_LAYER":  # one value for the whole render: a constant
+        if isinstance(places, object_properties.Places):
+            places.read = True  # the viewport compiles the graphs again on an edit of these places
         r, gr, b, a = object_properties.first_value(places, name)
         return {"Color": g.constant((r, gr, b), "color"), "Vector": g.constant((r, gr, b), "vector"),
                 "Fac": g.constant((r + gr + b) / 3.0, "float"), "Alpha": g.constant(a, "float")}

@@ -84,9 +84,16 @@ def unread_instance_attributes(inst, values: dict) -> list[str]:
     return [key.split(":", 1)[1] for key, v in values.items() if key.startswith("INSTANCER:") and v == MISSING]
 
 
-def view_layer_places(view_layer, scene) -> tuple:
+class Places(tuple):
+    """Where View Layer attributes are looked up (:func:`view_layer_places`); ``read`` turns True once a graph reads
+    one (the viewport then compiles the graphs again when the scene's properties are edited)."""
+
+    read = False
+
+
+def view_layer_places(view_layer, scene) -> Places:
     """Where a View Layer attribute is looked up, in order: the view layer, the scene, the scene's world."""
-    return tuple(p for p in (view_layer, scene, getattr(scene, "world", None)) if p is not None)
+    return Places(p for p in (view_layer, scene, getattr(scene, "world", None)) if p is not None)
 
 
 def first_value(places, name: str) -> tuple:

@@ -215,3 +215,37 @@ def test_a_world_reads_view_layer_attributes(addon):
     tree.nodes["Background"].inputs["Strength"].default_value = 2.0
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     assert np.allclose(sc.world_radiance, 0.9) and not [w for w in sc.warnings if "Attribute" in w]
+
+
+def test_a_scene_property_edit_reaches_the_viewports_graphs(addon):
+    """A View Layer attribute is folded into the graphs that read it; an edit of the scene's properties (a Scene
+    update) compiles them again in the viewport (SHADING, no mesh read) with the new value. A scene whose graphs read
+    none keeps a scene edit at SETTINGS (the exported scene reused)."""
+    from types import SimpleNamespace
+
+    from restir_engine.export import export_scene
+    from restir_engine.export.incremental import SceneExporter, reads_view_layer, update_level
+    scene = object_attribute_scene()
+    tree = scene.world.node_tree
+    att = tree.nodes.new("ShaderNodeAttribute")
+    att.attribute_type, att.attribute_name = "VIEW_LAYER", "b"
+    tree.links.new(att.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    tree.nodes["Background"].inputs["Strength"].default_value = 2.0
+    dg = bpy.context.evaluated_depsgraph_get()
+    exporter = SceneExporter()
+    cam = export_scene(dg).camera
+    first = exporter.export(dg, cam, "FULL")
+    assert reads_view_layer(first) and np.allclose(first.world_radiance, 0.9)
+    # what the properties panel sends for a scene's custom property: an update of the Scene alone
+    edit = [SimpleNamespace(id=scene, is_updated_geometry=False, is_updated_transform=False)]
+    assert update_level(edit, view_layer=reads_view_layer(first)) == "SHADING"
+    assert update_level(edit) == "SETTINGS"
+    scene["b"] = 0.25
+    scene.update_tag()  # as the panel's edit tags it: the evaluated scene takes the new value
+    bpy.context.view_layer.update()
+    out = exporter.export(bpy.context.evaluated_depsgraph_get(), cam, "SHADING")
+    assert exporter.last_level == "SHADING"  # around the last export's triangles: no mesh read
+    assert np.allclose(out.world_radiance, 0.5) and reads_view_layer(out)
+    from bpy_scenes import cornell_box
+    cornell_box()  # graphs that read no View Layer attribute
+    assert not reads_view_layer(export_scene(bpy.context.evaluated_depsgraph_get()))
