@@ -163,3 +163,28 @@ def test_ies_texture_on_a_lamp_is_a_program_and_a_missing_file_is_named(addon, t
     _lamp_power(light, light.name, warns, None, None, program)
     assert any("IES Texture" in w and "missing.ies" in w for w in warns)
     assert len(program) == 1  # the lookup reads 100 everywhere, folded into the lamp's program
+
+
+def test_textured_lamps_render_alike_on_worker_processes(addon):
+    """A scene with textured lamps (a gobo spot and an IES point lamp: their programs, images and profiles cross to
+    the workers) renders bit for bit the image one process renders, with ReSTIR DI."""
+    from bpy_scenes import ies_lamp_scene, textured_lamp_scene
+
+    from restir_engine.core.parallel import processes
+    from restir_engine.core.renderer import RenderSettings, render_frame
+    from restir_engine.export import export_scene
+    settings = RenderSettings(integrator="RESTIR", direct_method="RESTIR", samples=2, max_bounces=1,
+                              tile_pixels=1024, light_tiles="ON")
+    try:
+        for build in (lambda: textured_lamp_scene("spot", (48, 40)), lambda: ies_lamp_scene("turned", (48, 40))):
+            build()
+            scene = export_scene(bpy.context.evaluated_depsgraph_get())
+            assert scene.lamps.textured is not None
+            alone = render_frame(scene, settings, processes=1)
+            team = render_frame(scene, settings, processes=2)
+            assert team.stats["processes"] == 2
+            combined = alone.passes["Combined"]
+            assert combined[..., :3].mean() > 0.01
+            assert np.array_equal(combined, team.passes["Combined"])
+    finally:
+        processes.shutdown()
