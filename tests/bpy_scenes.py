@@ -1224,8 +1224,9 @@ def textured_lamp_scene(kind: str, size=(64, 64)):
     """A white diffuse floor seen from above (orthographic) lit by one lamp whose Emission comes from a node graph
     that varies over it, as artists texture lamps: ``point`` a tiny point lamp whose Color is a Checker of Texture
     Coordinate Normal (an IES-like pattern) and whose Strength grows along the Normal's X; ``spot`` a spot lamp
-    projecting a 16 x 16 image of colour ramps and squares through Texture Coordinate UV (a gobo); ``area`` a rectangular area lamp
-    whose Color is its UV and whose Strength is a Checker of Object coordinates; ``rotated`` a turned, scaled
+    projecting a 16 x 16 image of colour ramps and squares through Texture Coordinate UV (a gobo); ``area`` a
+    rectangular area lamp whose Color is its UV and whose Strength is a Checker of Object coordinates; ``rotated`` a
+    turned, scaled
     point lamp whose Color is a Gradient of Normal (object space) and Strength its UV's Y; ``attributes`` a point
     lamp whose Color is an Attribute node of Object type (a custom property of the lamp object) times a Checker of
     its Normal, and whose Strength is a View Layer attribute (a custom property of the scene)."""

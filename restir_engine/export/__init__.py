@@ -67,7 +67,8 @@ def export_scene(depsgraph, camera_override=None, camera=None, mesh_cache: dict 
     geometry_warnings = list(warnings)
     out = export_shading(depsgraph, registry, geometry, camera, warnings)
     out.export_stats = dict(stats, seconds=time.perf_counter() - t0, material_index=dict(registry.index),
-                            geometry_warnings=geometry_warnings, reads_view_layer=getattr(registry.view_layer, "read", False))
+                            geometry_warnings=geometry_warnings,
+                            reads_view_layer=getattr(registry.view_layer, "read", False))
     return out
 
 

@@ -133,7 +133,8 @@ class SceneExporter:
         if registry.index != stats["material_index"]:  # a mix gained or lost a component: rows moved
             return None
         out = export_shading(depsgraph, registry, last.geometry, camera, warnings)
-        out.export_stats = dict(stats, material_index=dict(registry.index), reads_view_layer=getattr(registry.view_layer, "read", False))
+        out.export_stats = dict(stats, material_index=dict(registry.index),
+                                reads_view_layer=getattr(registry.view_layer, "read", False))
         if _needs(out) != stats["material_needs"]:
             return None
         out.export_stats["material_needs"] = stats["material_needs"]

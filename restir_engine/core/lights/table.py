@@ -125,7 +125,8 @@ def texture_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray, q: np.ndar
         return None
     out = np.ones((3, len(lamp_tri)), np.float32)
     t = lamp_tri[sel]
-    out[:, sel] = lamp_texture_factor(lt, t, cols(p, sel), cols(q, sel), np.ascontiguousarray(lamps.tris.normals[t, 0].T))
+    normals = np.ascontiguousarray(lamps.tris.normals[t, 0].T)
+    out[:, sel] = lamp_texture_factor(lt, t, cols(p, sel), cols(q, sel), normals)
     return out
 
 
