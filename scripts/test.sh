@@ -28,6 +28,9 @@ if [ -z "${RESTIR_TEST_THREADS:-}" ]; then
   cores=$(getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)
   export RESTIR_TEST_THREADS=$(( cores / ${#versions[@]} > 0 ? cores / ${#versions[@]} : 1 ))
 fi
+# numpy's BLAS likewise (its threads spin while they wait, against the other suite's work; the core's worker
+# processes set theirs to 1 themselves)
+export OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-$RESTIR_TEST_THREADS} OMP_NUM_THREADS=${OMP_NUM_THREADS:-$RESTIR_TEST_THREADS}
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
 pids=()

@@ -228,3 +228,18 @@ def to_local(v: np.ndarray, n: np.ndarray, t: np.ndarray, b: np.ndarray) -> np.n
     out[1] = dot(v, b)
     out[2] = dot(v, n)
     return out
+
+
+def inverse3(m: np.ndarray) -> np.ndarray:
+    """Inverses of (..., 3, 3) matrices by cofactors, float64 (a batched np.linalg.inv calls LAPACK once per matrix
+    and lets BLAS start its threads, which contend with the renderer's own)."""
+    m = np.asarray(m, np.float64)
+    a, b, c = m[..., 0, 0], m[..., 0, 1], m[..., 0, 2]
+    d, e, f = m[..., 1, 0], m[..., 1, 1], m[..., 1, 2]
+    g, h, i = m[..., 2, 0], m[..., 2, 1], m[..., 2, 2]
+    c00, c01, c02 = e * i - f * h, f * g - d * i, d * h - e * g
+    c10, c11, c12 = c * h - b * i, a * i - c * g, b * g - a * h
+    c20, c21, c22 = b * f - c * e, c * d - a * f, a * e - b * d
+    det = a * c00 + b * c01 + c * c02
+    adj = np.stack([np.stack([c00, c10, c20], -1), np.stack([c01, c11, c21], -1), np.stack([c02, c12, c22], -1)], -2)
+    return adj / det[..., None, None]

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...sampling import barycentric, dot, norm
+from ...sampling import barycentric, dot, inverse3, norm
 
 _F = np.float32
 OBJECT_PROPERTY = "object_property:"  # + "KIND:name": RGB (3, n)
@@ -162,7 +162,7 @@ class HitAttributes:
             if inst is None:
                 return nn
             m = objs.world_to_object[inst][:, :, :3]  # normals go with the transposed world matrix: (M⁻¹)⁻ᵀ = Mᵀ
-            lin = np.linalg.inv(m.astype(np.float64)).astype(np.float32)
+            lin = inverse3(m).astype(np.float32)
             out = np.einsum("nji,jn->in", lin, nn)
             return (out / np.maximum(norm(out), _F(1e-30))).astype(np.float32)
         if name in {"object_location", "object_color", "object_alpha", "object_random"}:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...sampling import inverse3
 from .ops_math import f32
 
 _FLIP = np.diag([1.0, 1.0, -1.0])  # Blender's camera frame -> Cycles' camera space
@@ -22,7 +23,7 @@ def _camera_to_world(params) -> np.ndarray:
 
 def _inverse(m: np.ndarray) -> np.ndarray:
     """Inverse of affine (..., 3, 4) matrices."""
-    lin = np.linalg.inv(m[..., :3])
+    lin = inverse3(m[..., :3])
     return np.concatenate([lin, -(lin @ m[..., 3:4])], axis=-1)
 
 
@@ -30,7 +31,7 @@ def _apply(m: np.ndarray, v: np.ndarray, kind: str) -> np.ndarray:
     """(3, n) ``v`` through affine ``m`` ((3, 4), or (n, 3, 4) per column) as a POINT, VECTOR or NORMAL."""
     lin = m[..., :3]
     if kind == "NORMAL":
-        lin = np.swapaxes(np.linalg.inv(lin), -1, -2)
+        lin = np.swapaxes(inverse3(lin), -1, -2)
     if lin.ndim == 2:
         out = lin @ v
         if kind == "POINT":
