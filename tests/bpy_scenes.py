@@ -1223,11 +1223,11 @@ TEXTURED_LAMPS = ("point", "spot", "area", "rotated", "attributes")
 def textured_lamp_scene(kind: str, size=(64, 64)):
     """A white diffuse floor seen from above (orthographic) lit by one lamp whose Emission comes from a node graph
     that varies over it, as artists texture lamps: ``point`` a tiny point lamp whose Color is a Checker of Texture
-    Coordinate Normal (an IES-like pattern) and whose Strength grows along the Normal's X; ``spot`` a spot lamp
+    Coordinate Normal (an IES-like pattern) and whose Strength grows along the Normal's X; ``spot`` a spot lamp of radius 0.15
     projecting a 16 x 16 image of colour ramps and squares through Texture Coordinate UV (a gobo); ``area`` a
     rectangular area lamp whose Color is its UV and whose Strength is a Checker of Object coordinates; ``rotated`` a
-    turned, scaled
-    point lamp whose Color is a Gradient of Normal (object space) and Strength its UV's Y; ``attributes`` a point
+    turned, scaled point lamp of radius 0.15 (a sphere: its Normal is the sphere's at the light point) whose Color is
+    a Gradient of Normal (object space) and Strength its UV's Y; ``attributes`` a point
     lamp whose Color is an Attribute node of Object type (a custom property of the lamp object) times a Checker of
     its Normal, and whose Strength is a View Layer attribute (a custom property of the scene)."""
     import node_graphs as ng
@@ -1239,7 +1239,9 @@ def textured_lamp_scene(kind: str, size=(64, 64)):
     if kind in ("point", "rotated", "attributes"):
         lamp = light("POINT", (0.2, -0.1, 1.0), energy=60.0, shadow_soft_size=0.0)
     elif kind == "spot":
-        lamp = light("SPOT", (0.0, 0.0, 2.0), energy=150.0, shadow_soft_size=0.0, spot_size=1.3, spot_blend=0.1)
+        # a radius: the cone's edge is blurred by where on the sphere the light leaves (Cycles' attenuation of the
+        # direction from the light point, not from the centre)
+        lamp = light("SPOT", (0.0, 0.0, 2.0), energy=150.0, shadow_soft_size=0.15, spot_size=1.3, spot_blend=0.1)
         lamp.rotation_euler = (0.0, 0.15, 0.4)
     else:
         lamp = light("AREA", (0.1, 0.0, 0.8), energy=40.0, shape="RECTANGLE", size=1.2, size_y=0.7)
@@ -1290,6 +1292,7 @@ def textured_lamp_scene(kind: str, size=(64, 64)):
     else:
         lamp.rotation_euler = (0.3, -0.2, 0.7)
         lamp.scale = (1.0, 1.5, 1.0)
+        lamp.data.shadow_soft_size = 0.15  # a sphere: its Normal is the sphere's at the light point
         grad = ng._node(t, "ShaderNodeTexGradient")
         t.links.new(tc.outputs["Normal"], grad.inputs["Vector"])
         ramp = ng._node(t, "ShaderNodeValToRGB")

@@ -151,7 +151,8 @@ def _area(tris: np.ndarray) -> float:
 
 def _texture_record(program, light, inst, m: np.ndarray) -> tuple:
     """What lights/lamp_textures.LampTextures keeps of a textured lamp: (program, kind, world -> object (3, 4),
-    object -> world (3, 3), uv scale (2,), location, colour (4,), random, pass index, sphere normal, the Object /
+    object -> world (3, 3), uv scale (2,), location, colour (4,), random, pass index, sphere normal (a lamp of
+    non-zero Radius: Cycles' point and spot lamps are spheres then, whatever Soft Falloff says), the Object /
     Instancer attribute values its program reads ({key: rgba}, export/object_properties.py))."""
     from ..core.lights import lamp_textures as lt
     from . import object_properties
@@ -171,7 +172,7 @@ def _texture_record(program, light, inst, m: np.ndarray) -> tuple:
         inv = np.linalg.pinv(m)
     keys = {k for k in map(object_properties.key_of, program.reads) if k is not None}
     return (program, kind, inv[:3, :4], m[:3, :3], uv_scale, m[:3, 3], tuple(obj.color), object_random(inst),
-            float(getattr(obj, "pass_index", 0)), not getattr(light, "use_soft_falloff", True),
+            float(getattr(obj, "pass_index", 0)), float(light.shadow_soft_size) > 0,
             object_properties.instance_values(inst, obj, keys))
 
 

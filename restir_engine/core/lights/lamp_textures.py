@@ -6,8 +6,8 @@ The graph's value is a colour factor (scene-linear RGB, unitless) on the lamp's 
 its power, colour and the folded constants of its nodes. What the graph reads at a point q on the lamp seen from a
 receiver p (``wo`` = the unit direction from q to p), as Cycles sets up a lamp's shading point:
 
-- Position q; Incoming wo; Normal / True Normal: wo for point and spot lamps (Soft Falloff on, Blender's default)
-  or the sphere's outward normal at q (Soft Falloff off), the emitting side's normal for area lamps;
+- Position q; Incoming wo; Normal / True Normal: for point and spot lamps the sphere's outward normal at q (a lamp
+  of Radius 0 has none: wo), for area lamps the emitting side's normal;
 - Object and Generated: q in the lamp object's space; Object Normal: the normal in that space;
 - UV (and Parametric): area lamps (x / size_x + 1/2, y / size_y + 1/2) of q in object space; point lamps the
   sphere mapping of the object-space normal (u = (1 - atan2(x, y) / π) / 2, v = 1 - acos(z) / π); spot lamps the
@@ -37,8 +37,8 @@ class LampTextures:
     (n,) int8 (AREA, POINT, SPOT), ``to_local`` (n, 3, 4) float32 world -> lamp object space, ``to_world`` (n, 3,
     3) float32 the object's linear part (object -> world), ``uv_scale`` (n, 2) float32 (area: 1 / size_x, 1 / size_y
     in object space; spot: cot(spot size / 2) / 2, 0), ``location`` (n, 3), ``color`` (n, 4), ``random`` (n,),
-    ``pass_index`` (n,) float32 of the lamp object, ``sphere_normal`` (n,) bool (Soft Falloff off: the normal is
-    the sphere's), ``power_scale`` (n,) float32 the graph's mean luminance factor (for picking lamps by power).
+    ``pass_index`` (n,) float32 of the lamp object, ``sphere_normal`` (n,) bool (a point / spot lamp of non-zero
+    Radius: the normal is the sphere's), ``power_scale`` (n,) float32 the graph's mean luminance factor (for picking lamps by power).
     ``textures``: the material table's images the programs read; ``properties`` the Object / Instancer attributes
     they read, per lamp triangle (as ObjectTable.properties per instance)."""
 

@@ -86,14 +86,15 @@ def program_emission_density(tris: TriangleSet, materials: MaterialTable) -> tup
 
 def spot_factor(lamps: Lamps, lamp_tri: np.ndarray, p: np.ndarray, q: np.ndarray | None = None) -> np.ndarray:
     """Receiver-dependent factor (n,) of lamp triangles' radiance seen from points p ((3, n) rows): the spot cone's
-    attenuation (Cycles' smoothstep blend) times the lamp's Light Falloff, d^k · d² / (s + d²) (the last factor only
-    where s > 0) with d the distance from p to the light point q ((3, n); None: the lamp's centre)."""
+    attenuation (Cycles' smoothstep blend) of the direction from the light point q to p, times the lamp's Light
+    Falloff, d^k · d² / (s + d²) (the last factor only where s > 0) with d the distance from p to q ((3, n); None:
+    the lamp's centre)."""
     cos_cut = lamps.spot_cos[lamp_tri]
     out = np.ones(len(lamp_tri), np.float32)
     spot = np.flatnonzero(cos_cut > -1.5)
-    if spot.size:
+    if spot.size:  # the cone about the direction from the light point (Cycles' spot_light_to_local(-D))
         tri = lamp_tri[spot]
-        d = np.take(p, spot, axis=1) - lamps.spot_center[tri].T
+        d = np.take(p, spot, axis=1) - (lamps.spot_center[tri].T if q is None else np.take(q, spot, axis=1))
         d /= np.maximum(norm(d), 1e-30)
         t = dot(d, lamps.spot_axis[tri].T)
         sm = lamps.spot_smooth[tri]
