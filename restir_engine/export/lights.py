@@ -12,6 +12,8 @@ Colours multiply the power; everything is scene-linear RGB.
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ..core.scene import Lamps, TriangleSet
@@ -149,11 +151,26 @@ def _area(tris: np.ndarray) -> float:
     return float(0.5 * np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1).sum())
 
 
-def _texture_record(program, light, inst, m: np.ndarray) -> tuple:
-    """What lights/lamp_textures.LampTextures keeps of a textured lamp: (program, kind, world -> object (3, 4),
-    object -> world (3, 3), uv scale (2,), location, colour (4,), random, pass index, sphere normal (a lamp of
-    non-zero Radius: Cycles' point and spot lamps are spheres then, whatever Soft Falloff says), the Object /
-    Instancer attribute values its program reads ({key: rgba}, export/object_properties.py))."""
+class _LampRecord(NamedTuple):
+    """What lights/lamp_textures.LampTextures keeps of one lamp (see its fields)."""
+
+    program: object = None
+    kind: int = 0
+    to_local: np.ndarray = np.zeros((3, 4))
+    to_world: np.ndarray = np.eye(3)
+    uv_scale: tuple = (0.0, 0.0)
+    location: np.ndarray = np.zeros(3)
+    color: tuple = (0.0, 0.0, 0.0, 1.0)
+    random: float = 0.0
+    pass_index: float = 0.0
+    sphere_normal: bool = False
+    properties: dict = {}
+
+
+def _texture_record(program, light, inst, m: np.ndarray) -> _LampRecord:
+    """A textured lamp's record: its program, kind, frames, UV scale, Object Info, whether its normal is the
+    sphere's (a lamp of non-zero Radius: Cycles' point and spot lamps are spheres then, whatever Soft Falloff says)
+    and the Object / Instancer attribute values its program reads ({key: rgba}, export/object_properties.py)."""
     from ..core.lights import lamp_textures as lt
     from . import object_properties
     from .meshes import object_random
@@ -171,9 +188,9 @@ def _texture_record(program, light, inst, m: np.ndarray) -> tuple:
     except np.linalg.LinAlgError:
         inv = np.linalg.pinv(m)
     keys = {k for k in map(object_properties.key_of, program.reads) if k is not None}
-    return (program, kind, inv[:3, :4], m[:3, :3], uv_scale, m[:3, 3], tuple(obj.color), object_random(inst),
-            float(getattr(obj, "pass_index", 0)), float(light.shadow_soft_size) > 0,
-            object_properties.instance_values(inst, obj, keys))
+    return _LampRecord(program, kind, inv[:3, :4], m[:3, :3], uv_scale, m[:3, 3], tuple(obj.color),
+                       object_random(inst), float(getattr(obj, "pass_index", 0)), float(light.shadow_soft_size) > 0,
+                       object_properties.instance_values(inst, obj, keys))
 
 
 def _lamp_textures(records: list, counts: list, textures: list):
@@ -181,22 +198,23 @@ def _lamp_textures(records: list, counts: list, textures: list):
     constant lamp) and its triangle count."""
     from ..core.lights.lamp_textures import LampTextures
     from .object_properties import MISSING
-    blank = (None, 0, np.zeros((3, 4)), np.eye(3), (0.0, 0.0), np.zeros(3), (0.0, 0.0, 0.0, 1.0), 0.0, 0.0, False, {})
     programs, index = [], []
     for r in records:
         index.append(-1 if r is None else len(programs))
         if r is not None:
-            programs.append(r[0])
-    full = [blank if r is None else r for r in records]
+            programs.append(r.program)
+    full = [_LampRecord() if r is None else r for r in records]
 
-    def rep(k, dtype):
-        return np.repeat(np.array([r[k] for r in full], dtype), counts, axis=0)
-    keys = sorted({k for r in full for k in r[10]})
-    properties = {k: np.repeat(np.array([r[10].get(k, MISSING) for r in full], np.float32), counts, axis=0)
+    def rep(field, dtype):
+        return np.repeat(np.array([getattr(r, field) for r in full], dtype), counts, axis=0)
+    keys = sorted({k for r in full for k in r.properties})
+    properties = {k: np.repeat(np.array([r.properties.get(k, MISSING) for r in full], np.float32), counts, axis=0)
                   for k in keys}
-    return LampTextures(programs, np.repeat(np.array(index, np.int32), counts), rep(1, np.int8), rep(2, np.float32),
-                        rep(3, np.float32), rep(4, np.float32), rep(5, np.float32), rep(6, np.float32),
-                        rep(7, np.float32), rep(8, np.float32), rep(9, bool), textures=textures, properties=properties)
+    return LampTextures(programs, np.repeat(np.array(index, np.int32), counts), rep("kind", np.int8),
+                        rep("to_local", np.float32), rep("to_world", np.float32), rep("uv_scale", np.float32),
+                        rep("location", np.float32), rep("color", np.float32), rep("random", np.float32),
+                        rep("pass_index", np.float32), rep("sphere_normal", bool), textures=textures,
+                        properties=properties)
 
 
 #: points at which a textured lamp's graph is averaged for its share of the lamps' power

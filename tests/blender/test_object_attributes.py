@@ -203,16 +203,22 @@ def test_an_object_colour_edit_reaches_the_viewports_export(addon):
     assert level == "TRANSFORM" and np.allclose(out.geometry.objects.color[k], (0.2, 0.7, 0.1, 1.0))
 
 
-def test_a_world_reads_view_layer_attributes(addon):
-    """A world whose Background Color is a View Layer attribute: the scene's value over the world's (one constant
-    radiance); before, the node was approximated by its socket's value with a warning."""
-    from restir_engine.export import export_scene
+def _world_reading_view_layer_b():
+    """object_attribute_scene with its world's Background Color the View Layer attribute "b", Strength 2."""
     scene = object_attribute_scene()
     tree = scene.world.node_tree
     att = tree.nodes.new("ShaderNodeAttribute")
     att.attribute_type, att.attribute_name = "VIEW_LAYER", "b"
     tree.links.new(att.outputs["Color"], tree.nodes["Background"].inputs["Color"])
     tree.nodes["Background"].inputs["Strength"].default_value = 2.0
+    return scene
+
+
+def test_a_world_reads_view_layer_attributes(addon):
+    """A world whose Background Color is a View Layer attribute: the scene's value over the world's (one constant
+    radiance); before, the node was approximated by its socket's value with a warning."""
+    from restir_engine.export import export_scene
+    scene = _world_reading_view_layer_b()
     sc = export_scene(bpy.context.evaluated_depsgraph_get())
     assert np.allclose(sc.world_radiance, 0.9) and not [w for w in sc.warnings if "Attribute" in w]
 
@@ -225,12 +231,7 @@ def test_a_scene_property_edit_reaches_the_viewports_graphs(addon):
 
     from restir_engine.export import export_scene
     from restir_engine.export.incremental import SceneExporter, reads_view_layer, update_level
-    scene = object_attribute_scene()
-    tree = scene.world.node_tree
-    att = tree.nodes.new("ShaderNodeAttribute")
-    att.attribute_type, att.attribute_name = "VIEW_LAYER", "b"
-    tree.links.new(att.outputs["Color"], tree.nodes["Background"].inputs["Color"])
-    tree.nodes["Background"].inputs["Strength"].default_value = 2.0
+    scene = _world_reading_view_layer_b()
     dg = bpy.context.evaluated_depsgraph_get()
     exporter = SceneExporter()
     cam = export_scene(dg).camera

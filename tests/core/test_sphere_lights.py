@@ -129,7 +129,7 @@ def test_light_falloff_scales_a_lamp_by_its_distance_to_the_receiver():
     """A Light Falloff output multiplies a lamp's radiance by d^k (k 1 Linear, 2 Constant) and, with Smooth s,
     by d² / (s + d²), d from the receiver to the light point (the lamp's centre when none is given); spot cones and
     falloffs multiply; a lamp without one reads 1, also when a scene built its Lamps without falloff arrays."""
-    from restir_engine.core.lights.table import spot_factor
+    from restir_engine.core.lights.receiver import spot_factor
     lamps = floor_under_sphere().lamps
     n = len(lamps.spot_cos)
     tri = np.zeros(4, np.int64)

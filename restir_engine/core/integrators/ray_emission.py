@@ -7,7 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..lights.table import emitted_radiance, receiver_factor
+from ..lights.receiver import receiver_factor
+from ..lights.table import emitted_radiance
 from ..materials.glass import DELTA_PDF
 from ..sampling import cols, dot, norm
 from .trace_context import TraceContext

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..lights.table import receiver_factor
+from ..lights.receiver import receiver_factor
 from ..lights.tiles import PackedPoints, light_points
 from ..materials.anisotropy import AnisoWorld
 from ..materials.bsdf import view_terms
@@ -343,7 +343,7 @@ class ShadingTerms:
 
 def with_spots(pts: PackedPoints, spot_tri: np.ndarray, lamps, receivers: np.ndarray) -> PackedPoints:
     """``pts`` with the receiver-dependent factor of lamp triangles ``spot_tri`` (same shape as the points, -1 =
-    none: lights/table.receiver_factor, a spot cone, a Light Falloff, a node texture) towards ``receivers`` ((3, n), broadcasting
+    none: lights/receiver.receiver_factor, a spot cone, a Light Falloff, a node texture) towards ``receivers`` ((3, n), broadcasting
     like the points) applied to the radiance."""
     spot = np.nonzero(spot_tri >= 0)
     if spot[0].size == 0:
