@@ -1401,3 +1401,42 @@ def ies_lamp_scene(kind: str, size=(64, 64)):
     node.ies = text
     t.links.new(node.outputs["Fac"], em.inputs["Strength"])
     return scene
+
+
+def sky_scene(model="MULTIPLE_SCATTERING", size=(128, 64), view="SEEN", **settings):
+    """The world a Sky Texture of ``model`` with the node's ``settings`` (Sun Elevation / Rotation in radians as
+    the node holds them); ``view`` "SEEN": an equirectangular camera over the whole sphere and nothing else, each
+    pixel the sky in its direction; "HORIZON": 7° across the horizon towards +Y; "DISC": 2° about the sun (of Sun
+    Rotation 0); "LIT": spheres (diffuse, rough Principled, metal) on a grey floor lit by it."""
+    scene = reset()
+    world = bpy.data.worlds.new("Sky")
+    enable_nodes(world)
+    tree = world.node_tree
+    node = tree.nodes.new("ShaderNodeTexSky")
+    node.sky_type = model
+    for k, v in settings.items():
+        setattr(node, k, v)
+    tree.links.new(node.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    scene.world = world
+    if view == "HORIZON":  # a narrow view towards +Y (where a Sun Rotation of 0 puts the sun) across the horizon
+        camera((0, 0, 0), (math.radians(90), 0, 0), lens=300)
+    elif view == "DISC":  # a 2° view of the sun's disc (Sun Rotation 0 puts it towards +Y)
+        camera((0, 0, 0), (math.radians(90) + settings.get("sun_elevation", math.radians(15)), 0, 0), lens=1000)
+    elif view == "SEEN":
+        camera((0, 0, 0), (math.radians(90), 0, 0))
+        cam = scene.camera.data
+        cam.type = "PANO"
+        cam.panorama_type = "EQUIRECTANGULAR"
+        cam.latitude_min, cam.latitude_max = math.radians(-90), math.radians(90)
+        cam.longitude_min, cam.longitude_max = math.radians(-180), math.radians(180)
+    else:
+        plane("Floor", 20, (0, 0, 0), material=diffuse("Floor", (0.5, 0.5, 0.5)))
+        for x, mat in ((-1.2, diffuse("D", (0.8, 0.3, 0.2))),
+                       (0.0, principled("P", (0.3, 0.6, 0.8), roughness=0.4)),
+                       (1.2, principled("M", (0.9, 0.8, 0.6), roughness=0.3, metallic=1.0))):
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=0.5, location=(x, 0, 0.5), segments=32, ring_count=16)
+            bpy.ops.object.shade_smooth()
+            bpy.context.active_object.data.materials.append(mat)
+        camera((0, -4.5, 1.6), (math.radians(75), 0, 0), lens=35)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

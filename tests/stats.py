@@ -29,6 +29,14 @@ def welch_se(a: np.ndarray, b: np.ndarray, axis: int = 0) -> np.ndarray:
     return np.sqrt(a.var(axis=axis, ddof=1) / a.shape[axis] + b.var(axis=axis, ddof=1) / b.shape[axis])
 
 
+def pattern_agrees(ours: np.ndarray, ref: np.ndarray, float_tol: float = 1e-3) -> np.ndarray:
+    """Per cell (bool): |mean ours - mean ref| <= Z_MAX SE + MARGIN |ref| + ``float_tol`` for two sets of
+    repetitions (k, cells) of a noiseless pattern (what differs between seeds is where each pixel's samples fall):
+    the absolute term absorbs float32 differences in black cells."""
+    ma, mb = ours.mean(axis=0), ref.mean(axis=0)
+    return np.abs(ma - mb) <= Z_MAX * welch_se(ours, ref) + MARGIN * np.abs(mb) + float_tol
+
+
 def robust_var(x: np.ndarray) -> float:
     """The variance of normal data with the spread of ``x`` (1.4826 x its median absolute deviation, squared)."""
     return float((1.4826 * np.median(np.abs(x - np.median(x)))) ** 2)

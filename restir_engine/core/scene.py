@@ -418,7 +418,8 @@ class Scene:
     warnings: list = field(default_factory=list)
     world_image: np.ndarray | None = None     # (h, w, 3) equirectangular radiance (then world_radiance is unused)
     world_rotation: np.ndarray | None = None  # (3, 3) world -> environment texture frame (core/lights/world.py)
-    world_camera_view: tuple | None = None    # (radiance (3,), image or None) camera rays see instead, or None
+    world_camera_view: tuple | None = None    # (radiance (3,), image or None, graph or None) camera rays see instead
+    world_graph: object = None                # lights.world.WorldGraph: world_image's exact source, or None
     motion: Motion | None = None
     blur: object = None  # geometry.motion_blur.ShutterMotion: where things are during the shutter (None: no motion blur)
     light_groups: object = None  # lights.groups.LightGroups: the view layer's light groups (None: none)

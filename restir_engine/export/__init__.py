@@ -77,7 +77,8 @@ def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warn
     ``registry``) around ``geometry``."""
     groups = group_index(depsgraph)
     lamps = export_lamps(depsgraph, registry, warnings, groups)
-    world, world_image, world_rotation, camera_view = export_world(depsgraph.scene, warnings, registry.view_layer)
+    world, world_image, world_rotation, camera_view, world_graph = export_world(depsgraph.scene, warnings,
+                                                                                registry.view_layer)
     world = clamped_radiance(world, "World", warnings).astype(np.float32)
     if world_image is not None:
         world_image = clamped_radiance(world_image, "World texture", warnings).astype(np.float32)
@@ -86,4 +87,4 @@ def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warn
         lamps.textured.textures = materials.textures
     return Scene(geometry=geometry, materials=materials, lamps=lamps, camera=camera,
                  world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings,
-                 world_camera_view=camera_view, light_groups=export_light_groups(depsgraph, geometry, groups))
+                 world_camera_view=camera_view, world_graph=world_graph, light_groups=export_light_groups(depsgraph, geometry, groups))

@@ -9,7 +9,7 @@ import numpy as np
 from . import object_properties
 from .derived_attributes import POINTINESS, RANDOM_PER_ISLAND
 from .node_graph import Reg
-from .node_space_handlers import camera_data, ies_texture, normal, vector_transform
+from .node_space_handlers import camera_data, ies_texture, normal, sky_texture, vector_transform
 
 #: samples of a Color Ramp or curve table (Cycles' 257 entries over [0, 1])
 TABLE_SIZE = 257
@@ -494,5 +494,5 @@ HANDLERS = {
     "NORMAL_MAP": _normal_map, "BUMP": _bump, "TEX_VORONOI": _voronoi, "TEX_WAVE": _wave, "TEX_MAGIC": _magic,
     "TEX_BRICK": _brick, "BLACKBODY": _blackbody, "WAVELENGTH": _wavelength, "LIGHT_FALLOFF": _light_falloff,
     "AMBIENT_OCCLUSION": _ambient_occlusion, "BEVEL": _bevel, "WIREFRAME": _wireframe, "TEX_IES": ies_texture,
-    "TEX_GABOR": _gabor,
+    "TEX_GABOR": _gabor, "TEX_SKY": sky_texture,
 }

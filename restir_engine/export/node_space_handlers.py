@@ -1,11 +1,11 @@
-"""Shader-node handlers for the view, space and light-profile nodes: Camera Data, Vector Transform, Normal and IES
-Texture (each returns its outputs as registers of the graph compiler, export/node_graph.py; the vector operations are
+"""Shader-node handlers for the view, space, light-profile and sky nodes: Camera Data, Vector Transform, Normal, IES
+Texture and Sky Texture (each returns its outputs as registers of the graph compiler, export/node_graph.py; the vector operations are
 core/materials/nodes/)."""
 from __future__ import annotations
 
 import numpy as np
 
-from ..core.lights import ies
+from ..core.lights import ies, sky
 
 
 def camera_data(g, node, f):
@@ -79,3 +79,22 @@ def ies_texture(g, node, f):
                      [g.attribute("incoming", "vector")], ("vector",))[0]
     strength = g.inp(node, "Strength", "float", f)
     return {"Fac": g.emit("ies_texture", {"table": table}, [vec, strength], ("float",))[0]}
+
+
+def sky_texture(g, node, f):
+    """Sky Texture: the sky's radiance towards its Vector (unlinked: Generated, in a world the direction), each of
+    its four models as Cycles computes it (core/lights/sky.py)."""
+    kind = node.sky_type
+    sun = tuple(float(x) for x in node.sun_direction)
+    if kind == "PREETHAM":
+        model = sky.preetham_sky(sun, float(node.turbidity))
+    elif kind == "HOSEK_WILKIE":
+        model = sky.hosek_sky(sun, float(node.turbidity), float(node.ground_albedo))
+    else:
+        model = sky.atmosphere_sky(kind, bool(node.sun_disc), float(node.sun_size), float(node.sun_intensity),
+                                   float(node.sun_elevation), float(node.sun_rotation), float(node.altitude),
+                                   float(node.air_density), float(node.aerosol_density),
+                                   float(getattr(node, "ozone_density", 1.0)))
+    plain = not node.inputs["Vector"].is_linked
+    vec = g.inp(node, "Vector", "vector", f, default="generated")
+    return {"Color": g.emit("sky_texture", {"sky": model, "plain": plain}, [vec], ("color",))[0]}

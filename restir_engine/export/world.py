@@ -4,13 +4,16 @@ Supported: Background (Color x Strength). A plain equirectangular Environment Te
 through a Mapping node's rotation) is used as its image; any other graph of the Color and Strength (constants
 folded, or textures, gradients, mixes and maths of the direction: core/materials/nodes) is evaluated over the
 directions of an equirectangular image (BAKE_WIDTH x BAKE_WIDTH/2, or an environment texture's own resolution
-up to MAX_BAKE_WIDTH), which the world light then samples. Nodes the evaluator does not know are named.
+up to MAX_BAKE_WIDTH), which the world light samples, while the graph itself gives the radiance of each direction
+(core/lights/world.WorldGraph); the sun discs of Sky Textures read along the direction are left out of the image
+and sampled over their cones instead. Nodes the evaluator does not know are named.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..compat import uses_nodes
+from ..core.lights.world import WorldGraph
 from ..core.materials.nodes.ops_texture import euler_matrix
 from ..core.materials.textures import linear_texels
 from .materials import MaterialRegistry
@@ -23,10 +26,11 @@ _BAKE_CHUNK = 1 << 18
 
 def export_world(scene, warnings: list, view_layer=None):
     """(constant radiance (3,), image (h, w, 3) radiance or None, rotation world -> texture (3, 3) or None, what
-    camera rays see instead: (radiance, image) or None). ``view_layer``: where View Layer attributes are looked up
-    (object_properties.view_layer_places; None: not read)."""
+    camera rays see instead: (radiance, image, graph) or None, the WorldGraph the image was baked from or None).
+    ``view_layer``: where View Layer attributes are looked up (object_properties.view_layer_places; None: not
+    read)."""
     got = _export_world(scene, warnings, view_layer)
-    return got if len(got) == 4 else (*got, None)
+    return got + (None,) * (5 - len(got))
 
 
 def _export_world(scene, warnings: list, view_layer=None):
@@ -72,8 +76,26 @@ def _baked(world, registry, color_in, strength_in, warnings: list, view_layer=No
     program = g.program({"color": color, "strength": strength})
     camera_view = None
     if "is_camera_ray" in program.reads:  # Light Path > Is Camera Ray: what the camera sees, baked apart
-        camera_view = (np.zeros(3, np.float32), _bake(program, color, strength, registry, True))
-    return (np.zeros(3, np.float32), _bake(program, color, strength, registry, False), None, camera_view)
+        camera_view = (np.zeros(3, np.float32), _bake(program, color, strength, registry, True),
+                       _graph(program, color, strength, registry, True))
+    return (np.zeros(3, np.float32), _bake(program, color, strength, registry, False), None, camera_view,
+            _graph(program, color, strength, registry, False))
+
+
+def _graph(program, color, strength, registry, camera_ray: bool) -> WorldGraph:
+    return WorldGraph(program, registry.textures, camera_ray, None if color.const is None else color.const,
+                      None if strength.const is None else strength.const, tuple(_sun_cones(program)))
+
+
+def _sun_cones(program) -> list:
+    """(unit direction (3,), half-angle) of each sun disc of a Sky Texture the program reads along the direction."""
+    cones = []
+    for name, _outs, _ins, params in program.ops:
+        if name == "sky_texture" and params.get("plain"):
+            cone = params["sky"].sun_cone()
+            if cone is not None:
+                cones.append(cone)
+    return cones
 
 
 def _bake(program, color, strength, registry, camera_ray: bool) -> np.ndarray:
@@ -89,7 +111,7 @@ def _bake(program, color, strength, registry, camera_ray: bool) -> np.ndarray:
     image = np.empty((h * w, 3), np.float32)
     for lo in range(0, h * w, _BAKE_CHUNK):
         hi = min(lo + _BAKE_CHUNK, h * w)
-        out = program.run(DirectionAttributes(dirs[:, lo:hi], registry.textures, camera_ray))
+        out = program.run(DirectionAttributes(dirs[:, lo:hi], registry.textures, camera_ray, without_sun=True))
         c = out["color"] if "color" in out else np.asarray(color.const, np.float32).reshape(3, 1)
         s = out["strength"] if "strength" in out else np.float32(strength.const)
         image[lo:hi] = np.broadcast_to(c * s, (3, hi - lo)).T

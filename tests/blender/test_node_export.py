@@ -41,13 +41,13 @@ def test_varying_graph_becomes_a_program_and_unsupported_nodes_are_named(addon):
     def wire(tree, bsdf):
         n = _node(tree, "ShaderNodeTexNoise")
         tree.links.new(n.outputs["Fac"], bsdf.inputs["Roughness"])
-        v = _node(tree, "ShaderNodeTexSky")
-        tree.links.new(v.outputs["Color"], bsdf.inputs["Base Color"])
+        v = _node(tree, "ShaderNodeHairInfo")
+        tree.links.new(v.outputs["Tangent Normal"], bsdf.inputs["Base Color"])
     sc, _ = _principled_plane(wire)
     i = sc.materials.names.index("Wired")
     prog = sc.materials.programs[sc.materials.program[i]]
-    assert set(prog.outputs) == {"roughness"}  # the Sky Texture is not supported on a surface: a constant, reported
-    assert any("Sky Texture" in w and "not supported" in w for w in sc.warnings), sc.warnings
+    assert set(prog.outputs) == {"roughness"}  # Curves Info is not supported on a mesh: a constant, reported
+    assert any("HAIR_INFO" in w and "not supported" in w for w in sc.warnings), sc.warnings
 
 
 def test_node_programs_render_the_same_in_worker_processes(addon):
@@ -274,3 +274,27 @@ def test_principled_inputs_not_rendered_are_named(addon):
     assert any("Thin Film" in w for w in named), sc.warnings
     assert any("Thin Wall" in w for w in named) or "Thin Wall" not in bpy.data.materials["Wired"].node_tree.nodes[
         "Principled BSDF"].inputs
+
+
+def test_sky_worlds_render_the_same_in_worker_processes_and_warn_of_nothing(addon):
+    """A Sky Texture world (its radiance table, sun disc and the world's sun cone) travels to the workers with the
+    scene: the same image, bit for bit, with ReSTIR DI holding the world's samples; the Sky Texture is not named as
+    unsupported (every model is rendered)."""
+    from bpy_scenes import sky_scene
+
+    from process_runs import one_and_two_processes
+
+    from restir_engine.core.renderer import RenderSettings
+    for model in ("MULTIPLE_SCATTERING", "SINGLE_SCATTERING", "PREETHAM", "HOSEK_WILKIE"):
+        sky_scene(model, (32, 16), "LIT")
+        sc = export_scene(bpy.context.evaluated_depsgraph_get())
+        assert not [w for w in sc.warnings if "Sky" in w], sc.warnings
+    settings = RenderSettings(integrator="RESTIR", direct_method="RESTIR", world_method="RESAMPLED", samples=2,
+                              max_bounces=1, tile_pixels=256)
+    sky_scene("MULTIPLE_SCATTERING", (32, 24), "LIT", sun_elevation=0.4)
+    sc = export_scene(bpy.context.evaluated_depsgraph_get())
+    assert sc.world_graph is not None and len(sc.world_graph.suns) == 1
+    one, two = one_and_two_processes(sc, settings)
+    assert two.stats["processes"] == 2
+    assert one.passes["Combined"][..., :3].mean() > 0.05
+    assert np.array_equal(one.passes["Combined"], two.passes["Combined"])

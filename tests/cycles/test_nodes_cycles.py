@@ -16,7 +16,7 @@ import pytest
 from bpy_scenes import node_planes
 from cycles_compare import cycles_reference, ours_cells
 from node_graphs import FAMILIES
-from stats import Z_MAX, MARGIN, POWER_ERROR
+from stats import pattern_agrees, Z_MAX, MARGIN, POWER_ERROR
 
 COLS, PX, CELL = 8, 16, 4
 REPS, SAMPLES = 4, 16
@@ -47,9 +47,7 @@ def plane_cells(n_planes):
 
 
 def within(ours, ref):
-    ma, mb = ours.mean(axis=0), ref.mean(axis=0)
-    se = np.sqrt(ours.var(axis=0, ddof=1) / len(ours) + ref.var(axis=0, ddof=1) / len(ref))
-    return np.abs(ma - mb) <= Z_MAX * se + MARGIN * np.abs(mb) + FLOAT_TOL
+    return pattern_agrees(ours, ref, FLOAT_TOL)
 
 
 @pytest.mark.parametrize("family", sorted(FAMILIES))

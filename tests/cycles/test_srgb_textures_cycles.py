@@ -12,7 +12,7 @@ over the plane than Cycles and fails the edges' cells.
 import numpy as np
 from bpy_scenes import SRGB_READS, srgb_texture_planes
 from cycles_compare import cycles_reference, ours_cells
-from stats import MARGIN, POWER_ERROR, Z_MAX
+from stats import pattern_agrees, MARGIN, POWER_ERROR, Z_MAX
 
 PX, CELL, COLS = 32, 4, 3
 REPS, SAMPLES = 4, 16
@@ -33,9 +33,7 @@ def planes(images):
 
 
 def within(ours, ref):
-    ma, mb = ours.mean(axis=0), ref.mean(axis=0)
-    se = np.sqrt(ours.var(axis=0, ddof=1) / len(ours) + ref.var(axis=0, ddof=1) / len(ref))
-    return np.abs(ma - mb) <= Z_MAX * se + MARGIN * np.abs(mb) + FLOAT_TOL
+    return pattern_agrees(ours, ref, FLOAT_TOL)
 
 
 def test_srgb_image_textures_match_cycles(addon):

@@ -55,7 +55,7 @@ def fingerprint(*parts) -> bytes:
 def rest_key(scene) -> bytes:
     """What the context depends on besides the triangles: materials, lamps, the world."""
     return fingerprint(scene.materials, scene.lamps, scene.world_radiance, getattr(scene, "world_image", None),
-                       getattr(scene, "world_rotation", None))
+                       getattr(scene, "world_rotation", None), (getattr(scene, "world_camera_view", None) or ())[:2])
 
 
 def context_for(scene, max_bounces: int, film_transparent: bool, build):

@@ -136,7 +136,7 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
     geom_accel = accels["geom"].with_cutout(cut, geom_ng_rows if cut else None) if "geom" in accels else \
         Accel(geom.verts, cut, geom_ng_rows if cut else None)
     world = World(scene.world_radiance, getattr(scene, "world_image", None), getattr(scene, "world_rotation", None),
-                  getattr(scene, "world_camera_view", None))
+                  getattr(scene, "world_camera_view", None), getattr(scene, "world_graph", None))
     lights = scene_lights(scene, derived.bounds, world)
     return TraceContext(scene=scene, geom_accel=geom_accel,
                         lamp_accel=accels["lamp"] if "lamp" in accels else Accel(lamps.tris.verts),

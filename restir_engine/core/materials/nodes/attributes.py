@@ -223,12 +223,15 @@ class HitAttributes:
 class DirectionAttributes:
     """The attributes a world's node program reads for directions ``dirs`` (3, n) (unit, world space, pointing away
     from the scene), as Cycles gives a world shader: the direction as position and texture coordinates
-    (Generated, Object), the opposite one as the normal and the incoming view; no surface (UV 0, not backfacing)."""
+    (Generated, Object), the opposite one as the normal and the incoming view; no surface (UV 0, not backfacing).
+    ``without_sun``: Sky Textures leave their sun discs out (the world's image for sampling; lights/world.py samples
+    the discs apart)."""
 
-    def __init__(self, dirs, textures, camera_ray: bool = False):
+    def __init__(self, dirs, textures, camera_ray: bool = False, without_sun: bool = False):
         self.dirs = np.ascontiguousarray(dirs, np.float32)
         self.textures = textures
         self.camera_ray = camera_ray
+        self.without_sun = without_sun
 
     def __len__(self) -> int:
         return self.dirs.shape[1]

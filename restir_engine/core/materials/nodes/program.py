@@ -13,12 +13,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import gabor, ops_ies, ops_layers, ops_math, ops_normals, ops_patterns, ops_spaces, ops_texture
+from . import gabor, ops_ies, ops_layers, ops_math, ops_normals, ops_patterns, ops_sky, ops_spaces, ops_texture
 
 #: every operation an instruction may name
 OPERATIONS = {**ops_math.OPERATIONS, **ops_texture.OPERATIONS, **ops_patterns.OPERATIONS,
               **ops_normals.OPERATIONS, **ops_layers.OPERATIONS, **ops_spaces.OPERATIONS, **ops_ies.OPERATIONS,
-              **gabor.OPERATIONS}
+              **gabor.OPERATIONS, **ops_sky.OPERATIONS}
 #: operations that read the hits (never folded into constants)
 READS_HITS = ops_texture.READS_HITS | ops_normals.READS_HITS | ops_layers.READS_HITS | ops_spaces.READS_HITS
 
