@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..parallel.pool import run_chunks
+
 EARTH_RADIUS = 6371.0
 ATMOSPHERE_THICKNESS = 100.0
 ATMOSPHERE_RADIUS = EARTH_RADIUS + ATMOSPHERE_THICKNESS
@@ -175,7 +177,8 @@ def sky_table(sun_elevation: float, altitude_m: float, air: float, aerosol: floa
     lv = 2 * (rows.ravel() + 0.5) / TABLE_HEIGHT - 1
     elevation = np.copysign(lv * lv, lv) * (np.pi / 2)
     dirs = np.stack([np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)], 1)
-    left = atmosphere.sky(float(sun_elevation), altitude_km(altitude_m), dirs).reshape(TABLE_HEIGHT, half, 3)
+    left = in_parts(lambda part: atmosphere.sky(float(sun_elevation), altitude_km(altitude_m), part),
+                    dirs).reshape(TABLE_HEIGHT, half, 3)
     return np.ascontiguousarray(np.concatenate([left, left[:, ::-1]], axis=1), np.float32)
 
 
@@ -188,6 +191,17 @@ def sun_colors(sun_elevation: float, sun_size: float, altitude_m: float, air: fl
     atmosphere = Atmosphere(air, aerosol, ozone)
     return atmosphere.sun(np.array([sun_elevation - half, sun_elevation + half]), altitude_km(altitude_m),
                           solid_angle).astype(np.float32)
+
+
+def in_parts(fn, dirs: np.ndarray, parts: int = 8) -> np.ndarray:
+    """``fn(dirs)`` (n, 3) computed over ``parts`` slices of ``dirs`` (n, 3) on the thread pool."""
+    out = np.empty((len(dirs), 3))
+    step = -(-len(dirs) // parts)
+
+    def part(span):
+        out[span] = fn(dirs[span])
+    run_chunks(part, [slice(a, min(len(dirs), a + step)) for a in range(0, len(dirs), step)])
+    return out
 
 
 def _leave_sphere(b: np.ndarray, r2: np.ndarray, radius: float) -> np.ndarray:

@@ -22,7 +22,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .sky_atmosphere import TABLE_HEIGHT, TABLE_WIDTH
+from .sky_atmosphere import TABLE_HEIGHT, TABLE_WIDTH, in_parts
 
 EARTH_RADIUS = 6360e3
 ATMOSPHERE_RADIUS = 6420e3
@@ -127,7 +127,8 @@ def sky_table(sun_elevation: float, altitude_m: float, air: float, aerosol: floa
     la, lo = np.meshgrid(lat[half_h:], lon, indexing="ij")
     dirs = np.stack([np.cos(la) * np.cos(lo), np.cos(la) * np.sin(lo), np.sin(la)], axis=-1).reshape(-1, 3)
     scale = np.array([air, aerosol, ozone], np.float64)
-    upper = (_scattered(dirs, sun, _altitude(altitude_m), scale) @ cmf).reshape(h - half_h, half_w, 3)
+    upper = in_parts(lambda part: _scattered(part, sun, _altitude(altitude_m), scale) @ cmf,
+                     dirs).reshape(h - half_h, half_w, 3)
     table = np.empty((h, w, 3))
     table[half_h:, :half_w] = upper
     table[half_h:, half_w:] = upper[:, ::-1]
