@@ -99,7 +99,7 @@ class SceneExporter:
             done = "FULL"
         elif level in ("NONE", "SETTINGS"):  # a copy: the worker may be rendering the last one
             out = dataclasses.replace(self.last, camera=camera)
-            out.export_stats = self.last.export_stats
+            out.export_stats = dict(self.last.export_stats, meshes_read=0)
         elif level == "SHADING":
             out = self._shading(depsgraph, camera)
             if out is None:
@@ -133,7 +133,7 @@ class SceneExporter:
         if registry.index != stats["material_index"]:  # a mix gained or lost a component: rows moved
             return None
         out = export_shading(depsgraph, registry, last.geometry, camera, warnings)
-        out.export_stats = dict(stats, material_index=dict(registry.index),
+        out.export_stats = dict(stats, material_index=dict(registry.index), meshes_read=0,
                                 reads_view_layer=getattr(registry.view_layer, "read", False))
         if _needs(out) != stats["material_needs"]:
             return None

@@ -239,7 +239,7 @@ def test_edits_export_only_what_changed(addon):
         bsdf = bpy.data.materials["Wall"].node_tree.nodes["Principled BSDF"]
         level, shaded = edit(lambda: setattr(bsdf.inputs["Base Color"], "default_value", (0.9, 0.1, 0.1, 1.0)))
         assert level == "SHADING" and exporter.last_level == "SHADING"
-        assert shaded.geometry is first.geometry  # no geometry export
+        assert shaded.geometry is first.geometry and shaded.export_stats["meshes_read"] == 0  # no geometry export
         red = mean_rgb(shaded)
         assert red[0] / red[1] > 1.5 * base[0] / base[1]
         assert FrameRenderer(shaded, settings).ctx.geom_accel._scene is ctx0.geom_accel._scene  # Embree kept
