@@ -87,4 +87,5 @@ def export_shading(depsgraph, registry: MaterialRegistry, geometry, camera, warn
         lamps.textured.textures = materials.textures
     return Scene(geometry=geometry, materials=materials, lamps=lamps, camera=camera,
                  world_radiance=world, world_image=world_image, world_rotation=world_rotation, warnings=warnings,
-                 world_camera_view=camera_view, world_graph=world_graph, light_groups=export_light_groups(depsgraph, geometry, groups))
+                 world_camera_view=camera_view, world_graph=world_graph,
+                 light_groups=export_light_groups(depsgraph, geometry, groups))

@@ -1,6 +1,6 @@
 """Shader-node handlers for the view, space, light-profile and sky nodes: Camera Data, Vector Transform, Normal, IES
-Texture and Sky Texture (each returns its outputs as registers of the graph compiler, export/node_graph.py; the vector operations are
-core/materials/nodes/)."""
+Texture and Sky Texture (each returns its outputs as registers of the graph compiler, export/node_graph.py; the
+vector operations are core/materials/nodes/)."""
 from __future__ import annotations
 
 import numpy as np

@@ -7,8 +7,8 @@ straight down). ``rotation`` maps world directions into the texture's frame (a M
 ``camera_view`` (colour, image[, graph]): what camera rays see where that differs from the light (a world graph
 reading Light Path > Is Camera Ray). ``graph`` (a :class:`WorldGraph`): the node program the image was baked from,
 evaluated exactly for the radiance of a direction (camera rays, BSDF rays that miss, sampled directions) while the
-image gives the sampling density: unbiased wherever the image is non-zero around a direction the graph lights
-(export/world.py bakes texels that hold a sky's sun disc finely enough for that).
+image gives the sampling density (unbiased: the image is non-zero wherever the graph's sky is); a Sky Texture's sun
+discs, left out of the image, are sampled uniformly over their cones in a mixture with it, each by its power's share.
 Sampling an image picks a texel with probability ∝ its luminance times sin θ (one cumulative table over the texels),
 then a uniform point in it: pdf_ω = p(texel) · w h / (2π² sin θ), θ the direction's own polar angle. The luminance is taken
 as the largest of each texel and its 8 neighbours, so bilinear lookups never light a direction of pdf 0. A constant
