@@ -143,6 +143,8 @@ def one(args) -> dict:
         wall = time.perf_counter() - t
         hist = r.history
         rows.append({"frame_s": wall, "stages": {k: v["wall"] for k, v in clock.stages.items()},
+                     "stages_cpu": {k: v["cpu"] for k, v in clock.stages.items()},
+                     "stage_calls": {k: v["calls"] for k, v in clock.stages.items()},
                      "build_s": r.stats.get("build_seconds")})
         digest = hashlib.sha1(np.ascontiguousarray(r.passes["Combined"]).tobytes()).hexdigest()[:16]
     steady = rows[1:] if len(rows) > 1 else rows
@@ -151,7 +153,8 @@ def one(args) -> dict:
     if team is not None:
         processes.shutdown()
     return {"cores": cores, "mode": args.mode, "frame_s": med["frame_s"], "frames_s": [r["frame_s"] for r in rows],
-            "stages": med["stages"], "first_frame_s": rows[0]["frame_s"], "team_start_s": start,
+            "stages": med["stages"], "stages_cpu": med["stages_cpu"], "stage_calls": med["stage_calls"],
+            "first_frame_s": rows[0]["frame_s"], "team_start_s": start,
             "checksum": digest, "method": r.stats.get("direct_method"), "indirect": r.stats.get("indirect_method")}
 
 

@@ -167,7 +167,10 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         stats = out["stats"]
         stats["processes"] = team.size
         stats["passes_one_per_process"] = at_once  # rendered whole by one worker each, at the same time
-        if clock is not None and "stages" in stats:
-            clock.stages.update(stats["stages"])
+        if clock is not None and "stages" in stats:  # the leader's stages, added to the frame's other bands'
+            for name, rec in stats["stages"].items():
+                mine = clock.stages.setdefault(name, {k: 0 for k in rec})
+                for k, v in rec.items():
+                    mine[k] = mine.get(k, 0) + v
         hist = SharedHistory(team.id, token, _view_size(cam)) if out["history"] else None
         return FrameResult(passes, done, time.perf_counter() - t0, cancelled, stats, hist)
