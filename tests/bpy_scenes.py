@@ -1440,3 +1440,50 @@ def sky_scene(model="MULTIPLE_SCATTERING", size=(128, 64), view="SEEN", **settin
         camera((0, -4.5, 1.6), (math.radians(75), 0, 0), lens=35)
     scene.render.resolution_x, scene.render.resolution_y = size
     return scene
+
+
+def _path_coloured(name, rgb_of):
+    """A diffuse Principled BSDF whose Base Color is Combine Color of three Light Path terms: ``rgb_of`` maps
+    "R", "G", "B" to (output name, scale, offset), each channel offset + scale x that output."""
+    m = principled(name, (0.5, 0.5, 0.5), roughness=1.0)
+    tree = m.node_tree
+    lp = tree.nodes.new("ShaderNodeLightPath")
+    comb = tree.nodes.new("ShaderNodeCombineColor")
+    for channel, (output, scale, offset) in rgb_of.items():
+        ma = tree.nodes.new("ShaderNodeMath")
+        ma.operation = "MULTIPLY_ADD"
+        tree.links.new(lp.outputs[output], ma.inputs[0])
+        ma.inputs[1].default_value = scale
+        ma.inputs[2].default_value = offset
+        tree.links.new(ma.outputs[0], comb.inputs[{"R": "Red", "G": "Green", "B": "Blue"}[channel]])
+    tree.links.new(comb.outputs["Color"], tree.nodes["Principled BSDF"].inputs["Base Color"])
+    return m
+
+
+def light_path_types_scene(size=(96, 64)):
+    """Surfaces coloured by the ray that reaches them (Light Path's ray types and depths), seen directly, in a
+    mirror, a rough metal and a glass sphere and by diffuse bounces: the floor red by Is Glossy Ray, green by Ray
+    Depth, blue by Is Transmission Ray; the back wall red by Diffuse Depth, green by Glossy Depth, blue by Is
+    Singular Ray; a side wall red by Is Reflection Ray, green by Transmission Depth, blue by Is Diffuse Ray; under
+    an area light."""
+    scene = reset()
+    floor = _path_coloured("PathFloor", {"R": ("Is Glossy Ray", 0.6, 0.2), "G": ("Ray Depth", -0.2, 0.7),
+                                         "B": ("Is Transmission Ray", 0.6, 0.2)})
+    wall = _path_coloured("PathWall", {"R": ("Diffuse Depth", 0.3, 0.2), "G": ("Glossy Depth", 0.3, 0.2),
+                                       "B": ("Is Singular Ray", 0.6, 0.2)})
+    side = _path_coloured("PathSide", {"R": ("Is Reflection Ray", 0.5, 0.3), "G": ("Transmission Depth", 0.2, 0.3),
+                                       "B": ("Is Diffuse Ray", 0.5, 0.3)})
+    plane("Floor", 8, (0, 0, 0), material=floor)
+    plane("Wall", 8, (0, 2.5, 2), (math.pi / 2, 0, 0), material=wall)
+    plane("Side", 8, (2.6, 0, 2), (0, math.pi / 2, 0), material=side)
+    for x, mat in ((-1.3, principled("Mirror", (0.9, 0.9, 0.9), roughness=0.0, metallic=1.0)),
+                   (0.0, glass_material("PathGlass", "GLASS")),
+                   (1.3, principled("RoughMetal", (0.9, 0.8, 0.7), roughness=0.35, metallic=1.0))):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.55, location=(x, 0.4, 0.55), segments=32, ring_count=16)
+        bpy.ops.object.shade_smooth()
+        bpy.context.active_object.data.materials.append(mat)
+    light("AREA", (0, -1.0, 3.8), (math.radians(20), 0, 0), energy=600.0, size=1.5)
+    camera((0, -4.5, 1.4), (math.radians(80), 0, 0), lens=30)
+    black_world(scene)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    return scene

@@ -38,19 +38,27 @@ def _tangent(g, node, f):
 
 
 def _light_path(g, node, f):
-    linked = [o.name for o in node.outputs
-              if o.is_linked and o.name not in ("Is Camera Ray", "Is Shadow Ray", "Ray Length")]
+    """Light Path, per hit as the path that reached it (core/materials/nodes/attributes.PATH_ATTRIBUTES: the ray's
+    type and the bounces before it, carried along the path tracer's paths). Approximated and named: Transparent
+    Depth (0), Portal Depth and Is Volume Scatter Ray (0); in a world every output but Is Camera Ray, Is Shadow Ray
+    and Ray Length (as a camera ray's); in a lamp the depths (as a camera hit's light)."""
+    attr = {"Is Camera Ray": "is_camera_ray", "Is Shadow Ray": "is_shadow_ray", "Ray Length": "ray_length",
+            "Is Diffuse Ray": "is_diffuse_ray", "Is Glossy Ray": "is_glossy_ray", "Is Singular Ray": "is_singular_ray",
+            "Is Reflection Ray": "is_reflection_ray", "Is Transmission Ray": "is_transmission_ray",
+            "Ray Depth": "ray_depth", "Diffuse Depth": "diffuse_depth", "Glossy Depth": "glossy_depth",
+            "Transmission Depth": "transmission_depth", "Transparent Depth": "transparent_depth"}
+    exact = set(attr) - {"Transparent Depth"}
+    if getattr(g, "world", False):
+        exact = {"Is Camera Ray", "Is Shadow Ray", "Ray Length"}
+    elif getattr(g, "falloffs", None) is not None:
+        exact -= {"Ray Depth", "Diffuse Depth", "Glossy Depth", "Transmission Depth"}
+    linked = [o.name for o in node.outputs if o.is_linked and o.name not in exact]
     if linked:
-        g.warn(f"'{node.name}' (Light Path): {', '.join(linked)} approximated (camera hits read as a camera ray, "
-               "other hits as a reflection of depth 1)")
-    camera = g.attribute("is_camera_ray", "float")
-    one_minus = g.emit("one_minus", {}, [camera], ("float",))[0]
+        g.warn(f"'{node.name}' (Light Path): {', '.join(linked)} approximated here")
     zero = g.constant(0.0, "float")
-    return {"Is Camera Ray": camera, "Is Shadow Ray": g.attribute("is_shadow_ray", "float"), "Is Diffuse Ray": one_minus, "Is Glossy Ray": zero,
-            "Is Singular Ray": zero, "Is Reflection Ray": one_minus, "Is Transmission Ray": zero,
-            "Is Volume Scatter Ray": zero, "Ray Length": g.attribute("ray_length", "float"),
-            "Ray Depth": one_minus, "Diffuse Depth": one_minus, "Glossy Depth": zero, "Transparent Depth": zero,
-            "Transmission Depth": zero, "Portal Depth": zero}
+    out = {name: g.attribute(a, "float") for name, a in attr.items()}
+    out.update({"Is Volume Scatter Ray": zero, "Portal Depth": zero})
+    return out
 
 
 def _uvmap(g, node, f):

@@ -68,6 +68,7 @@ def _baked(world, registry, color_in, strength_in, warnings: list, view_layer=No
     notes = []
     g = GraphCompiler(lambda image, alpha: registry._texture(world, image, alpha=alpha), notes.append)
     g.view_layer = view_layer
+    g.world = True  # Light Path reads as a camera ray's here (node_handlers._light_path)
     color, strength = g.value(color_in, "color"), g.value(strength_in, "float")
     warnings.extend(f"World '{world.name}': {n}" for n in dict.fromkeys(notes))
     if color.const is not None and strength.const is not None:

@@ -11,6 +11,7 @@ from ..geometry import camera as camera_mod
 from ..geometry.accel import Hits
 from ..lights import groups as light_groups
 from ..lights.table import emitted_radiance
+from . import path_state
 from ..materials import volume
 from ..materials.surface import Surface
 from ..sampling import cols, finite
@@ -201,9 +202,15 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
     alive = np.ones(n, bool)
     idx = np.flatnonzero(s.glass)
     cur = s.take(idx)
+    # the Light Path state of each pixel's chain (path_state.py), where some program reads it
+    state = path_state.at_camera(n) if ctx.reads_path else None
     for k in range(ctx.max_bounces + 1):  # as the path tracer: rays from vertices 0..max_bounces find emission,
         ray = sample_rays(cur, rng.random((3, len(idx)), dtype=np.float32))  # vertices up to max_bounces are shaded
         alive[np.setdiff1d(idx, idx[ray.rows])] = False
+        if state is not None and ray.kinds is not None:
+            moved = path_state.after_bounce(path_state.take(state, idx), ray.rows, *ray.kinds)
+            for key, v in moved.items():
+                state[key][idx[ray.rows]] = v
         idx = idx[ray.rows]
         if idx.size == 0:
             break
@@ -228,7 +235,8 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
             break
         prim[idx], b1[idx], b2[idx], t[idx] = hit.prim[sel], hit.u[sel], hit.v[sel], hit.t[sel]
         o[:, idx], d[:, idx] = cols(ray.o, sel), cols(ray.d, sel)
-        cur = Surface(ctx, prim[idx], b1[idx], b2[idx], o[:, idx], d[:, idx], t[idx])
+        cur = Surface(ctx, prim[idx], b1[idx], b2[idx], o[:, idx], d[:, idx], t[idx],
+                      path=path_state.take(state, idx))
         more = np.zeros(len(idx), bool) if cur.glass is None else cur.glass
         if not more.any():
             idx = idx[:0]
@@ -238,7 +246,8 @@ def follow_specular(ctx: TraceContext, hits: PrimaryHits, rng: np.random.Generat
     alive[idx] = False  # still on glass when the bounce budget ran out
     keep = np.flatnonzero(alive)
     hits.rows = hits.rows[keep]
-    hits.surf = Surface(ctx, prim[keep], b1[keep], b2[keep], o[:, keep], d[:, keep], t[keep], walks=True)
+    hits.surf = Surface(ctx, prim[keep], b1[keep], b2[keep], o[:, keep], d[:, keep], t[keep], walks=True,
+                        path=path_state.take(state, keep))
     hits.tint = None
     return SpecularChains(thr[:, keep], depth[keep])
 

@@ -33,6 +33,7 @@ from ..materials.params import SurfaceParams
 from ..materials.surface import Surface
 from ..materials import volume
 from ..sampling import cols, dot, finite, norm, to_local, to_world, vfinite, vmax
+from . import path_state
 from .ray_emission import _emission_on_rays, power_heuristic
 from .subsurface import subsurface_light, vertex_walks, with_exit_rays
 from .trace_context import TraceContext
@@ -155,6 +156,7 @@ class BsdfRay:
     d: np.ndarray
     hits: object = None
     delta: np.ndarray | None = None  # (k,) bool: a delta sample (smooth glass): f is its weight, pdf DELTA_PDF
+    kinds: tuple | None = None  # (diffuse, singular, transmit) (k,) bool each: the Light Path type (path_state.py)
     walked: np.ndarray | None = None    # (k,) bool: a ray from a subsurface walk's exit (subsurface.with_exit_rays)
     origin_n: np.ndarray | None = None  # (3, k): the normals at the rays' origins where not all are the rows'
 
@@ -186,8 +188,9 @@ def sample_rays(s: Surface, u: np.ndarray) -> BsdfRay:
         delta = s.glass
     rows = np.flatnonzero(ok)
     d = cols(wi, rows)
+    kinds = tuple(k[rows] for k in path_state.ray_kinds(s, u[0], wi)) if getattr(s, "reads_path", False) else None
     return BsdfRay(rows, cols(wi_l, rows), cols(f, rows), pdf[rows], offset_origin(cols(s.p, rows), cols(s.ng, rows), d),
-                   d, delta=None if delta is None else delta[rows])
+                   d, delta=None if delta is None else delta[rows], kinds=kinds)
 
 
 def needs_continuation(ctx: TraceContext, direct_resampled: bool, world_resampled: bool = False) -> bool:
@@ -339,6 +342,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     world_on = ctx.world.sampled or bool((ctx.world.mean > 0).any())
     first = None
     dthr = None  # with first_bounce, after x2's BSDF sample: the throughput through x2's diffuse lobe alone
+    # the Light Path state of the vertices s (path_state.py), where some program reads it
+    state = None if not ctx.reads_path else (s.path if s.path is not None else path_state.at_camera(len(idx)))
     for bounce in range(ctx.max_bounces + 1):
         target = direct if bounce == 0 else (indirect if first is None else first.lo)
         target_g = direct_g if bounce == 0 else (indirect_g if first is None else first.lo_g)
@@ -359,6 +364,8 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         keep = np.flatnonzero(ok)
         if keep.size == 0:
             break
+        ray_state = None if state is None else path_state.unknown(keep.size) if ray.kinds is None else \
+            path_state.take(path_state.after_bounce(state, rows, *ray.kinds), keep)
         if ctx.world.sampled:  # the receivers' normals, for a constant world's light-sample pdf
             origin_n = cols(s.ns, rows[keep]) if ray.origin_n is None else cols(ray.origin_n, keep)
         idx, throughput, prev_pdf = idx[rows[keep]], cols(thr, keep), pdf[keep]
@@ -382,7 +389,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         # the world resampled at the first surfaces too: only their delta rays collect it
         world_collect = collect if world_resampled else None
         hsel, hp = _emission_on_rays(ctx, o, d, hits, prev_pdf, collect, world_collect, add, world_on,
-                                     origin_n if ctx.world.sampled else None)
+                                     origin_n if ctx.world.sampled else None, ray_state)
         if hsel.size == 0:
             break
         last = None if budget is None else budget[idx[hsel]] <= bounce  # this path's bounces are spent
@@ -395,7 +402,9 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
         idx, throughput = idx[hsel], cols(throughput, hsel)
         if dthr is not None:
             dthr = cols(dthr, hsel)
-        s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], cols(o, hsel), cols(d, hsel), hits.t[hsel], walks=True)
+        s = Surface(ctx, hp, hits.u[hsel], hits.v[hsel], cols(o, hsel), cols(d, hsel), hits.t[hsel], walks=True,
+                    path=path_state.take(ray_state, hsel))
+        state = s.path
         if bounce == 0 and first_bounce:
             # from here on the path estimates the radiance leaving x2: throughput 1, accumulated per first hit
             first = FirstBounce(idx, throughput, prev_pdf[hsel], s.p, s.facing_normals()[0], s.params,

@@ -110,14 +110,16 @@ def _suns_on_rays(ctx: TraceContext, d, esc, prev_pdf, add) -> None:
         add(esc[inside], le, group)
 
 
-def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) -> None:
-    """Emissive triangles hit by the rays ``hsel`` (primitives ``hp``), MIS-weighted against light sampling."""
+def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add, path=None) -> None:
+    """Emissive triangles hit by the rays ``hsel`` (primitives ``hp``), MIS-weighted against light sampling;
+    ``path``: the rays' Light Path state or None."""
     light = ctx.lights.geom_to_light[hp]
     em = np.flatnonzero((light >= 0) if collect is None else (light >= 0) & collect[hsel])
     if em.size:
         hs = hsel[em]
         le = emitted_radiance(ctx.scene.geometry, ctx.scene.materials, hp[em], hits.u[hs], hits.v[hs],
-                              -cols(d, hs) if ctx.has_programs else None)
+                              -cols(d, hs) if ctx.has_programs else None,
+                              path=None if path is None else {k: v[hs] for k, v in path.items()})
         cos_l = -dot(cols(d, hs), cols(ctx.geom_ng_rows, hp[em]))
         le *= (cos_l > 0) | ctx.lights.tri_two_sided[light[em]]
         pl = ctx.lights.tri_pdf_solid_angle(light[em], hits.t[hs], cos_l)
@@ -125,11 +127,12 @@ def _emitters_hit(ctx: TraceContext, d, hits, hsel, hp, prev_pdf, collect, add) 
         add(hs, le, None if ctx.groups is None else ctx.groups.of_lights(light[em]))
 
 
-def _emission_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, world_collect, add, world: bool, origin_n):
+def _emission_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, world_collect, add, world: bool, origin_n,
+                      path: dict | None = None):
     """The emission BSDF rays (o, d; traced ``hits``) find, into ``add``: lamps in front of the hits, then the
     hit emitters, else the world where ``world``. ``collect`` (or None: all rays): the rays that collect lamps and
-    emitters; ``world_collect`` (or None: all) the escaping rays that collect the world. Returns (rows that hit
-    geometry, their primitives)."""
+    emitters; ``world_collect`` (or None: all) the escaping rays that collect the world; ``path``: the rays' Light
+    Path state (integrators/path_state.py) or None. Returns (rows that hit geometry, their primitives)."""
     gather = collect is None or bool(collect.any())
     if gather and len(ctx.scene.lamps.tris):
         _lamps_on_rays(ctx, o, d, hits, prev_pdf, collect, add)
@@ -144,5 +147,5 @@ def _emission_on_rays(ctx: TraceContext, o, d, hits, prev_pdf, collect, world_co
     hsel = np.flatnonzero(hit)
     hp = hits.prim[hsel]
     if hsel.size and gather:
-        _emitters_hit(ctx, d, hits, hsel, hp, prev_pdf, collect, add)
+        _emitters_hit(ctx, d, hits, hsel, hp, prev_pdf, collect, add, path)
     return hsel, hp

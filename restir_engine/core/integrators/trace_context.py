@@ -40,6 +40,7 @@ class TraceContext:
     bump_maps: bool = False    # some material has a Bump node (image_normals.bump_map)
     has_glass: bool = False    # some material has a smooth glass closure (core/materials/glass.py)
     has_programs: bool = False  # some material has a node program (core/materials/nodes)
+    reads_path: bool = False  # some material's program reads the Light Path's ray type or depths (path_state.py)
     anisotropic: bool = False  # some material may have an anisotropic GGX lobe (core/materials/anisotropy.py)
     sheen: bool = False  # some material is a sheen lobe (core/materials/sheen.py)
     has_subsurface: bool = False  # some material has a subsurface share (integrators/subsurface.py)
@@ -152,6 +153,7 @@ def build_context(scene: Scene, max_bounces: int, film_transparent: bool = False
                         has_glass=scene.materials.transmission is not None
                         and bool((scene.materials.transmission > 0).any()),
                         has_programs=bool(getattr(scene.materials, "programs", None)),
+                        reads_path=_reads_path(scene.materials),
                         anisotropic=may_be_anisotropic(scene.materials), world=world,
                         sheen=getattr(scene.materials, "sheen_roughness", None) is not None
                         and bool((scene.materials.sheen_roughness > 0).any()),
@@ -246,3 +248,10 @@ def _still_part(base: TraceContext, rows: np.ndarray) -> tuple:
     still = (Accel(base.scene.geometry.verts[still_rows]), still_rows)
     _STILL = (base.geom_accel, rows.copy(), still)
     return still
+
+
+def _reads_path(materials) -> bool:
+    """Whether some material's node program reads the Light Path outputs carried along paths."""
+    from ..materials.nodes.attributes import PATH_ATTRIBUTES
+    wanted = set(PATH_ATTRIBUTES)
+    return any(wanted.intersection(getattr(p, "reads", ())) for p in getattr(materials, "programs", None) or ())

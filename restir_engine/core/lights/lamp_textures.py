@@ -171,6 +171,8 @@ class LampAttributes:
             return lt.pass_index[tri].astype(np.float32)
         if name == "ray_length":
             return self.dist
+        if name == "ray_depth":  # evaluated as emission: one bounce past the lit point (taken as a camera hit's)
+            return np.ones(k, np.float32)
         if name == "footprint":
             return np.full(k, _F(1e-3), np.float32)
         if name in {"tangent_uv", "tangent_sign"}:

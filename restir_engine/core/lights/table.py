@@ -38,11 +38,14 @@ def triangle_geometry(verts: np.ndarray):
 
 def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarray,
                      b1: np.ndarray, b2: np.ndarray, wo: np.ndarray | None = None, camera_ray: bool = False,
-                     footprint: np.ndarray | None = None) -> np.ndarray:
+                     footprint: np.ndarray | None = None, path: dict | None = None,
+                     sampled: bool = False) -> np.ndarray:
     """Emitted radiance (3, n) rows, W·sr⁻¹·m⁻², at barycentrics (b1, b2) of triangles ``tri``, towards unit
     directions ``wo`` (3, n) where a node program reads the view (Layer Weight, Fresnel, Incoming, Backfacing;
     without ``wo`` the view is along the surface normal); ``camera_ray``: seen by camera rays (Light Path);
-    ``footprint`` (n,): the pixel's width there (scene units), where known."""
+    ``footprint`` (n,): the pixel's width there (scene units), where known; ``path``: the Light Path values of the
+    rays that found the points (attributes.PATH_ATTRIBUTES, (n,) each), or ``sampled``: points chosen by light
+    sampling (Light Path reads them as emission)."""
     mat = tris.material[tri]
     le = np.take(materials.emission, mat, axis=0)
     if tris.uvs is not None and (materials.emit_tex[mat] >= 0).any():
@@ -52,7 +55,8 @@ def emitted_radiance(tris: TriangleSet, materials: MaterialTable, tri: np.ndarra
     le = np.ascontiguousarray(le.T, dtype=np.float32)
     for rows, out in run_programs(materials, mat, lambda r: HitAttributes(
             tris, tri[r], b1[r], b2[r], materials.textures, wo=None if wo is None else cols(wo, r),
-            camera_ray=camera_ray, footprint=None if footprint is None else footprint[r]), ("emission",)):
+            camera_ray=camera_ray, footprint=None if footprint is None else footprint[r],
+            path=None if path is None else {k: v[r] for k, v in path.items()}, emission=sampled), ("emission",)):
         le[:, rows] = out["emission"]
     return le
 
@@ -75,7 +79,7 @@ def program_emission_density(tris: TriangleSet, materials: MaterialTable) -> tup
     k = len(_POWER_POINTS)
     pts = np.repeat(tri, k)
     b = np.tile(_POWER_POINTS, (tri.size, 1))
-    le = emitted_radiance(tris, materials, pts, b[:, 0], b[:, 1])
+    le = emitted_radiance(tris, materials, pts, b[:, 0], b[:, 1], sampled=True)
     dens = np.maximum(luminance(le.T), 0).reshape(tri.size, k).mean(axis=1)
     mat = tris.material[tri]
     sums = np.bincount(mat, dens, minlength=len(materials.emission))
@@ -350,7 +354,7 @@ class LightTable:
                             wo = cols(p_receiver, rows) - self.positions(light[rows], b1[rows], b2[rows])
                             wo = wo / np.maximum(norm(wo), np.float32(1e-30))
                         out[:, rows] = emitted_radiance(tris, scene.materials, ids[lt[sel] - offset], b1[rows],
-                                                        b2[rows], wo)
+                                                        b2[rows], wo, sampled=True)
         if p_receiver is not None and self.any_spots:
             lm = np.flatnonzero(light >= self.n_geom)
             if lm.size:

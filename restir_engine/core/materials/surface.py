@@ -36,13 +36,16 @@ class Surface:
     index and BSDF params (textures applied)."""
 
     def __init__(self, ctx, prim, u, v, o, d, t, camera: bool = False, lambert: bool = False,
-                 walks: bool | None = None):
+                 walks: bool | None = None, path: dict | None = None):
         """``camera``: hits of camera rays. ``walks`` (default: ``camera``): a subsurface share stays its own lobe
         (``params.sss``, walked by integrators/subsurface.py) at these hits, the first the camera's paths shade; at
         others it is part of the diffuse lobe. ``lambert``: every hit is a white Lambertian surface whatever its
-        material (a subsurface walk's exit, as Cycles shades it)."""
+        material (a subsurface walk's exit, as Cycles shades it). ``path``: the Light Path values of the rays that
+        reached the hits (attributes.PATH_ATTRIBUTES, (n,) each; None: a camera hit's, or a diffuse bounce's)."""
         geom = ctx.scene.geometry
         self.camera = camera  # hits of camera rays (Light Path > Is Camera Ray in node programs)
+        self.path = path
+        self.reads_path = getattr(ctx, "reads_path", False)  # whether the paths carry their Light Path state
         self._t = t
         prim = prim.astype(np.intp)  # one index conversion for every gather below
         self.prim = prim
@@ -96,8 +99,9 @@ class Surface:
         t = np.asarray(self._t, np.float32)[r]
         if given.get("footprint") is None:
             given["footprint"] = pixel_footprint(ctx.scene.camera, t)
+        path = None if self.path is None else {k: v[r] for k, v in self.path.items()}
         return HitAttributes(ctx.scene.geometry, self.prim[r], self.b1[r], self.b2[r], ctx.scene.materials.textures,
-                             wo=wo, camera_ray=self.camera, ray_length=t, **given)
+                             wo=wo, camera_ray=self.camera, ray_length=t, path=path, **given)
 
     def _uv(self, geom, rows) -> np.ndarray:
         """(k, 2) texture coordinates of the hits ``rows``."""
@@ -434,6 +438,8 @@ class Surface:
         out.aniso = None if self.aniso is None else self.aniso.take(idx, len(self))
         out.sheen = None if self.sheen is None else self.sheen.take(idx, len(self))
         out.params = self.params.take(idx)
+        out.camera, out.reads_path = self.camera, self.reads_path
+        out.path = None if self.path is None else {k: v[idx] for k, v in self.path.items()}
         return out
 
 

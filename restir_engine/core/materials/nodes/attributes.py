@@ -5,7 +5,8 @@ exporter's programs read them): "position", "normal" (shading), "true_normal", "
 "backfacing" (1 or 0), "uv" (u, v, 0), "generated" (the object's texture space, [0, 1] over its box),
 "object" (object-space position), "object_normal", "reflection", "parametric", "object_location",
 "object_color", "object_alpha", "object_random", "is_camera_ray" / "is_shadow_ray" (1 or 0: Light Path, as the
-ray that reached the point), "attr:<name>" / "attr_alpha:<name>" for a colour attribute
+ray that reached the point), the Light Path outputs of PATH_ATTRIBUTES (the ray's type and the bounces before it,
+given per hit by the path that reached it; else :data:`SURFACE_DEFAULT` / :data:`EMISSION_DEFAULT`), "attr:<name>" / "attr_alpha:<name>" for a colour attribute
 (RGB and alpha, linear), OBJECT_PROPERTY / OBJECT_PROPERTY_ALPHA + "<KIND>:<name>" for a property of the instance's
 object (the Attribute node's Object and Instancer types: ObjectTable.properties, (r, g, b, a) per instance), "tangent_uv" / "tangent_sign" (the UV map's interpolated tangent and bitangent sign, or
 None without tangents) and "footprint" (a pixel's width on the surface, scene units)."""
@@ -16,6 +17,16 @@ import numpy as np
 from ...sampling import barycentric, dot, inverse3, norm
 
 _F = np.float32
+#: Light Path outputs read per hit (1 / 0 flags and counts) as Cycles defines them for the ray reaching a point: its
+#: lobe (diffuse, glossy or singular: glossy counts singular too), side (reflection or transmission), the bounces
+#: before it (Ray Depth; diffuse and glossy reflections and transmissions apart) and the transparent surfaces passed
+PATH_ATTRIBUTES = ("is_diffuse_ray", "is_glossy_ray", "is_singular_ray", "is_reflection_ray", "is_transmission_ray",
+                   "ray_depth", "diffuse_depth", "glossy_depth", "transmission_depth", "transparent_depth")
+#: what a surface reached by an unknown ray reads: a diffuse reflection after one bounce
+SURFACE_DEFAULT = {"is_diffuse_ray": 1.0, "is_reflection_ray": 1.0, "ray_depth": 1.0, "diffuse_depth": 1.0}
+#: what an emitter sampled for next-event estimation, or a surface a shadow ray passes, reads (Cycles: no ray type,
+#: one bounce past the lit point, taken here as a camera hit's)
+EMISSION_DEFAULT = {"ray_depth": 1.0}
 OBJECT_PROPERTY = "object_property:"  # + "KIND:name": RGB (3, n)
 OBJECT_PROPERTY_ALPHA = "object_property_alpha:"  # + "KIND:name": alpha (n,)
 
@@ -26,7 +37,8 @@ class HitAttributes:
     ``textures``: the material table's images."""
 
     def __init__(self, tris, prim, b1, b2, textures, wo=None, normal=None, true_normal=None, footprint=None,
-                 camera_ray: bool = False, ray_length=None, shadow_ray: bool = False):
+                 camera_ray: bool = False, ray_length=None, shadow_ray: bool = False, path: dict | None = None,
+                 emission: bool = False):
         self.tris, self.prim = tris, np.asarray(prim, np.intp)
         self.b1, self.b2 = np.asarray(b1, np.float32), np.asarray(b2, np.float32)
         self.textures = textures
@@ -47,6 +59,9 @@ class HitAttributes:
             self._cache["ray_length"] = np.broadcast_to(np.asarray(ray_length, np.float32), self.b1.shape)
         if footprint is not None:
             self._cache["footprint"] = np.broadcast_to(np.asarray(footprint, np.float32), self.b1.shape)
+        # Light Path: the given path's values (read on first use), else a camera hit's (all 0) or a default
+        self._path = path or {}
+        self._path_default = {} if camera_ray else (EMISSION_DEFAULT if emission or shadow_ray else SURFACE_DEFAULT)
 
     def shifted(self, delta) -> "HitAttributes":
         """The same points moved by ``delta`` (3, n) in their triangles' planes (barycentrics moved, so that
@@ -61,7 +76,8 @@ class HitAttributes:
         return HitAttributes(self.tris, self.prim, self.b1 + db1, self.b2 + db2, self.textures, wo=self._wo,
                              normal=self.get("normal"), true_normal=self.get("true_normal"),
                              footprint=self.get("footprint"), camera_ray=self.camera_ray,
-                             ray_length=self._cache.get("ray_length"), shadow_ray=self.shadow_ray)
+                             ray_length=self._cache.get("ray_length"), shadow_ray=self.shadow_ray,
+                             path={k: self.get(k) for k in PATH_ATTRIBUTES})
 
     def object_normal_to_world(self, n) -> np.ndarray:
         """Object-space normals (3, n) in world space (the inverse transpose of each instance's matrix)."""
@@ -84,6 +100,12 @@ class HitAttributes:
         if got is None:
             got = self._cache[name] = self._compute(name)
         return got
+
+    def _path_value(self, name: str) -> np.ndarray:
+        got = self._path.get(name)
+        if got is not None:
+            return np.ascontiguousarray(np.broadcast_to(np.asarray(got, np.float32), self.b1.shape))
+        return np.full(len(self.prim), _F(self._path_default.get(name, 0.0)), np.float32)
 
     def _corners(self, data):
         c = np.take(data, self.prim, axis=0)  # (n, 3 corners, k)
@@ -193,6 +215,8 @@ class HitAttributes:
             return (t / np.maximum(norm(t), _F(1e-30))).astype(np.float32)
         if name == "ray_length":
             return np.zeros(n, np.float32)
+        if name in PATH_ATTRIBUTES:
+            return self._path_value(name)
         if name == "object_index":
             inst, objs = self._instances()
             idx = None if inst is None else getattr(objs, "pass_index", None)
