@@ -98,8 +98,8 @@ def _load_core():
 
 def one(args) -> dict:
     cores = int(args.cores)
-    if hasattr(os, "sched_setaffinity"):
-        os.sched_setaffinity(0, set(range(cores)))  # as taskset -c 0-(N-1); spawned workers inherit it
+    if hasattr(os, "sched_setaffinity"):  # as taskset -c K-(K+N-1); spawned workers inherit it (K: first_core)
+        os.sched_setaffinity(0, set(range(args.first_core, args.first_core + cores)))
     _load_core()
     import dataclasses
 
@@ -349,6 +349,7 @@ def main(argv=None):
     o.add_argument("--spec")
     o.add_argument("--cores")
     o.add_argument("--mode")
+    o.add_argument("--first-core", type=int, default=0, help="the first of the cores it is pinned to")
     c = sub.add_parser("chart")
     c.add_argument("--json", default=os.path.join(ROOT, "docs", "results", "scaling", "scaling.json"))
     args = ap.parse_args(argv)

@@ -27,6 +27,7 @@ Messages (tuples from the rendering process; each is answered with ("ok", pickle
 """
 from __future__ import annotations
 
+import os
 import traceback
 
 import numpy as np
@@ -233,4 +234,20 @@ class _Worker:
 
 
 def serve(rank: int, size: int, conn, barrier, stop, progress, threads: int, order) -> None:
-    _Worker(rank, size, conn, barrier, stop, progress, threads, order).serve()
+    worker = _Worker(rank, size, conn, barrier, stop, progress, threads, order)
+    folder = os.environ.get(PROFILE_ENV)
+    if not folder:
+        worker.serve()
+        return
+    import cProfile  # a measurement aid (scripts/benchmarks/scaling.py --profile): each worker's own profile
+    profile = cProfile.Profile()
+    profile.enable()
+    try:
+        worker.serve()
+    finally:
+        profile.disable()
+        profile.dump_stats(os.path.join(folder, f"worker{rank}.prof"))
+
+
+#: where workers write their cProfile statistics when set (a folder; unset: no profiling)
+PROFILE_ENV = "RESTIR_PROFILE_WORKERS"
