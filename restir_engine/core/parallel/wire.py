@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import io
 import pickle
-import threading
 from multiprocessing import shared_memory
 
 ALIGN = 64
@@ -71,12 +70,6 @@ def unlink_segments(segs) -> None:
             seg.unlink()
         except OSError:  # FileNotFoundError included
             pass
-
-
-def unlink_later(segs) -> None:
-    """:func:`unlink_segments` on a thread of its own (the kernel's unlinking of a large segment takes milliseconds
-    the caller need not wait for; not a daemon, so the names go before the process exits)."""
-    threading.Thread(target=unlink_segments, args=(list(segs),), name="restir-unlink").start()
 
 
 def pack(obj):

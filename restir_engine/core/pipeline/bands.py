@@ -67,7 +67,6 @@ def render_in_bands(render_one, scene, settings, bands: int, progress=None, shou
     histories, stats, samples, cancelled = [], {}, None, False
     limit = settings.time_limit / len(rows) if settings.time_limit > 0 else 0.0
     largest = w * max(min(h, b + m) - max(0, a - m) for a, b in rows)
-    written = 0  # the rows of the bands rendered so far
     try:
         for i, (a, b) in enumerate(rows):
             lo, hi = max(0, a - m), min(h, b + m)
@@ -85,10 +84,9 @@ def render_in_bands(render_one, scene, settings, bands: int, progress=None, shou
                 cancelled = True
                 break
             for name, image in result.passes.items():
-                if name not in passes:  # every row is written by its band (rows left by a stop: zeroed below)
-                    passes[name] = np.empty((h, w) + image.shape[2:], image.dtype)
+                if name not in passes:
+                    passes[name] = np.zeros((h, w) + image.shape[2:], image.dtype)
                 passes[name][a:b] = image[a - lo:a - lo + (b - a)]
-            written = b
             histories.append(result.history)
             samples = result.samples_done if samples is None else min(samples, result.samples_done)
             if i == 0:
@@ -98,8 +96,6 @@ def render_in_bands(render_one, scene, settings, bands: int, progress=None, shou
                 break
     finally:
         scene.camera = cam
-    for image in passes.values():
-        image[written:] = 0
     stats["bands"] = len(rows)
     stats["band_margin"] = m
     keep = None if cancelled or not histories or any(hh is None for hh in histories) else \

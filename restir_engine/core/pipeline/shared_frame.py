@@ -120,7 +120,7 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
                                 "keep_histories": int(keep_histories), "keep_history": bool(keep_history),
                                 "costs": team.costs_seg.name, "clock": clock is not None}))
         finally:  # every worker attached (or the team is gone): the name is no longer needed
-            wire.unlink_later([seg])
+            wire.unlink_segments([seg])
         done, cancelled, counts, settled, at_once = 0, False, {}, None, 0
         while done < settings.samples and not out_of_time(settings, t0, done):
             if settled is not None and settings.time_limit <= 0:
