@@ -9,7 +9,7 @@ import numpy as np
 from . import object_properties
 from .derived_attributes import POINTINESS, RANDOM_PER_ISLAND
 from .node_graph import Reg
-from .node_space_handlers import camera_data, ies_texture, normal, sky_texture, vector_transform
+from .node_space_handlers import camera_data, ies_texture, light_path, normal, sky_texture, vector_transform
 
 #: samples of a Color Ramp or curve table (Cycles' 257 entries over [0, 1])
 TABLE_SIZE = 257
@@ -35,30 +35,6 @@ def _tangent(g, node, f):
     if node.axis != "Z":
         g.warn(f"'{node.name}': a radial tangent about {node.axis} is approximated by the one about Z")
     return {"Tangent": g.attribute("tangent", "vector")}
-
-
-def _light_path(g, node, f):
-    """Light Path, per hit as the path that reached it (core/materials/nodes/attributes.PATH_ATTRIBUTES: the ray's
-    type and the bounces before it, carried along the path tracer's paths). Approximated and named: Transparent
-    Depth (0), Portal Depth and Is Volume Scatter Ray (0); in a world every output but Is Camera Ray, Is Shadow Ray
-    and Ray Length (as a camera ray's); in a lamp the depths (as a camera hit's light)."""
-    attr = {"Is Camera Ray": "is_camera_ray", "Is Shadow Ray": "is_shadow_ray", "Ray Length": "ray_length",
-            "Is Diffuse Ray": "is_diffuse_ray", "Is Glossy Ray": "is_glossy_ray", "Is Singular Ray": "is_singular_ray",
-            "Is Reflection Ray": "is_reflection_ray", "Is Transmission Ray": "is_transmission_ray",
-            "Ray Depth": "ray_depth", "Diffuse Depth": "diffuse_depth", "Glossy Depth": "glossy_depth",
-            "Transmission Depth": "transmission_depth", "Transparent Depth": "transparent_depth"}
-    exact = set(attr) - {"Transparent Depth"}
-    if getattr(g, "world", False):
-        exact = {"Is Camera Ray", "Is Shadow Ray", "Ray Length"}
-    elif getattr(g, "falloffs", None) is not None:
-        exact -= {"Ray Depth", "Diffuse Depth", "Glossy Depth", "Transmission Depth"}
-    linked = [o.name for o in node.outputs if o.is_linked and o.name not in exact]
-    if linked:
-        g.warn(f"'{node.name}' (Light Path): {', '.join(linked)} approximated here")
-    zero = g.constant(0.0, "float")
-    out = {name: g.attribute(a, "float") for name, a in attr.items()}
-    out.update({"Is Volume Scatter Ray": zero, "Portal Depth": zero})
-    return out
 
 
 def _uvmap(g, node, f):
@@ -480,7 +456,7 @@ def _bevel(g, node, f):
 
 
 HANDLERS = {
-    "TEX_COORD": _texcoord, "TANGENT": _tangent, "LIGHT_PATH": _light_path, "UVMAP": _uvmap,
+    "TEX_COORD": _texcoord, "TANGENT": _tangent, "LIGHT_PATH": light_path, "UVMAP": _uvmap,
     "NEW_GEOMETRY": _geometry, "OBJECT_INFO": _object_info,
     "VERTEX_COLOR": _color_attribute, "ATTRIBUTE": _attribute, "FRESNEL": _fresnel, "LAYER_WEIGHT": _layer_weight,
     "VALUE": _value, "RGB": _rgb, "MAPPING": _mapping, "VECTOR_ROTATE": _vector_rotate, "MATH": _math,

@@ -1,5 +1,5 @@
-"""Shader-node handlers for the view, space, light-profile and sky nodes: Camera Data, Vector Transform, Normal, IES
-Texture and Sky Texture (each returns its outputs as registers of the graph compiler, export/node_graph.py; the
+"""Shader-node handlers for the view, ray, space, light-profile and sky nodes: Camera Data, Light Path, Vector
+Transform, Normal, IES Texture and Sky Texture (each returns its outputs as registers of the graph compiler, export/node_graph.py; the
 vector operations are core/materials/nodes/)."""
 from __future__ import annotations
 
@@ -102,3 +102,27 @@ def sky_texture(g, node, f):
     plain = not node.inputs["Vector"].is_linked
     vec = g.inp(node, "Vector", "vector", f, default="generated")
     return {"Color": g.emit("sky_texture", {"sky": model, "plain": plain}, [vec], ("color",))[0]}
+
+
+def light_path(g, node, f):
+    """Light Path, per hit as the path that reached it (core/materials/nodes/attributes.PATH_ATTRIBUTES: the ray's
+    type and the bounces before it, carried along the path tracer's paths). Approximated and named: Transparent
+    Depth (0), Portal Depth and Is Volume Scatter Ray (0); in a world every output but Is Camera Ray, Is Shadow Ray
+    and Ray Length (as a camera ray's); in a lamp the depths (as a camera hit's light)."""
+    attr = {"Is Camera Ray": "is_camera_ray", "Is Shadow Ray": "is_shadow_ray", "Ray Length": "ray_length",
+            "Is Diffuse Ray": "is_diffuse_ray", "Is Glossy Ray": "is_glossy_ray", "Is Singular Ray": "is_singular_ray",
+            "Is Reflection Ray": "is_reflection_ray", "Is Transmission Ray": "is_transmission_ray",
+            "Ray Depth": "ray_depth", "Diffuse Depth": "diffuse_depth", "Glossy Depth": "glossy_depth",
+            "Transmission Depth": "transmission_depth", "Transparent Depth": "transparent_depth"}
+    exact = set(attr) - {"Transparent Depth"}
+    if getattr(g, "world", False):
+        exact = {"Is Camera Ray", "Is Shadow Ray", "Ray Length"}
+    elif getattr(g, "falloffs", None) is not None:
+        exact -= {"Ray Depth", "Diffuse Depth", "Glossy Depth", "Transmission Depth"}
+    linked = [o.name for o in node.outputs if o.is_linked and o.name not in exact]
+    if linked:
+        g.warn(f"'{node.name}' (Light Path): {', '.join(linked)} approximated here")
+    zero = g.constant(0.0, "float")
+    out = {name: g.attribute(a, "float") for name, a in attr.items()}
+    out.update({"Is Volume Scatter Ray": zero, "Portal Depth": zero})
+    return out

@@ -68,7 +68,7 @@ def _baked(world, registry, color_in, strength_in, warnings: list, view_layer=No
     notes = []
     g = GraphCompiler(lambda image, alpha: registry._texture(world, image, alpha=alpha), notes.append)
     g.view_layer = view_layer
-    g.world = True  # Light Path reads as a camera ray's here (node_handlers._light_path)
+    g.world = True  # Light Path reads as a camera ray's here (node_space_handlers.light_path)
     color, strength = g.value(color_in, "color"), g.value(strength_in, "float")
     warnings.extend(f"World '{world.name}': {n}" for n in dict.fromkeys(notes))
     if color.const is not None and strength.const is not None:
@@ -77,10 +77,10 @@ def _baked(world, registry, color_in, strength_in, warnings: list, view_layer=No
     program = g.program({"color": color, "strength": strength})
     camera_view = None
     if "is_camera_ray" in program.reads:  # Light Path > Is Camera Ray: what the camera sees, baked apart
-        camera_view = (np.zeros(3, np.float32), _bake(program, color, strength, registry, True),
-                       _graph(program, color, strength, registry, True))
-    return (np.zeros(3, np.float32), _bake(program, color, strength, registry, False), None, camera_view,
-            _graph(program, color, strength, registry, False))
+        seen = _graph(program, color, strength, registry, True)
+        camera_view = (np.zeros(3, np.float32), _bake(seen, registry), seen)
+    graph = _graph(program, color, strength, registry, False)
+    return np.zeros(3, np.float32), _bake(graph, registry), None, camera_view, graph
 
 
 def _graph(program, color, strength, registry, camera_ray: bool) -> WorldGraph:
@@ -99,12 +99,12 @@ def _sun_cones(program) -> list:
     return cones
 
 
-def _bake(program, color, strength, registry, camera_ray: bool) -> np.ndarray:
-    """The world graph's Color x Strength over the directions of an equirectangular image (h, w, 3)."""
+def _bake(graph: WorldGraph, registry) -> np.ndarray:
+    """The world graph's Color x Strength over the directions of an equirectangular image (h, w, 3), its sky's sun
+    discs left out (the world samples them apart)."""
     sizes = [t.shape[1] for t in registry.textures]
     w = int(min(MAX_BAKE_WIDTH, max([BAKE_WIDTH] + sizes)))
     h = max(1, w // 2)
-    from ..core.materials.nodes.attributes import DirectionAttributes
     rows, cols = np.meshgrid(np.arange(h), np.arange(w), indexing="ij")
     u, v = (cols.ravel() + 0.5) / w, (rows.ravel() + 0.5) / h
     phi, theta = (0.5 - u) * 2 * np.pi, (1.0 - v) * np.pi  # the world image's convention (core/lights/world.py)
@@ -112,11 +112,8 @@ def _bake(program, color, strength, registry, camera_ray: bool) -> np.ndarray:
     image = np.empty((h * w, 3), np.float32)
     for lo in range(0, h * w, _BAKE_CHUNK):
         hi = min(lo + _BAKE_CHUNK, h * w)
-        out = program.run(DirectionAttributes(dirs[:, lo:hi], registry.textures, camera_ray, without_sun=True))
-        c = out["color"] if "color" in out else np.asarray(color.const, np.float32).reshape(3, 1)
-        s = out["strength"] if "strength" in out else np.float32(strength.const)
-        image[lo:hi] = np.broadcast_to(c * s, (3, hi - lo)).T
-    return np.where(np.isfinite(image), image, 0).reshape(h, w, 3)
+        image[lo:hi] = graph.evaluate(dirs[:, lo:hi], without_sun=True).T
+    return image.reshape(h, w, 3)
 
 
 def _plain_rotation(world, env, warnings: list):

@@ -319,6 +319,21 @@ def _no_first_bounce(ctx: TraceContext) -> FirstBounce:
                        light_groups.zeros(ctx.groups, 0), light_groups.zeros(ctx.groups, 0))
 
 
+def _walked_light(ctx: TraceContext, s: Surface, rng, budget):
+    """The paths' accumulators (direct, indirect (3, n) each, their light-group splits or None) with the direct light
+    of the subsurface walks from s already in, and the walks' result (subsurface.subsurface_light) or None."""
+    n = len(s)
+    direct = np.zeros((3, n), np.float32)
+    indirect = np.zeros((3, n), np.float32)
+    direct_g, indirect_g = light_groups.zeros(ctx.groups, n), light_groups.zeros(ctx.groups, n)
+    walked = subsurface_light(ctx, s, rng, continue_paths, budget) if ctx.has_subsurface else None
+    if walked is not None:
+        direct[:, walked.rows] += walked.direct
+        if direct_g is not None:
+            direct_g[:, :, walked.rows] += walked.direct_g
+    return direct, indirect, direct_g, indirect_g, walked
+
+
 def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, direct_resampled: bool = False,
                    first_ray=None, first_bounce: bool = False, budget: np.ndarray | None = None,
                    world_resampled: bool = False) -> PathResult:
@@ -329,14 +344,7 @@ def continue_paths(ctx: TraceContext, s: Surface, rng: np.random.Generator, dire
     ``budget`` (n,) (optional): the bounces each path may still take (fewer than max_bounces behind a specular
     chain)."""
     n = len(s)
-    direct = np.zeros((3, n), np.float32)
-    indirect = np.zeros((3, n), np.float32)
-    direct_g, indirect_g = light_groups.zeros(ctx.groups, n), light_groups.zeros(ctx.groups, n)
-    walked = subsurface_light(ctx, s, rng, continue_paths, budget) if ctx.has_subsurface else None
-    if walked is not None:
-        direct[:, walked.rows] += walked.direct
-        if direct_g is not None:
-            direct_g[:, :, walked.rows] += walked.direct_g
+    direct, indirect, direct_g, indirect_g, walked = _walked_light(ctx, s, rng, budget)
     idx = np.arange(n)
     throughput = np.ones((3, n), np.float32)
     world_on = ctx.world.sampled or bool((ctx.world.mean > 0).any())

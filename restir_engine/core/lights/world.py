@@ -42,13 +42,17 @@ class WorldGraph:
 
     def radiance(self, d: np.ndarray) -> np.ndarray:
         """Radiance (3, n) towards directions ``d`` (3, n) (need not be unit); non-finite values read 0."""
-        from ..materials.nodes.attributes import DirectionAttributes
-        n = d.shape[1]
-        if n == 0:
+        if d.shape[1] == 0:
             return np.zeros((3, 0), np.float32)
         ln = np.sqrt((d * d).sum(axis=0))
-        unit = (d / np.maximum(ln, np.float32(1e-30))).astype(np.float32)
-        out = self.program.run(DirectionAttributes(unit, self.textures, self.camera_ray))
+        return self.evaluate((d / np.maximum(ln, np.float32(1e-30))).astype(np.float32))
+
+    def evaluate(self, unit: np.ndarray, without_sun: bool = False) -> np.ndarray:
+        """Radiance (3, n) towards unit directions (3, n) (``without_sun``: Sky Textures leave their sun discs
+        out); non-finite values read 0."""
+        from ..materials.nodes.attributes import DirectionAttributes
+        n = unit.shape[1]
+        out = self.program.run(DirectionAttributes(unit, self.textures, self.camera_ray, without_sun=without_sun))
         c = out["color"] if "color" in out else np.asarray(self.color, np.float32).reshape(3, 1)
         s = out["strength"] if "strength" in out else np.float32(self.strength)
         rgb = np.broadcast_to(c * s, (3, n))
@@ -177,18 +181,7 @@ class World:
             return d, (np.maximum(local[2], 0) / np.pi).astype(np.float32), self.radiance(d)
         if self._suns:
             return self._sample_with_suns(np.asarray(u1, np.float64), np.asarray(u2, np.float64))
-        h, w = self._p.shape
-        flat = np.clip(np.searchsorted(self._cdf, u1, side="right") - 1, 0, h * w - 1)
-        lo, hi = self._cdf[flat], self._cdf[flat + 1]
-        fu = np.clip((u1 - lo) / np.maximum(hi - lo, 1e-300), 0, 1)     # u1's position within the texel's interval
-        row, col = np.divmod(flat, w)
-        u = (col + fu) / w
-        v = (row + u2) / h
-        phi = np.pi - 2 * np.pi * u
-        theta = np.pi - np.pi * v
-        st = np.sin(theta)
-        t = np.stack([st * np.cos(phi), st * np.sin(phi), np.cos(theta)])
-        d = (t if self.rotation is None else self.rotation.T.astype(np.float64) @ t).astype(np.float32)
+        d, row, col, st = self._sample_image(u1, u2)
         pdf = (self._p[row, col] * self._wh / (2 * np.pi * np.pi * np.maximum(st, 1e-6))).astype(np.float32)
         return d, pdf, self.radiance(d)
 
@@ -206,21 +199,25 @@ class World:
             lo += p
         rest = ~taken
         if rest.any():
-            d[:, rest] = self._sample_image(np.clip((u1[rest] - lo) / max(1 - lo, 1e-300), 0, 1), u2[rest])
+            d[:, rest] = self._sample_image(np.clip((u1[rest] - lo) / max(1 - lo, 1e-300), 0, 1), u2[rest])[0]
         return d, self.pdf(d), self.radiance(d)
 
-    def _sample_image(self, u1: np.ndarray, u2: np.ndarray) -> np.ndarray:
-        """Directions (3, n) drawn from the image's texel table (as :meth:`sample`)."""
+    def _sample_image(self, u1: np.ndarray, u2: np.ndarray):
+        """Directions (3, n) drawn from the image's texel table, with their texels' rows and columns and the sines
+        of their polar angles (n,) each."""
         h, w = self._p.shape
         flat = np.clip(np.searchsorted(self._cdf, u1, side="right") - 1, 0, h * w - 1)
         lo, hi = self._cdf[flat], self._cdf[flat + 1]
-        fu = np.clip((u1 - lo) / np.maximum(hi - lo, 1e-300), 0, 1)
+        fu = np.clip((u1 - lo) / np.maximum(hi - lo, 1e-300), 0, 1)     # u1's position within the texel's interval
         row, col = np.divmod(flat, w)
-        phi = np.pi - 2 * np.pi * (col + fu) / w
-        theta = np.pi - np.pi * (row + u2) / h
+        u = (col + fu) / w
+        v = (row + u2) / h
+        phi = np.pi - 2 * np.pi * u
+        theta = np.pi - np.pi * v
         st = np.sin(theta)
         t = np.stack([st * np.cos(phi), st * np.sin(phi), np.cos(theta)])
-        return (t if self.rotation is None else self.rotation.T.astype(np.float64) @ t).astype(np.float32)
+        d = (t if self.rotation is None else self.rotation.T.astype(np.float64) @ t).astype(np.float32)
+        return d, row, col, st
 
 
 #: directions probed per sun disc for its share of the sampling

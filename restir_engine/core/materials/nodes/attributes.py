@@ -98,7 +98,7 @@ class HitAttributes:
     def get(self, name: str):
         got = self._cache.get(name)
         if got is None:
-            got = self._cache[name] = self._compute(name)
+            got = self._cache[name] = self._path_value(name) if name in PATH_ATTRIBUTES else self._compute(name)
         return got
 
     def _path_value(self, name: str) -> np.ndarray:
@@ -215,8 +215,6 @@ class HitAttributes:
             return (t / np.maximum(norm(t), _F(1e-30))).astype(np.float32)
         if name == "ray_length":
             return np.zeros(n, np.float32)
-        if name in PATH_ATTRIBUTES:
-            return self._path_value(name)
         if name == "object_index":
             inst, objs = self._instances()
             idx = None if inst is None else getattr(objs, "pass_index", None)
