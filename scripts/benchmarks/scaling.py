@@ -104,7 +104,7 @@ def one(args) -> dict:
     import dataclasses
 
     import numpy as np
-    from restir_core.parallel import pool, processes, wire
+    from restir_core.parallel import pool, processes, timeline, wire
     from restir_core.pipeline.frame_render import render_frame
     from restir_core.profile import StageClock
 
@@ -135,6 +135,7 @@ def one(args) -> dict:
     still = spec["frames"] == 1 and procs > 1
     for f in range(2 if still else spec["frames"]):
         clock = StageClock()
+        timeline.mark("frame", str(f))
         t = time.perf_counter()
         r = render_frame(scenes[0 if still else f % len(scenes)],
                          dataclasses.replace(settings, frame=1 if spec["frames"] == 1 else f + 1),
@@ -150,6 +151,8 @@ def one(args) -> dict:
     steady = rows[1:] if len(rows) > 1 else rows
     order = sorted(range(len(steady)), key=lambda i: steady[i]["frame_s"])
     med = steady[order[len(order) // 2]]
+    timeline.mark("end")
+    timeline.dump("main")
     if team is not None:
         processes.shutdown()
     return {"cores": cores, "mode": args.mode, "frame_s": med["frame_s"], "frames_s": [r["frame_s"] for r in rows],
@@ -233,8 +236,12 @@ def run(args) -> None:
                     continue  # one process of one thread: the processes row's 1
                 cmd = [sys.executable, __file__, "one", "--scene", path, "--spec", spec, "--cores", str(n),
                        "--mode", mode if n > 1 else "processes"]
+                env = dict(os.environ)
+                if args.timeline and mode == "processes" and n > 1:  # each process's events (team_timeline.py)
+                    env["RESTIR_TIMELINE"] = os.path.join(args.timeline, f"{name.replace(' ', '_')}_{n}")
+                    os.makedirs(env["RESTIR_TIMELINE"], exist_ok=True)
                 t = time.perf_counter()
-                proc = subprocess.run(cmd, capture_output=True, text=True, timeout=args.timeout)
+                proc = subprocess.run(cmd, capture_output=True, text=True, timeout=args.timeout, env=env)
                 if proc.returncode != 0:
                     print(f"{name} {mode} {n}: failed\n{proc.stderr[-3000:]}", flush=True)
                     continue
@@ -344,12 +351,16 @@ def main(argv=None):
     r.add_argument("--no-spread", action="store_true",
                    help="share a still's later passes out pass by pass (not one per worker)")
     r.add_argument("--out", default=os.path.join(ROOT, "docs", "results", "scaling"))
+    r.add_argument("--timeline", default=None,
+                   help="a folder: record each multi-process run's barrier and message events there")
     o = sub.add_parser("one")
     o.add_argument("--scene")
     o.add_argument("--spec")
     o.add_argument("--cores")
     o.add_argument("--mode")
     o.add_argument("--first-core", type=int, default=0, help="the first of the cores it is pinned to")
+    t = sub.add_parser("timeline", help="where a team's processes wait (a folder of --timeline's events)")
+    t.add_argument("folder")
     c = sub.add_parser("chart")
     c.add_argument("--json", default=os.path.join(ROOT, "docs", "results", "scaling", "scaling.json"))
     args = ap.parse_args(argv)
@@ -359,6 +370,10 @@ def main(argv=None):
         run(args)
     elif args.step == "one":
         print(json.dumps(one(args)))
+    elif args.step == "timeline":
+        sys.path.insert(0, HERE)
+        from team_timeline import report
+        report(args.folder)
     else:
         chart(args)
 

@@ -26,7 +26,7 @@ from multiprocessing import connection
 
 import numpy as np
 
-from . import wire
+from . import timeline, wire
 
 CORE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BOOT_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "boot")
@@ -134,6 +134,8 @@ class WorkerTeam:
         closed)."""
         if self.closed:
             raise WorkerFailed("the render worker processes were shut down")
+        if timeline.FOLDER is not None:
+            timeline.mark("ask", msg[0])
         for i, c in enumerate(self.conns):
             try:
                 c.send(msg)
@@ -181,7 +183,10 @@ class WorkerTeam:
             self.stop.value = 0
             if any(r[0] == "stopped" for r in replies):
                 return None
-        return [wire.loads(r[1], "restir_core") for r in replies]
+        out = [wire.loads(r[1], "restir_core") for r in replies]
+        if timeline.FOLDER is not None:
+            timeline.mark("answered", msg[0])
+        return out
 
     def start_order(self) -> None:
         """Before the workers render passes at once, one each (team.Independent): none committed, no chunk added."""

@@ -22,6 +22,7 @@ import time
 
 import numpy as np
 
+from . import timeline
 from .tasks import Stopped
 
 ALIGN = 64  # bytes: each buffer starts on a cache line
@@ -144,10 +145,14 @@ class Team:
 
     def barrier(self) -> None:
         """Wait until every member arrives; a stop request (or a member that stopped) raises Stopped in all."""
+        if timeline.FOLDER is not None:
+            timeline.mark("arrive", timeline.caller(1))
         try:
             self._barrier.wait()
         except threading.BrokenBarrierError:
             raise Stopped from None
+        if timeline.FOLDER is not None:
+            timeline.mark("leave")
 
     def abort(self) -> None:
         """Release every member waiting at (or arriving at) the barrier with Stopped."""

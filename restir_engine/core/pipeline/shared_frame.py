@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..parallel import wire
+from ..parallel import timeline, wire
 from ..parallel.processes import WorkerTeam
 from ..sampling import finite
 from . import memory, methods, spread
@@ -113,7 +113,11 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         film_name, film = shared_film(team, scene, settings)
         slots = team.ensure_slots(slot_bytes(max(w * h, int(slot_pixels)), settings), keep_histories)
         usable = isinstance(history, SharedHistory) and history.team == team.id and history.fits(cam)
+        if timeline.FOLDER is not None:
+            timeline.mark("main", "film and slots")
         seg, packed = wire.pack(scene)
+        if timeline.FOLDER is not None:
+            timeline.mark("main", "scene packed")
         try:
             team.run(("frame", {"scene": packed, "settings": wire.dumps(settings), "sender": wire.core_name(),
                                 "history": history.token if usable else None, "film": film_name, "slots": slots,
@@ -164,6 +168,8 @@ def render_frame_shared(scene, settings: RenderSettings, team: WorkerTeam, progr
         if out["data"] is not None:
             passes["Depth"], passes["Normal"], passes["Vector"] = (finite(a) for a in out["data"])
         film.release()
+        if timeline.FOLDER is not None:
+            timeline.mark("main", "film read")
         stats = out["stats"]
         stats["processes"] = team.size
         stats["passes_one_per_process"] = at_once  # rendered whole by one worker each, at the same time

@@ -32,7 +32,7 @@ import traceback
 
 import numpy as np
 
-from ..parallel import wire
+from ..parallel import timeline, wire
 from ..parallel.pool import set_thread_count
 from ..parallel.team import FAILED, Arena, Team, film_zeros
 from .film import FILM_DTYPE
@@ -198,6 +198,8 @@ class _Worker:
             except EOFError:
                 return
             kind = msg[0]
+            if timeline.FOLDER is not None:
+                timeline.mark("recv", kind)
             if kind == "quit":
                 return
             try:
@@ -227,6 +229,8 @@ class _Worker:
                 else:
                     raise ValueError(f"unknown message {kind!r}")
                 self.conn.send(("ok", wire.dumps(out)))
+                if timeline.FOLDER is not None:
+                    timeline.mark("sent", kind)
             except Exception as exc:  # the others must not wait for this one at a barrier or for its turn
                 self.stop.value = FAILED
                 self.barrier.abort()
@@ -237,7 +241,10 @@ def serve(rank: int, size: int, conn, barrier, stop, progress, threads: int, ord
     worker = _Worker(rank, size, conn, barrier, stop, progress, threads, order)
     folder = os.environ.get(PROFILE_ENV)
     if not folder:
-        worker.serve()
+        try:
+            worker.serve()
+        finally:
+            timeline.dump(f"worker{rank}")
         return
     import cProfile  # a measurement aid (scripts/benchmarks/scaling.py --profile): each worker's own profile
     profile = cProfile.Profile()

@@ -1,0 +1,109 @@
+"""Where a team of worker processes waits: read the events one multi-process run recorded
+(``scaling.py run --timeline DIR``; restir_engine/core/parallel/timeline.py) and print, per steady frame (frames
+after the first) and per worker, the time spent waiting at each barrier site and for the rendering process's next
+message, which site's barrier each worker reached last (the one the team waited for), and what the rendering process
+did between its messages. Writes ``timeline.json`` beside the events.
+"""
+from __future__ import annotations
+
+import glob
+import json
+import os
+from collections import defaultdict
+
+import numpy as np
+
+
+def _load(folder: str):
+    main = json.load(open(os.path.join(folder, "main.json")))
+    workers = {}
+    for path in glob.glob(os.path.join(folder, "worker*.json")):
+        workers[int(os.path.basename(path)[6:-5])] = json.load(open(path))
+    return main, dict(sorted(workers.items()))
+
+
+def _barriers(events, lo: float, hi: float) -> list:
+    """(arrive, leave, site) of each barrier passed within [lo, hi)."""
+    out, arrive = [], None
+    for t, kind, label in events:
+        if kind == "arrive":
+            arrive = (t, label)
+        elif kind == "leave" and arrive is not None:
+            if lo <= arrive[0] < hi:
+                out.append((arrive[0], t, arrive[1]))
+            arrive = None
+    return out
+
+
+def _message_waits(events, lo: float, hi: float) -> dict:
+    """Seconds between a worker's reply and its next message within [lo, hi), by 'reply -> message' kinds."""
+    waits, last = defaultdict(float), None
+    for t, kind, label in events:
+        if kind == "sent":
+            last = (t, label)
+        elif kind == "recv" and last is not None:
+            if lo <= last[0] and t < hi:
+                waits[f"{last[1]} -> {label}"] += t - last[0]
+            last = None
+    return dict(waits)
+
+
+def _main_gaps(events, lo: float, hi: float) -> dict:
+    """The rendering process's seconds between its marks within [lo, hi): from each event to the next, named by
+    both (answered X -> main Y -> ask Z)."""
+    gaps = defaultdict(float)
+    inside = [(t, k if k == "frame" else f"{k} {lab}".strip()) for t, k, lab in events if lo <= t < hi]
+    for (t0, a), (t1, b) in zip(inside, inside[1:]):
+        if not a.startswith("ask"):  # from an ask to its answer the workers work
+            gaps[f"{a} -> {b}"] += t1 - t0
+    return dict(gaps)
+
+
+def report(folder: str) -> dict:
+    main, workers = _load(folder)
+    frames = [t for t, k, _ in main if k == "frame"]
+    end = next(t for t, k, _ in main if k == "end")
+    lo = frames[1] if len(frames) > 1 else frames[0]
+    steady = len(frames) - 1 if len(frames) > 1 else 1
+    wall = (end - lo) / steady
+    size = len(workers)
+    per = {r: _barriers(ev, lo, end) for r, ev in workers.items()}
+    n = min(len(b) for b in per.values())
+    site_wait, site_count, last_at, spread = defaultdict(float), defaultdict(int), defaultdict(lambda: defaultdict(int)), \
+        defaultdict(float)
+    for k in range(n):
+        arrivals = np.array([per[r][k][0] for r in workers])
+        site = per[0][k][2]
+        site_count[site] += 1
+        spread[site] += arrivals.max() - arrivals.min()
+        last_at[site][list(workers)[int(arrivals.argmax())]] += 1
+        for r in workers:
+            site_wait[site] += per[r][k][1] - per[r][k][0]
+    msg = defaultdict(float)
+    for r, ev in workers.items():
+        for key, v in _message_waits(ev, lo, end).items():
+            msg[key] += v
+    out = {
+        "frame_s": wall, "workers": size, "barriers_per_frame": n / steady,
+        "barrier_wait_per_worker_s": sum(site_wait.values()) / size / steady,
+        "message_wait_per_worker_s": sum(msg.values()) / size / steady,
+        "sites": {s: {"per_frame": site_count[s] / steady, "wait_per_worker_s": site_wait[s] / size / steady,
+                      "mean_spread_s": spread[s] / site_count[s],
+                      "last": dict(sorted(last_at[s].items(), key=lambda kv: -kv[1])[:4])}
+                  for s in sorted(site_wait, key=lambda s: -site_wait[s])},
+        "message_waits_per_worker_s": {k: v / size / steady for k, v in sorted(msg.items(), key=lambda kv: -kv[1])},
+        "main_gaps_s": {k: v / steady for k, v in sorted(_main_gaps(main, lo, end).items(), key=lambda kv: -kv[1])},
+    }
+    with open(os.path.join(folder, "timeline.json"), "w") as fh:
+        json.dump(out, fh, indent=1)
+    print(f"{folder}: frame {wall:.3f} s, {size} workers, {out['barriers_per_frame']:.0f} barriers a frame; "
+          f"a worker waits {out['barrier_wait_per_worker_s']:.3f} s at barriers and "
+          f"{out['message_wait_per_worker_s']:.3f} s for messages a frame")
+    for s, rec in list(out["sites"].items())[:12]:
+        print(f"  {rec['wait_per_worker_s']:.3f} s  x{rec['per_frame']:.1f}  spread {rec['mean_spread_s'] * 1e3:6.1f} ms"
+              f"  last: {rec['last']}  {s}")
+    for k, v in list(out["message_waits_per_worker_s"].items())[:6]:
+        print(f"  message wait {v:.3f} s  {k}")
+    for k, v in list(out["main_gaps_s"].items())[:10]:
+        print(f"  rendering process {v:.3f} s  {k}")
+    return out
