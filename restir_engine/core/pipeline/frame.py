@@ -468,7 +468,7 @@ class FrameRenderer:
                                                 self.prev_history, self.reuse_stats)
             hand_back(mine, "gi_res", gi_res)
         if plan.sample == 0 and gb is not None and self.keeps_history:
-            self._keep_history(gb, res, gb_gi, gi_history, gi_reused)
+            self._keep_history(run, gb, res, gb_gi, gi_history, gi_reused)
         unbiased = st.bias_correction == "UNBIASED"
         with run.stage("shade"):
             run.map_chunks(lambda c: shade.shade(ctx, plan, gi_reused, unbiased, c, self.catchers), chunks, 2)
@@ -484,12 +484,13 @@ class FrameRenderer:
             self.batches.unsettle()  # the active pixels changed: the batch is chosen again
         return plan.batch
 
-    def _keep_history(self, gb, res, gb_gi, gi_history, gi_reused: bool) -> None:
+    def _keep_history(self, run, gb, res, gb_gi, gi_history, gi_reused: bool) -> None:
         """The next frame's history from this first pass; confidence at most the cap, so no reused M exceeds it."""
         st, lights = self.settings, self.ctx.lights
         self.team.kept()
+        cap = st.confidence_cap
         self.history = TemporalHistory(
-            gb, None if res is None else res.replace(M=np.minimum(res.M, st.confidence_cap)), self.ctx.scene.camera,
-            lights.signature, st.frame, lights.light_uid, lights.uid_space,
-            gi_res=None if gi_history is None else reuse.age_history(self.gi, gi_history),
+            gb, None if res is None else run.per_span(res, lambda r: r.replace(M=np.minimum(r.M, cap))),
+            self.ctx.scene.camera, lights.signature, st.frame, lights.light_uid, lights.uid_space,
+            gi_res=None if gi_history is None else run.per_span(gi_history, lambda r: reuse.age_history(self.gi, r)),
             gi_terms=None if gb_gi is None else gb_gi.terms, gi_key=self.gi_light_key if gi_reused else None)

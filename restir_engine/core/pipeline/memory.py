@@ -31,7 +31,7 @@ GI_HISTORY = 260  # ... and the GI reservoirs' and terms'
 DENOISER = 112    # the denoiser's images after the frame: its cleaned inputs, guides, prefiltered guides, output
 DENOISED_PASSES = 128  # the frame's passes while it is denoised (float32: Combined, guides, Noisy Image, a few more)
 DENOISER_SCRATCH = 1024 << 20  # OIDN's scratch memory, capped by the caller (restir_engine/denoise.py)
-BAND_BYTES = 1536 << 20  # one band's working set at most (pipeline/bands.py)
+BAND_BYTES = 2048 << 20  # one band's working set at most (pipeline/bands.py)
 MIN_BAND_ROWS = 32
 
 

@@ -46,6 +46,15 @@ def spatial(run: PassRunner, space, gb, res, cfg, stream, stage):
         return run.gather(space.kind, parts, len(gb))
 
 
+PERCENTILE_STRIDE = 16  # the confidence percentiles (a diagnostic) are read from every 16th reservoir
+
+
+def m_percentiles(m: np.ndarray) -> list:
+    """The 10th, 50th and 90th percentiles of the confidences ``m``, estimated from every PERCENTILE_STRIDE-th (the
+    leader computes them while the team waits at the next barrier)."""
+    return [float(v) for v in np.percentile(m[::PERCENTILE_STRIDE], [10, 50, 90])]
+
+
 def reuse_di(run: PassRunner, st, ctx, space, spatial_cfg, gb, res, hist, stats: dict):
     """Temporal (where the plan says), boiling filter, spatial passes. Returns (the final reservoirs, the number
     of reservoirs the boiling filter emptied)."""
@@ -68,7 +77,7 @@ def reuse_di(run: PassRunner, st, ctx, space, spatial_cfg, gb, res, hist, stats:
     for k in range(spatial_cfg.passes if spatial_cfg.neighbors else 0):
         res = spatial(run, space, gb, res, spatial_cfg, STREAM_SPATIAL + k, "spatial")
     if len(res.M) and run.team.leader:
-        stats["final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
+        stats["final_M_p10_p50_p90"] = m_percentiles(res.M)
     return res, dropped
 
 
@@ -103,7 +112,7 @@ def reuse_gi(run: PassRunner, st, ctx, gi_cfg, gi_space, gi_spatial, gb, res, hi
         res = spatial(run, gi_space, gb, res, gi_spatial, STREAM_GI_SPATIAL + k, "gi_spatial")
         res = gi_visible(run, ctx, gb, res, unbiased, "gi_spatial")
     if len(res.M) and run.team.leader:
-        stats["gi_final_M_p10_p50_p90"] = [float(v) for v in np.percentile(res.M, [10, 50, 90])]
+        stats["gi_final_M_p10_p50_p90"] = m_percentiles(res.M)
     return res, history
 
 

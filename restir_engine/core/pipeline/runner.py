@@ -49,6 +49,17 @@ class PassRunner:
         self.team.barrier()
         return out
 
+    def per_span(self, res, make):
+        """``make(part)`` of the reservoirs ``res`` as one set of the same kind, where ``make`` works reservoir by
+        reservoir: at once alone, or on a team each member its spans into the team's shared buffers (complete once
+        the barrier passed), so that no member computes the whole frame's."""
+        if self.team.size == 1:
+            return make(res)
+        out = frame_array(type(res), len(res), self.team)
+        self.map(lambda rows: out.assign(rows, make(res.take(rows))), self.spans(len(res)))
+        self.team.barrier()
+        return out
+
     def spans(self, n: int) -> list[slice]:
         """The frame's n surfaces (or pixels) in chunk-sized slices."""
         return spans(n, self.tile_pixels)
