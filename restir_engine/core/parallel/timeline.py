@@ -19,8 +19,9 @@ _events: list = []
 
 
 def mark(kind: str, label: str = "") -> None:
-    """Record event ``kind`` (with ``label``) now."""
-    _events.append((time.perf_counter(), kind, label))
+    """Record event ``kind`` (with ``label``) now, with the CPU seconds this process has used so far (a worker whose
+    wall time between two events exceeds its CPU time was waiting or not scheduled)."""
+    _events.append((time.perf_counter(), kind, label, time.process_time()))
 
 
 def caller(depth: int) -> str:
