@@ -19,7 +19,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CASES = ("ablation_restir_di", "adaptive", "coverage", "default_cube", "defaults", "denoise", "direct_methods",
          "first_sample", "foundation", "frame_cost", "gi_materials", "glass", "integrators", "material_cost",
          "memory", "memory_1080p", "memory_bands", "motion_blur", "node_cost", "pan", "restir_di", "restir_gi",
-         "scaling", "scene_update", "sky", "stages", "subsurface", "third_party", "viewport", "world_light",
+         "scaling", "scene_update", "sky", "stages", "subsurface", "team_timeline", "third_party", "viewport",
+         "world_light",
          "world_reservoirs", "evaluate")
 
 

@@ -1,13 +1,14 @@
-"""Where a team of worker processes waits: read the events one multi-process run recorded
-(``scaling.py run --timeline DIR``; restir_engine/core/parallel/timeline.py) and print, per steady frame (frames
-after the first) and per worker, the time spent waiting at each barrier site and for the rendering process's next
-message, which site's barrier each worker reached last (the one the team waited for), and what the rendering process
-did between its messages, and per barrier site how long the last arriver and the others spent off the CPU since
-the barrier before (wall minus CPU time: waiting for a lock or a message, or not scheduled). Writes
-``timeline.json`` beside the events.
+"""Where a team of worker processes waits: read the events one multi-process run recorded (``scaling.py run
+--timeline DIR``; restir_engine/core/parallel/timeline.py) and print, per steady frame (frames after the first) and
+per worker, the time spent waiting at each barrier site and for the rendering process's next message, which site's
+barrier each worker reached last (the one the team waited for), what the rendering process did between its messages,
+and per barrier site how long the last arriver and the others spent off the CPU since the barrier before (wall minus
+CPU time: waiting for a lock or a message, or not scheduled). Writes ``timeline.json`` beside the events.
+Run: ``scripts/bench.py team_timeline FOLDER`` (or ``scaling.py timeline FOLDER``).
 """
 from __future__ import annotations
 
+import argparse
 import glob
 import json
 import os
@@ -117,3 +118,13 @@ def report(folder: str) -> dict:
     for k, v in list(out["main_gaps_s"].items())[:10]:
         print(f"  rendering process {v:.3f} s  {k}")
     return out
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("folder", help="one run's events (a folder under scaling.py run --timeline DIR)")
+    report(ap.parse_args(argv).folder)
+
+
+if __name__ == "__main__":
+    main()

@@ -235,15 +235,15 @@ class Exits:
 def _same_object_hits(ctx, o, d, tmax, obj):
     """The nearest hit (prim, t, u, v) of rays (o, d, up to tmax) on their own object ``obj`` (k,), passing through
     other objects' surfaces (prim -1: none within tmax)."""
-    hits = ctx.geom_accel.intersect(o, d, tmax)
-    prim, t, u, v = hits.prim.copy(), hits.t.copy(), hits.u.copy(), hits.v.copy()
+    hits = ctx.geom_accel.intersect(o, d, tmax)  # fresh arrays, this function's to change
+    prim, t, u, v = hits.prim, hits.t, hits.u, hits.v
     inst = ctx.scene.geometry.instance
     if inst is None:
         return prim, t, u, v
     for _ in range(OTHER_OBJECT_SKIPS):
         other = np.flatnonzero((prim >= 0) & (inst[np.maximum(prim, 0)] != obj))
         if other.size == 0:
-            break
+            return prim, t, u, v
         dd = cols(d, other)
         start = cols(o, other) + dd * t[other]
         step = np.maximum(vmax(np.abs(start)), np.float32(1.0)) * np.float32(1e-4)
