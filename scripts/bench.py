@@ -20,8 +20,7 @@ CASES = ("ablation_restir_di", "adaptive", "coverage", "default_cube", "defaults
          "first_sample", "foundation", "frame_cost", "gi_materials", "glass", "integrators", "material_cost",
          "memory", "memory_1080p", "memory_bands", "motion_blur", "node_cost", "pan", "restir_di", "restir_gi",
          "scaling", "scene_update", "sky", "stages", "subsurface", "team_timeline", "third_party", "viewport",
-         "world_light",
-         "world_reservoirs", "evaluate")
+         "world_light", "world_reservoirs", "evaluate")
 
 
 def bootstrap() -> None:

@@ -352,15 +352,14 @@ def main(argv=None):
                    help="share a still's later passes out pass by pass (not one per worker)")
     r.add_argument("--out", default=os.path.join(ROOT, "docs", "results", "scaling"))
     r.add_argument("--timeline", default=None,
-                   help="a folder: record each multi-process run's barrier and message events there")
+                   help="a folder: record each multi-process run's barrier and message events there "
+                        "(read by scripts/bench.py team_timeline)")
     o = sub.add_parser("one")
     o.add_argument("--scene")
     o.add_argument("--spec")
     o.add_argument("--cores")
     o.add_argument("--mode")
     o.add_argument("--first-core", type=int, default=0, help="the first of the cores it is pinned to")
-    t = sub.add_parser("timeline", help="where a team's processes wait (a folder of --timeline's events)")
-    t.add_argument("folder")
     c = sub.add_parser("chart")
     c.add_argument("--json", default=os.path.join(ROOT, "docs", "results", "scaling", "scaling.json"))
     args = ap.parse_args(argv)
@@ -370,10 +369,6 @@ def main(argv=None):
         run(args)
     elif args.step == "one":
         print(json.dumps(one(args)))
-    elif args.step == "timeline":
-        sys.path.insert(0, HERE)
-        from team_timeline import report
-        report(args.folder)
     else:
         chart(args)
 

@@ -4,7 +4,7 @@ per worker, the time spent waiting at each barrier site and for the rendering pr
 barrier each worker reached last (the one the team waited for), what the rendering process did between its messages,
 and per barrier site how long the last arriver and the others spent off the CPU since the barrier before (wall minus
 CPU time: waiting for a lock or a message, or not scheduled). Writes ``timeline.json`` beside the events.
-Run: ``scripts/bench.py team_timeline FOLDER`` (or ``scaling.py timeline FOLDER``).
+Run: ``scripts/bench.py team_timeline FOLDER``.
 """
 from __future__ import annotations
 

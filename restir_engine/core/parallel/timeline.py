@@ -4,7 +4,7 @@ the rendering process and its workers.
 Recorded only where the environment variable RESTIR_TIMELINE names a folder (workers inherit it); each process then
 writes its events to ``<folder>/<name>.json`` when it ends. Times are ``time.perf_counter()`` seconds, which on
 Linux is CLOCK_MONOTONIC, one clock for every process of the machine, so the records line up.
-``scripts/benchmarks/scaling.py timeline FOLDER`` reads them.
+``scripts/bench.py team_timeline FOLDER`` reads them.
 """
 from __future__ import annotations
 
